@@ -1,0 +1,1 @@
+"""Command-line subcommands, one module each; :mod:`helmcheck.cli` dispatches to them."""

@@ -1,0 +1,27 @@
+"""The wire format of the remote helm protocol: grammar, typed sentences, codec and framer.
+
+``remote_helm.lark`` (in this package) is the one definition of every sentence. This package is
+sans-IO: it imports no serial, clock or threading module.
+
+Public API::
+
+    parse(line, profile=DEFAULT) -> Sentence          # raises SentenceError
+    decode(line, profile=DEFAULT) -> Decoded           # never raises; .sentence/.error/.findings
+    format(sentence) -> bytes                          # canonical: upper-case checksum, CR LF
+    checksum(body) -> int;  checksum_hex(body) -> str
+    Framer(max_line=256).feed(bytes) -> [Line | Discard]
+"""
+
+from .capture import WireLogError, WireLogWriter, WireRecord, read_records
+from .checksum import checksum, checksum_hex
+from .codec import KNOWN_IDS, Decoded, decode, format, format_body, parse
+from .errors import Finding, SentenceError
+from .framer import Discard, Framer, Line
+from .sentences import *  # noqa: F401,F403
+from .sentences import __all__ as _sentence_names
+
+__all__ = [
+    "parse", "decode", "format", "format_body", "Decoded", "KNOWN_IDS", "checksum",
+    "checksum_hex", "Framer", "Line", "Discard", "SentenceError", "Finding", "WireRecord",
+    "WireLogError", "WireLogWriter", "read_records", *_sentence_names,
+]

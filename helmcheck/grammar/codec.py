@@ -1,0 +1,305 @@
+"""Parse one line into a typed sentence, and format a sentence into canonical bytes.
+
+``decode(line, profile)`` is the full reading of one line — framing (RH-FRM-1..7), checksum
+(RH-FRM-2/3), ID (RH-FRM-5, RH-RD-16), field syntax (the grammar), and value ranges (the
+profile) — and returns a :class:`Decoded` with the sentence, or the first error, plus SHOULD
+findings. ``parse`` is the same but raises :class:`SentenceError`. ``format`` writes canonical
+bytes: upper-case zero-padded checksum and CR LF, so ``parse(format(s)) == s`` and, for
+canonical input, ``format(parse(b)) == b``.
+
+Two engines read the body: ``"fast"`` (regular expressions compiled from the grammar, the
+default) and ``"lark"`` (the Lark LALR parser over the same grammar). They agree; the property
+tests prove it. Errors are always located with Lark, which knows where a parse went wrong.
+"""
+
+from __future__ import annotations
+
+import builtins
+import re
+from dataclasses import dataclass, field
+from decimal import Decimal
+from typing import Optional
+
+from lark import Token, Tree
+from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, UnexpectedToken
+
+from ..profile import DEFAULT, Profile
+from . import sentences as S
+from .checksum import checksum
+from .compile import build_sentence, lark_parser, specs
+from .errors import FRAMING, SYNTAX, Finding, SentenceError
+from .ranges import check_ranges
+
+__all__ = ["decode", "parse", "format", "format_body", "Decoded", "KNOWN_IDS", "rules_for_id"]
+
+
+@dataclass(frozen=True)
+class Decoded:
+    """Everything learned from one line."""
+
+    raw: bytes
+    sentence: Optional[S.Sentence] = None
+    error: Optional[SentenceError] = None
+    findings: tuple[Finding, ...] = ()
+    sentence_id: Optional[str] = None
+    terminator: str = ""  #: "\r\n", "\n" or "" (none)
+
+    @property
+    def valid(self) -> bool:
+        return self.sentence is not None
+
+    def as_dict(self) -> dict:
+        s = self.sentence
+        return {
+            "type": type(s).__name__ if s is not None else None,
+            "id": self.sentence_id,
+            "valid": self.valid,
+            "fields": s.as_dict() if s is not None else None,
+            "errors": [self.error.as_dict()] if self.error else [],
+            "findings": [f.as_dict() for f in self.findings],
+        }
+
+
+# --------------------------------------------------------------------------- ID dispatch
+
+def _first_literal(rule_pattern: str) -> str:
+    m = re.match(r"[A-Z]+", rule_pattern)
+    return m.group(0) if m else ""
+
+
+_RULES_BY_ID: dict[str, list] = {}
+for _spec in specs().values():
+    _RULES_BY_ID.setdefault(_first_literal(_spec.regex.pattern), []).append(_spec)
+KNOWN_IDS = frozenset(_RULES_BY_ID)
+_COMMAND_ERR = {cls.ID: (cls.ACK_TYPE, cls.ERR) for cls in S.COMMAND_CLASSES if cls.ACK_TYPE}
+_REPLY_CLAUSE = {"OSI": "RH-OUT-1", "ACK": "RH-ACK-1"}
+_ID_RE = re.compile(r"[A-Z]+")
+_CHECKSUM_RE = re.compile(r"[0-9A-Fa-f]{2}")
+_BAD_BYTE = re.compile(rb"[^\x20-\x7e]")
+
+
+def rules_for_id(sentence_id: str) -> list:
+    """The compiled sentence rules whose body starts with this ID (OMSTART and OMW have two)."""
+    return _RULES_BY_ID.get(sentence_id, [])
+
+
+# --------------------------------------------------------------------------- decoding
+
+def _fail(raw: bytes, err: SentenceError, findings=(), sid=None, term="") -> Decoded:
+    return Decoded(raw, None, err, tuple(findings), sid, term)
+
+
+def decode(line: bytes | str, profile: Profile = DEFAULT, engine: str = "fast") -> Decoded:
+    """Read one line (with or without its terminator). Never raises for bad input."""
+    raw = line.encode("latin-1", "replace") if isinstance(line, str) else bytes(line)
+    findings: list[Finding] = []
+    if raw.endswith(b"\r\n"):
+        term, data = "\r\n", raw[:-2]
+    elif raw.endswith(b"\n"):
+        term, data = "\n", raw[:-1]
+        findings.append(Finding("RH-FRM-7", "line ends in a bare LF; CR LF expected (RH-BS-7)", len(raw)))
+    else:
+        term, data = "", raw
+    total = len(data) + (len(term) or 2)
+    if total > profile.max_line_bytes:
+        return _fail(raw, SentenceError("RH-FRM-6", f"line is {total} bytes, longer than "
+                                        f"{profile.max_line_bytes} with its terminator", profile.max_line_bytes + 1), findings, term=term)
+    if not data.startswith(b"$"):
+        return _fail(raw, SentenceError("RH-FRM-7", "line does not start with '$'", 1), findings, term=term)
+    bad = _BAD_BYTE.search(data)
+    if bad:
+        return _fail(raw, SentenceError("RH-FRM-1", f"byte 0x{data[bad.start()]:02X} is not printable ASCII",
+                                        bad.start() + 1), findings, term=term)
+    text = data.decode("ascii")
+    star = text.find("*")
+    if star < 0:
+        return _fail(raw, SentenceError("RH-FRM-4", "checksum missing: no '*'", len(text) + 1), findings, term=term)
+    if text.find("*", star + 1) >= 0:
+        return _fail(raw, SentenceError("RH-FRM-4", "line has two '*' (RH-RD-16)", text.find("*", star + 1) + 1),
+                     findings, term=term)
+    cks = text[star + 1:]
+    if not (len(cks) == 2 and _CHECKSUM_RE.fullmatch(cks)):
+        return _fail(raw, SentenceError("RH-FRM-4", f"checksum {cks!r} is not exactly two hex digits", star + 2),
+                     findings, term=term)
+    if cks != cks.upper():
+        if not profile.lowercase_checksum_in:
+            return _fail(raw, SentenceError("RH-FRM-3", f"checksum {cks} is lower-case hex", star + 2), findings, term=term)
+        findings.append(Finding("RH-FRM-3", f"checksum {cks} is lower-case hex; upper case expected (RH-BS-7)", star + 2))
+    body = text[1:star]
+    want = checksum(data[1:star])
+    if int(cks, 16) != want:
+        return _fail(raw, SentenceError("RH-FRM-2", f"checksum {cks.upper()} does not match computed {want:02X}",
+                                        star + 2), findings, term=term)
+    m = _ID_RE.match(body)
+    head = body.split(",", 1)[0]
+    if m is None or (m.end() != len(head) and not (m.group(0) == "C" and head[1:2] in "-0123456789")):
+        return _fail(raw, SentenceError("RH-FRM-5", f"unknown ID {head!r} (IDs are upper-case letters, RH-RD-16)", 2),
+                     findings, term=term)
+    sid = "C" if m.group(0) == "C" and m.end() != len(head) else m.group(0)
+    if sid not in KNOWN_IDS:
+        return _fail(raw, SentenceError("RH-FRM-5", f"unknown ID {sid!r}", 2), findings, sid, term)
+    sentence = _read_body(body, sid, engine)
+    if isinstance(sentence, SentenceError):
+        return _fail(raw, sentence, findings, sid, term)
+    problem = check_ranges(sentence, profile)
+    if problem is not None:
+        return _fail(raw, problem, findings, sid, term)
+    return Decoded(raw, sentence, None, tuple(findings), sid, term)
+
+
+def parse(line: bytes | str, profile: Profile = DEFAULT, engine: str = "fast") -> S.Sentence:
+    """The sentence on this line; raises :class:`SentenceError` naming clause and column."""
+    d = decode(line, profile, engine)
+    if d.error is not None:
+        raise d.error
+    return d.sentence  # type: ignore[return-value]
+
+
+def _read_body(body: str, sid: str, engine: str):
+    if engine == "fast":
+        for spec in _RULES_BY_ID[sid]:
+            m = spec.regex.fullmatch(body)
+            if m is not None:
+                return build_sentence(spec, m.groupdict())
+        return _locate_error(body, sid)
+    if engine == "lark":
+        try:
+            tree = lark_parser().parse(body, start="body")
+        except UnexpectedInput:
+            return _locate_error(body, sid)
+        return _from_tree(tree.children[0])
+    raise ValueError(f"unknown engine {engine!r}")
+
+
+def _from_tree(node: Tree) -> S.Sentence:
+    """Build the sentence from a Lark tree, through the same builder as the fast path."""
+    spec = specs()[str(node.data)]
+    raw: dict[str, Optional[str]] = {}
+    for child in node.children:
+        if child is None or not isinstance(child, Tree):
+            continue
+        name = str(child.data)
+        if name.endswith("_item"):
+            raw[name] = (raw.get(name) or "") + _text(child, with_separators=True)
+        elif name.endswith("_opt"):
+            raw[name] = _text(child, with_separators=True)
+        elif name == "trailing_empty":
+            raw[name] = ","
+        else:
+            raw[name] = _text(child, with_separators=False)
+    return build_sentence(spec, raw)
+
+
+_ITEM_SEPARATOR = {"compass_extra_item": ""}
+
+
+def _text(t: Tree, with_separators: bool) -> str:
+    """Text of a field subtree. Items and opts get their separator back (Lark drops literals)."""
+    parts = [str(c) for c in t.children if isinstance(c, Token)]
+    if not with_separators:
+        return "".join(parts)
+    name = str(t.data)
+    sep = _ITEM_SEPARATOR.get(name, ",")
+    if name == "oysi_readings_item":
+        return "," + ",".join(parts)
+    return sep + "".join(parts)
+
+
+def _locate_error(body: str, sid: str) -> SentenceError:
+    """Why and where the body does not follow the grammar (RH-ACK-3 / RH-OUT-1/2)."""
+    column = None
+    what = "does not follow the grammar"
+    try:
+        lark_parser().parse(body, start="body")
+    except UnexpectedEOF:
+        column, what = len(body) + 2, "too few fields"
+    except UnexpectedToken as e:
+        column = (e.column or 0) + 1
+        if e.token.type == "$END":
+            what = "too few fields"
+        elif e.token.type == "COMMA":
+            what = "too many fields or an empty field"
+        else:
+            what = f"unexpected {str(e.token)!r}"
+    except UnexpectedCharacters as e:
+        column = e.column + 1
+        what = f"unexpected {body[e.pos_in_stream:e.pos_in_stream + 8]!r}"
+    field_name = None
+    if what in ("too few fields", "too many fields or an empty field"):
+        what = f"{what} (got {body.count(',')})"
+    elif column is not None:
+        idx = body[: max(column - 2, 0)].count(",")  # 0 = the ID, 1 = first field
+        names = _RULES_BY_ID[sid][0].cls.field_names() if _RULES_BY_ID.get(sid) else ()
+        field_name = names[idx - 1] if 0 < idx <= len(names) else f"field {idx}"
+        what = f"{field_name}: {what}" if idx > 0 else what
+    ack_type, ack_err = _COMMAND_ERR.get(sid, (None, None))
+    clause = "RH-ACK-3" if ack_type is not None else _REPLY_CLAUSE.get(sid, "RH-OUT-2")
+    if sid == "OXFLT":
+        clause = "RH-SAF-5"
+    return SentenceError(clause, f"${sid} {what}", column, SYNTAX, sid, field_name, ack_type, ack_err)
+
+
+# --------------------------------------------------------------------------- formatting
+
+def _fmt(v) -> str:
+    if isinstance(v, Decimal):
+        return builtins.format(v, "f")
+    if v is None:
+        return ""
+    return str(v)
+
+
+#: Optional fields whose ``None`` means "absent" (the sentence stops there), not "empty".
+_TAIL_OPTIONAL = {
+    S.OMSTART: ("srp",),
+    S.GPRMC: ("mode",),
+    S.ORWSET: ("state",),
+    S.OSI: ("mission_name", "remaining_time", "true_heading", "depth", "battery", "srp_active",
+            "vehicle_name"),
+}
+
+
+def _fields(s: S.Sentence) -> list[str]:
+    cls = type(s)
+    tail = _TAIL_OPTIONAL.get(cls, ())
+    out: list[str] = []
+    for name in cls.field_names():
+        v = getattr(s, name)
+        if name in tail and v is None:
+            break
+        if isinstance(v, bool):
+            if v:
+                out.append("")
+            continue
+        if isinstance(v, tuple):
+            for item in v:
+                if isinstance(item, tuple):
+                    out.extend(_fmt(x) for x in item)
+                else:
+                    out.append(_fmt(item))
+            continue
+        if isinstance(v, S.Sentence):
+            out.extend(_fields(v))
+            continue
+        if name == "park_time" and cls is S.OSI:
+            out.append(f"P{v}")
+            continue
+        out.append(_fmt(v))
+    return out
+
+
+def format_body(s: S.Sentence) -> str:
+    """The text between ``$`` and ``*``."""
+    if isinstance(s, S.Compass):
+        text = (f"C{_fmt(s.heading)}P{_fmt(s.pitch)}R{_fmt(s.roll)}T{_fmt(s.temperature)}"
+                f"D{_fmt(s.depth)}")
+        return text + "".join(f"{k}{_fmt(v)}" for k, v in s.extra)
+    parts = _fields(s)
+    return s.ID + "".join("," + p for p in parts)
+
+
+def format(s: S.Sentence, lowercase: bool = False, terminator: str = "\r\n") -> bytes:  # noqa: A001
+    """Canonical bytes of a sentence: ``$body*HH`` + CR LF (RH-FRM-1..3)."""
+    body = format_body(s).encode("latin-1")
+    cks = "%02x" % checksum(body) if lowercase else "%02X" % checksum(body)
+    return b"$" + body + b"*" + cks.encode() + terminator.encode()

@@ -1,0 +1,63 @@
+"""Compliance reports: pure functions of a results directory (``results.json`` + ``wire.log``).
+
+Modules, one concern each:
+
+* :mod:`~helmcheck.reports.results` — ``results.json`` schema 1: builder, validator, loader,
+  verdict rules (:func:`overall_verdict`, :func:`run_verdict`, :func:`exit_code`).
+* :mod:`~helmcheck.reports.atomic` — atomic file writes.
+* :mod:`~helmcheck.reports.digest` — the certificate digest (SHA-256 of both files).
+* :mod:`~helmcheck.reports.wirelog` — a tolerant summary of the wire log.
+* :mod:`~helmcheck.reports.rundir` — one read of a results directory (:class:`Run`).
+* :mod:`~helmcheck.reports.view` — clause rows joined with the profile, grouped and counted.
+* :mod:`~helmcheck.reports.text` — printable text, short titles.
+* :mod:`~helmcheck.reports.timeline` — the mode timeline SVG.
+* :mod:`~helmcheck.reports.html`, :mod:`~helmcheck.reports.junit`,
+  :mod:`~helmcheck.reports.markdown`, :mod:`~helmcheck.reports.compare` — the renderings.
+* :mod:`~helmcheck.reports.render` — :func:`render_all` and the ``helmcheck report`` command.
+"""
+
+from .digest import Digest, digest_bytes, digest_dir
+from .render import main, render_all
+from .results import (
+    CLAUSE_VERDICTS,
+    VERDICTS,
+    ReportError,
+    add_clause,
+    add_event,
+    add_mode,
+    add_replay,
+    exit_code,
+    finish,
+    load_results,
+    new_results,
+    overall_verdict,
+    run_verdict,
+    validate,
+    write_results_atomic,
+)
+from .rundir import Run, load_run
+
+__all__ = [
+    "CLAUSE_VERDICTS",
+    "VERDICTS",
+    "Digest",
+    "ReportError",
+    "Run",
+    "add_clause",
+    "add_event",
+    "add_mode",
+    "add_replay",
+    "digest_bytes",
+    "digest_dir",
+    "exit_code",
+    "finish",
+    "load_results",
+    "load_run",
+    "main",
+    "new_results",
+    "overall_verdict",
+    "render_all",
+    "run_verdict",
+    "validate",
+    "write_results_atomic",
+]

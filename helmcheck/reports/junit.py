@@ -1,0 +1,101 @@
+"""JUnit XML for CI dashboards: one ``<testcase>`` per clause of the results.
+
+Mapping (classname = section of the reference profile, name = clause ID + short title):
+
+* ``pass`` → a plain testcase;
+* ``fail`` → ``<failure message="reason" type="MUST|SHOULD">`` with the wire evidence as text;
+* ``inconclusive`` → ``<error message="reason" type="inconclusive">``;
+* ``not-tested`` → ``<skipped message="reason">``;
+* ``non-strict`` → passes with a ``<system-out>`` note, or ``<failure type="non-strict">`` when
+  the run is strict (a SHOULD then counts as a MUST).
+
+The suite's ``<properties>`` carry the certificate digest, so a CI artefact can be matched to its
+results directory. Built with the standard library; text is stripped of characters XML forbids.
+"""
+
+from __future__ import annotations
+
+import xml.etree.ElementTree as ET
+from typing import Any, Mapping
+
+from .rundir import Run
+from .text import printable, section_name, short_title
+from .view import VERDICT_LABEL, clause_rows
+
+__all__ = ["render_junit"]
+
+_EVIDENCE_LIMIT = 50
+
+
+def _t(value: object) -> str:
+    return printable(value)
+
+
+def _evidence_text(row: Mapping[str, Any]) -> str:
+    lines = [f'{ev["t"]:.6f} {ev["dir"]} {ev["line"]}' for ev in row["evidence"][:_EVIDENCE_LIMIT]]
+    if len(row["evidence"]) > _EVIDENCE_LIMIT:
+        lines.append(f'… {len(row["evidence"]) - _EVIDENCE_LIMIT} more lines in results.json')
+    head = [f"{row['id']} ({row['level']}): {row['reason']}"]
+    if row["cases"]:
+        head.append("cases: " + ", ".join(row["cases"]))
+    if row["replay"]:
+        head.append(f"replay: {row['replay']}")
+    return _t("\n".join(head + lines))
+
+
+def render_junit(run: Run, strict: bool | None = None) -> str:
+    """The JUnit XML document (a string with an XML declaration). *strict* defaults to the run's."""
+    r = run.results
+    strict = run.strict if strict is None else strict
+    rows = clause_rows(r)
+    suite_name = f"helmcheck {r['role']}"
+    tallies = {"tests": len(rows), "failures": 0, "errors": 0, "skipped": 0}
+
+    suite = ET.Element("testsuite", name=suite_name, timestamp=_t(r["started"]),
+                       time=f'{r["duration_s"] or 0:.3f}', hostname=_t(r["implementation"].get("port") or ""))
+    props = ET.SubElement(suite, "properties")
+    meta = [
+        ("helmcheck.digest", run.digest.combined),
+        ("helmcheck.results_sha256", run.digest.results),
+        ("helmcheck.wire_sha256", run.digest.wire or "absent"),
+        ("helmcheck.verdict", r["verdict"]),
+        ("helmcheck.verdict_reason", r["verdict_reason"]),
+        ("helmcheck.partial", "true" if r["partial"] else "false"),
+        ("helmcheck.strict", "true" if strict else "false"),
+        ("helmcheck.role", r["role"]),
+        ("helmcheck.seed", "" if r["seed"] is None else str(r["seed"])),
+        ("helmcheck.tool_version", r["tool"]["version"]),
+        ("helmcheck.command", r["command"]),
+    ] + [(f"implementation.{k}", "" if v is None else str(v)) for k, v in r["implementation"].items()]
+    for name, value in meta:
+        ET.SubElement(props, "property", name=_t(name), value=_t(value))
+
+    for row in rows:
+        title = short_title(row["text"]) if row["text"] else "not in the reference profile"
+        case = ET.SubElement(suite, "testcase",
+                             classname=_t(section_name(row["section"], row["section_title"])),
+                             name=_t(f"{row['id']} {title}"), time="0")
+        v = row["verdict"]
+        if v == "fail" or (v == "non-strict" and strict):
+            kind = "non-strict" if v == "non-strict" else row["level"]
+            el = ET.SubElement(case, "failure", message=_t(row["reason"]), type=_t(kind))
+            el.text = _evidence_text(row)
+            tallies["failures"] += 1
+        elif v == "inconclusive":
+            el = ET.SubElement(case, "error", message=_t(row["reason"]), type="inconclusive")
+            el.text = _evidence_text(row)
+            tallies["errors"] += 1
+        elif v == "not-tested":
+            ET.SubElement(case, "skipped", message=_t(row["reason"]))
+            tallies["skipped"] += 1
+        elif v == "non-strict":
+            out = ET.SubElement(case, "system-out")
+            out.text = _t(f"{VERDICT_LABEL[v]} (SHOULD not met): {row['reason']}")
+    for key, value in tallies.items():
+        suite.set(key, str(value))
+
+    root = ET.Element("testsuites", name="helmcheck", time=suite.get("time", "0"),
+                      **{k: str(v) for k, v in tallies.items()})
+    root.append(suite)
+    ET.indent(root)
+    return '<?xml version="1.0" encoding="UTF-8"?>\n' + ET.tostring(root, encoding="unicode") + "\n"

@@ -1,0 +1,89 @@
+"""A short Markdown summary for pull requests and CI job pages.
+
+A verdict line, a PARTIAL warning if the run was interrupted, a counts table, the clauses that
+did not pass with their reasons (worst first), and the certificate digest. Strings from the
+results file or the device are escaped for GitHub-flavoured Markdown, including the HTML it
+renders: ``<``, ``>`` and ``&`` become entities and Markdown punctuation is backslash-escaped.
+"""
+
+from __future__ import annotations
+
+import re
+
+from .rundir import Run
+from .text import printable
+from .view import VERDICT_LABEL, counts, non_pass_rows
+
+__all__ = ["render_markdown", "md_escape", "ROW_LIMIT"]
+
+ROW_LIMIT = 60  # non-pass rows listed before "… and N more"
+
+# Markdown punctuation that can start markup inline; ``$`` because GitHub renders $…$ as math.
+_MD_SPECIAL = re.compile(r"([\\`*_\[\]|~$])")
+
+
+def md_escape(value: object) -> str:
+    """Any value as inline Markdown text: one line, no markup, no HTML."""
+    text = " ".join(printable(value).split())
+    text = text.replace("&", "&amp;").replace("<", "&lt;").replace(">", "&gt;")
+    return _MD_SPECIAL.sub(r"\\\1", text)
+
+
+def digest_markdown(run: Run) -> str:
+    d = run.digest
+    return (f"Certificate digest (SHA-256): `{d.combined}`  \n"
+            f"results.json `{d.results}` · wire log `{d.wire or 'absent'}`")
+
+
+def render_markdown(run: Run, comparison_md: str | None = None) -> str:
+    """The Markdown summary of *run* (optionally followed by a comparison section)."""
+    r = run.results
+    word = VERDICT_LABEL.get(r["verdict"], r["verdict"])
+    impl = r["implementation"]
+    out = [f"## helmcheck {md_escape(r['role'])} report: **{word}**", ""]
+    if r["partial"]:
+        out += ["> **PARTIAL RUN**: the run was interrupted before it finished; "
+                "this is not a complete certificate.", ""]
+    if not run.wire["present"]:
+        out += [f"> **Wire log missing**: {md_escape(r['wire_log'])} is not in the results directory.", ""]
+    strict = " (strict)" if run.strict else ""
+    out += [f"**{word}**{strict}: {md_escape(r['verdict_reason'])}", ""]
+
+    facts = []
+    if impl.get("vehicle_name"):
+        facts.append(md_escape(impl["vehicle_name"]))
+    if impl.get("port"):
+        facts.append(f"on {md_escape(impl['port'])}")
+    if impl.get("protocol"):
+        facts.append(f"protocol {md_escape(impl['protocol'])}")
+    seen = run.wire["osi_vehicle_name"]
+    if seen is not None and seen != impl.get("vehicle_name"):
+        facts.append(f"(name on the wire: {md_escape(seen)})")
+    when = f"started {md_escape(r['started'])}"
+    if r["duration_s"] is not None:
+        when += f", {r['duration_s']:.1f} s"
+    seed = f", seed {md_escape(r['seed'])}" if r["seed"] is not None else ""
+    out += [f"Implementation: {' '.join(facts) or 'not recorded'}; {when}{seed}.", ""]
+
+    c = counts(r)
+    out.append("| " + " | ".join(VERDICT_LABEL[v] for v in c) + " | total |")
+    out.append("|" + "---:|" * (len(c) + 1))
+    out.append("| " + " | ".join(str(n) for n in c.values()) + f" | {sum(c.values())} |")
+    out.append("")
+
+    rows = non_pass_rows(r)
+    if rows:
+        out += [f"### Not passed ({len(rows)})", "", "| Clause | Level | Verdict | Reason |", "|---|---|---|---|"]
+        for row in rows[:ROW_LIMIT]:
+            out.append(f"| {md_escape(row['id'])} | {md_escape(row['level'])} | "
+                       f"{VERDICT_LABEL.get(row['verdict'], md_escape(row['verdict']))} | {md_escape(row['reason'])} |")
+        if len(rows) > ROW_LIMIT:
+            out.append(f"\n… and {len(rows) - ROW_LIMIT} more; see report.html.")
+        out.append("")
+    else:
+        out += ["Every clause passes.", ""]
+
+    if comparison_md:
+        out += [comparison_md.rstrip(), ""]
+    out += [digest_markdown(run), ""]
+    return "\n".join(out)
