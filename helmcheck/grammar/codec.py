@@ -253,6 +253,7 @@ def _fmt(v) -> str:
 _TAIL_OPTIONAL = {
     S.OMSTART: ("srp",),
     S.GPRMC: ("mode",),
+    S.OMWClear: ("waypoint",),
     S.ORWSET: ("state",),
     S.OSI: ("mission_name", "remaining_time", "true_heading", "depth", "battery", "srp_active",
             "vehicle_name"),

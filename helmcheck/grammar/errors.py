@@ -22,7 +22,7 @@ SYNTAX = "syntax"
 RANGE = "range"
 
 
-@dataclass(frozen=True, eq=True)
+@dataclass(eq=True, unsafe_hash=True)
 class SentenceError(Exception):
     """A line that is not a valid sentence. ``str()`` is ``CLAUSE: message at column N``."""
 

@@ -115,7 +115,7 @@ class DataCache:
         return s.OPI(percent=dec(_clamp(p.battery_pct, 0, 100), 1),
                      remaining_wh=dec(max(0.0, p.remaining_wh), 1), watts=dec(p.watts, 1),
                      volts=dec(max(0.0, p.volts), 2), amps=dec(p.amps, 2),
-                     minutes=dec(max(0.0, p.minutes), 0), state=p.battery_state,
+                     minutes_left=dec(max(0.0, p.minutes), 0), battery_state=p.battery_state,
                      leak=1 if p.leak else 0)
 
     def _dvl(self, fix: bool) -> s.DVL:

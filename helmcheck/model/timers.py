@@ -71,8 +71,13 @@ class Timers:
             self._recompute()
 
     def remaining(self, name: str, now: float) -> Optional[float]:
-        d = self.deadline(name)
-        return None if d is None else max(0.0, d - now)
+        """Seconds left *on the vehicle's own countdown*: ``start + duration - now``, unskewed.
+
+        A skewed shadow expires early or late, but what it displays (``$OSI`` field 10) and
+        what it saves when a park is frozen is its own clock's count (RH-TIM-1).
+        """
+        t = self._t.get(name)
+        return None if t is None else max(0.0, t[0] + t[1] - now)
 
     def earliest(self) -> Optional[tuple[float, str]]:
         """(deadline, name) of the next timer to expire; ties go by name for determinism."""

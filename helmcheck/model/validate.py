@@ -10,7 +10,7 @@ Bounds: ``$OMS`` RH-SRV-2; ``$OMP`` RH-PRM-2; ``$OPK`` RH-PK-1; ``$OMW`` RH-OMW-
 RH-RD-7; ``$OLOGL``/``$OLOGD`` RH-LOG-1/2, RH-RD-9; ``$ORWSET`` RH-SET-1/2, RH-RD-8; ``$ODVL``
 RH-DVL-1, RH-RD-9.
 
-Decisions (spec open): ``$OMLOAD`` and ``$OMSTOP`` flags must be 0; a bad path in the ``$OMSTART``
+Decisions (spec open): the ``$OMSTOP`` flag must be 0 (the ``$OMLOAD`` flag is not judged); a bad path in the ``$OMSTART``
 SRP name is err 30 like the mission name (a field value), while a missing or unusable SRP file
 is err 31 (a look-up); ``$ORWSET,<s>,R`` must carry no state and no values.
 """
@@ -102,8 +102,7 @@ def _omstop(c: s.OMSTOP, p: Profile) -> bool:
 
 
 def _omload(c: s.OMLOAD, p: Profile) -> bool:
-    return (isinstance(c.name, str) and mission_name_problem(c.name) is None
-            and _int_between(c.flag, 0, 0))
+    return isinstance(c.name, str) and mission_name_problem(c.name) is None
 
 
 def _omstart(c: s.OMSTART, p: Profile) -> bool:

@@ -141,6 +141,8 @@ class VehicleModel:
         self.timers = Timers()
         self._pending: list[ev.ModelEvent] = []
         self._base: Optional["VehicleModel"] = None
+        #: keep a copy of the state before the first timer fires after an input (for observers)
+        self.checkpoints = True
         self._snap = snapshot if snapshot is not None else PlantSnapshot()
         self._data = DataCache(profile, self._snap)
 
@@ -428,7 +430,7 @@ class VehicleModel:
     def _run_due(self, now: float) -> None:
         timers = self.timers
         while timers.due is not None and timers.due <= now:
-            if self._base is None:
+            if self._base is None and self.checkpoints:
                 self._base = self.clone()
             deadline, name = timers.earliest()  # type: ignore[misc]
             if self.now is None or deadline > self.now:

@@ -1,36 +1,26 @@
-"""``results.json`` schema 1: the builder, the validator, the loader and the verdict rules.
+"""``results.json`` schema 1: the builder, the loader and the atomic writer.
 
-A results document is a plain ``dict`` (it is JSON on disk and JSON in memory); this module is
-the one place that knows its shape. Certifiers build it with :func:`new_results`,
-:func:`add_clause`, :func:`add_replay`, :func:`add_event`, :func:`add_mode` and :func:`finish`,
-and save it with :func:`write_results_atomic`. Reports read it back with :func:`load_results`,
-which validates it and turns every problem into a one-line :class:`ReportError` naming the file.
-
-Verdict rules (reference profile, preamble: a MUST not met gives FAIL, a SHOULD not met gives
-NON-STRICT):
-
-* :func:`overall_verdict` — any ``fail`` → ``fail``; else any ``inconclusive`` →
-  ``inconclusive``; else any ``non-strict`` → ``non-strict`` (``fail`` when *strict*: a SHOULD
-  is then held to a MUST); else ``pass``. ``not-tested`` never lowers the verdict.
-* :func:`run_verdict` — the verdict written into ``results.json``: :func:`overall_verdict`,
-  except that a run that was interrupted (``partial``) or that judged no clause at all cannot
-  certify ``pass``/``non-strict`` and is ``inconclusive`` instead. An observed ``fail`` stays.
-* :func:`exit_code` — pass → 0, non-strict → 0 (1 when strict), fail → 1, inconclusive → 2.
+A results document is a plain ``dict`` (it is JSON on disk and JSON in memory). Certifiers build
+it with :func:`new_results`, :func:`add_clause`, :func:`add_replay`, :func:`add_event`,
+:func:`add_mode` and :func:`finish`, and save it with :func:`write_results_atomic`. Reports read
+it back with :func:`load_results`, which validates it (:mod:`helmcheck.reports.schema`) and turns
+every problem into a one-line :class:`ReportError` naming the file. The verdict rules live in
+:mod:`helmcheck.reports.verdicts` and are re-exported here.
 """
 
 from __future__ import annotations
 
 import json
-import math
-import re
 from datetime import datetime, timezone
-from pathlib import Path, PurePosixPath
+from pathlib import Path
 from typing import Any, Iterable, Mapping
 
 from helmcheck import __version__
 from helmcheck.clauses import SPEC_NAME, catalogue
 
 from .atomic import write_bytes_atomic
+from .schema import DIRECTIONS, EVENT_KINDS, LEVELS, ROLES, SCHEMA, validate
+from .verdicts import CLAUSE_VERDICTS, VERDICTS, describe_verdict, exit_code, overall_verdict, run_verdict
 
 __all__ = [
     "SCHEMA",
@@ -60,19 +50,8 @@ __all__ = [
     "exit_code",
 ]
 
-SCHEMA = 1
 RESULTS_NAME = "results.json"
 WIRE_LOG_NAME = "wire.log"
-
-ROLES = ("vehicle", "backseat", "log")
-VERDICTS = ("pass", "non-strict", "fail", "inconclusive")
-CLAUSE_VERDICTS = VERDICTS + ("not-tested",)
-LEVELS = ("MUST", "SHOULD")
-DIRECTIONS = (">", "<", ">~", "<~", "!")  # docs/contracts.md, wire-log format 1
-EVENT_KINDS = ("command", "ack-error", "lockout", "note")
-
-_CLAUSE_ID = re.compile(r"^RH-[A-Z]+-\d+$")
-_STEP_ACTIONS = ("send", "wait", "expect")
 
 
 class ReportError(Exception):
@@ -87,92 +66,6 @@ class ReportError(Exception):
         self.message = message
         self.errors = list(errors)
         super().__init__(f"{self.path}: {message}")
-
-
-# --------------------------------------------------------------------------- verdict rules
-
-_RANK = {"pass": 0, "non-strict": 1, "inconclusive": 2, "fail": 3}
-
-
-def overall_verdict(clause_verdicts: Iterable[str], strict: bool = False) -> str:
-    """The verdict of a set of clause verdicts (precedence fail > inconclusive > non-strict > pass).
-
-    ``not-tested`` does not lower the verdict. With *strict*, a ``non-strict`` clause (a SHOULD
-    not met) counts as ``fail``. An unknown verdict word raises ``ValueError``.
-    """
-    worst = "pass"
-    for v in clause_verdicts:
-        if v == "not-tested":
-            continue
-        if v not in _RANK:
-            raise ValueError(f"unknown clause verdict {v!r}; expected one of {CLAUSE_VERDICTS}")
-        if strict and v == "non-strict":
-            v = "fail"
-        if _RANK[v] > _RANK[worst]:
-            worst = v
-    return worst
-
-
-def run_verdict(clause_verdicts: Iterable[str], *, strict: bool = False, partial: bool = False) -> str:
-    """The verdict a run records: :func:`overall_verdict`, made ``inconclusive`` when the run was
-    interrupted or judged nothing and would otherwise claim ``pass`` or ``non-strict``."""
-    verdicts = list(clause_verdicts)
-    verdict = overall_verdict(verdicts, strict)
-    judged = any(v != "not-tested" for v in verdicts)
-    if verdict in ("pass", "non-strict") and (partial or not judged):
-        return "inconclusive"
-    return verdict
-
-
-def exit_code(verdict: str, strict: bool = False) -> int:
-    """Process exit status for a run verdict: pass 0, non-strict 0 (1 if strict), fail 1,
-    inconclusive 2."""
-    if verdict == "pass":
-        return 0
-    if verdict == "non-strict":
-        return 1 if strict else 0
-    if verdict == "fail":
-        return 1
-    if verdict == "inconclusive":
-        return 2
-    raise ValueError(f"unknown verdict {verdict!r}; expected one of {VERDICTS}")
-
-
-def _id_list(ids: list[str], limit: int = 5) -> str:
-    shown = ", ".join(ids[:limit])
-    return shown if len(ids) <= limit else f"{shown} and {len(ids) - limit} more"
-
-
-def describe_verdict(clauses: list[Mapping[str, Any]], *, strict: bool = False, partial: bool = False) -> str:
-    """One sentence explaining :func:`run_verdict` for these clause entries."""
-    text = _describe(clauses, strict=strict, partial=partial)
-    if partial and "interrupted" not in text:
-        text += " The run was interrupted before it finished."
-    return text
-
-
-def _describe(clauses: list[Mapping[str, Any]], *, strict: bool, partial: bool) -> str:
-    by: dict[str, list[str]] = {v: [] for v in CLAUSE_VERDICTS}
-    for c in clauses:
-        by.setdefault(c["verdict"], []).append(c["id"])
-    verdict = run_verdict([c["verdict"] for c in clauses], strict=strict, partial=partial)
-    judged = len(clauses) - len(by["not-tested"])
-    if verdict == "fail":
-        if by["fail"]:
-            return f"{len(by['fail'])} clause(s) failed: {_id_list(by['fail'])}."
-        return f"Strict run: {len(by['non-strict'])} SHOULD clause(s) not met: {_id_list(by['non-strict'])}."
-    if verdict == "inconclusive":
-        if by["inconclusive"]:
-            return (f"No clause failed, but {len(by['inconclusive'])} could not be judged: "
-                    f"{_id_list(by['inconclusive'])}.")
-        if partial:
-            return f"The run was interrupted after judging {judged} clause(s); nothing failed before it stopped."
-        return "No clause was judged."
-    if verdict == "non-strict":
-        return (f"Every MUST judged is met; {len(by['non-strict'])} SHOULD clause(s) not met: "
-                f"{_id_list(by['non-strict'])}.")
-    untested = f" ({len(by['not-tested'])} not tested)" if by["not-tested"] else ""
-    return f"All {judged} judged clause(s) pass{untested}."
 
 
 # --------------------------------------------------------------------------- builder
@@ -316,313 +209,6 @@ def finish(results: dict[str, Any], *, finished: str | None = None, partial: boo
     results["verdict"] = run_verdict(verdicts, strict=strict, partial=partial)
     results["verdict_reason"] = describe_verdict(results["clauses"], strict=strict, partial=partial)
     return results["verdict"]
-
-
-# --------------------------------------------------------------------------- validator
-
-class _Checker:
-    """Collects schema errors, each prefixed with the JSON path it is about."""
-
-    def __init__(self) -> None:
-        self.errors: list[str] = []
-
-    def err(self, path: str, msg: str) -> None:
-        self.errors.append(f"{path}: {msg}")
-
-    def typed(self, path: str, value: Any, kinds: tuple[type, ...], what: str, *,
-              optional: bool = False) -> bool:
-        if value is None and optional:
-            return False
-        if isinstance(value, bool) and bool not in kinds:
-            ok = False
-        else:
-            ok = isinstance(value, kinds)
-        if ok and isinstance(value, float) and not math.isfinite(value):
-            self.err(path, "must be a finite number")
-            return False
-        if not ok:
-            self.err(path, f"expected {what}{' or null' if optional else ''}, got {_jtype(value)}")
-        return ok
-
-    def number(self, path: str, value: Any, *, optional: bool = False, minimum: float | None = 0.0) -> bool:
-        ok = self.typed(path, value, (int, float), "a number", optional=optional)
-        if ok and minimum is not None and value < minimum:
-            self.err(path, f"must be ≥ {minimum:g}, got {value!r}")
-            return False
-        return ok
-
-    def string(self, path: str, value: Any, *, optional: bool = False) -> bool:
-        return self.typed(path, value, (str,), "a string", optional=optional)
-
-    def one_of(self, path: str, value: Any, words: tuple[str, ...]) -> bool:
-        if not isinstance(value, str) or value not in words:
-            self.err(path, f"{_short(value)} is not one of {', '.join(words)}")
-            return False
-        return True
-
-    def obj(self, path: str, value: Any) -> bool:
-        return self.typed(path, value, (dict,), "an object")
-
-    def arr(self, path: str, value: Any) -> bool:
-        return self.typed(path, value, (list,), "an array")
-
-    def str_list(self, path: str, value: Any, length: int | None = None) -> None:
-        if not self.arr(path, value):
-            return
-        if length is not None and len(value) != length:
-            self.err(path, f"expected {length} items, got {len(value)}")
-        for i, item in enumerate(value):
-            self.string(f"{path}[{i}]", item)
-
-    def timestamp(self, path: str, value: Any, *, optional: bool = False) -> None:
-        if not self.string(path, value, optional=optional):
-            return
-        try:
-            parsed = datetime.fromisoformat(value)
-        except ValueError:
-            self.err(path, f"{_short(value)} is not an ISO 8601 date-time")
-            return
-        if parsed.tzinfo is None:
-            self.err(path, f"{_short(value)} has no time zone (write UTC with a trailing Z)")
-
-
-def _jtype(value: Any) -> str:
-    if value is None:
-        return "null"
-    if isinstance(value, bool):
-        return "a boolean"
-    if isinstance(value, (int, float)):
-        return "a number"
-    if isinstance(value, str):
-        return "a string"
-    if isinstance(value, list):
-        return "an array"
-    if isinstance(value, dict):
-        return "an object"
-    return type(value).__name__
-
-
-def _short(value: Any, limit: int = 40) -> str:
-    text = repr(value)
-    return text if len(text) <= limit else text[: limit - 1] + "…"
-
-
-_REQUIRED = ("schema", "tool", "role", "partial", "started", "finished", "duration_s", "verdict",
-             "verdict_reason", "command", "implementation", "profile", "settings", "seed",
-             "clauses", "replays", "coverage", "timeline", "events", "wire_log")
-
-_IMPLEMENTATION_KEYS = {"port": str, "vehicle_name": str, "protocol": str, "osi_fields": int,
-                        "fault_injection": str}
-_SETTINGS_KEYS = {"time_scale": (int, float), "strict": bool, "seed": int, "examples": int,
-                  "hypothesis_profile": str}
-
-_KIND_WORDS: dict[Any, str] = {(int, float): "a number", bool: "a boolean", int: "an integer", str: "a string"}
-
-
-def validate(results: Any) -> list[str]:
-    """Every way *results* departs from schema 1, each message naming its JSON path.
-
-    An empty list means the document is valid. Unknown keys are allowed (later schema-1 writers
-    may add some); the verdict must follow from the clause verdicts (:func:`run_verdict`).
-    """
-    ck = _Checker()
-    if not isinstance(results, dict):
-        ck.err("$", f"expected an object, got {_jtype(results)}")
-        return ck.errors
-    for key in _REQUIRED:
-        if key not in results:
-            ck.err(key, "missing")
-    r = results.get
-
-    if "schema" in results and (r("schema") != SCHEMA or isinstance(r("schema"), bool)):
-        ck.err("schema", f"expected {SCHEMA}, got {_short(r('schema'))}")
-    if "tool" in results and ck.obj("tool", r("tool")):
-        ck.string("tool.name", r("tool").get("name"))
-        ck.string("tool.version", r("tool").get("version"))
-    if "role" in results:
-        ck.one_of("role", r("role"), ROLES)
-    if "partial" in results:
-        ck.typed("partial", r("partial"), (bool,), "a boolean")
-    if "started" in results:
-        ck.timestamp("started", r("started"))
-    if "finished" in results:
-        ck.timestamp("finished", r("finished"), optional=True)
-    if "duration_s" in results:
-        ck.number("duration_s", r("duration_s"), optional=True)
-    if "verdict" in results:
-        ck.one_of("verdict", r("verdict"), VERDICTS)
-    for key in ("verdict_reason", "command"):
-        if key in results:
-            ck.string(key, r(key))
-    if "implementation" in results and ck.obj("implementation", r("implementation")):
-        for key, kind in _IMPLEMENTATION_KEYS.items():
-            value = r("implementation").get(key)
-            if value is not None:
-                ck.typed(f"implementation.{key}", value, (kind,), "a " + ("string" if kind is str else "integer"))
-    if "profile" in results and ck.obj("profile", r("profile")):
-        bench = r("profile").get("bench_safety")
-        if bench is not None:
-            ck.obj("profile.bench_safety", bench)
-    if "settings" in results and ck.obj("settings", r("settings")):
-        for key, kind in _SETTINGS_KEYS.items():
-            value = r("settings").get(key)
-            if value is not None:
-                kinds = kind if isinstance(kind, tuple) else (kind,)
-                ck.typed(f"settings.{key}", value, kinds, _KIND_WORDS.get(kind, "a value"))
-        ts = r("settings").get("time_scale")
-        if isinstance(ts, (int, float)) and not isinstance(ts, bool) and ts <= 0:
-            ck.err("settings.time_scale", f"must be > 0, got {ts!r}")
-    if "seed" in results:
-        ck.typed("seed", r("seed"), (int,), "an integer", optional=True)
-
-    replay_files = _check_replays(ck, r("replays")) if "replays" in results else set()
-    clause_ids = _check_clauses(ck, r("clauses"), replay_files) if "clauses" in results else set()
-    if isinstance(r("replays"), list):
-        for i, rep in enumerate(r("replays")):
-            if isinstance(rep, dict) and isinstance(rep.get("clause"), str) and clause_ids \
-                    and rep["clause"] not in clause_ids:
-                ck.err(f"replays[{i}].clause", f"{rep['clause']!r} has no entry in clauses")
-    if "coverage" in results:
-        _check_coverage(ck, r("coverage"))
-    if "timeline" in results:
-        _check_timeline(ck, r("timeline"))
-    if "events" in results:
-        _check_events(ck, r("events"))
-    if "wire_log" in results and ck.string("wire_log", r("wire_log")):
-        _check_relative(ck, "wire_log", r("wire_log"))
-
-    if not ck.errors:
-        strict = bool(r("settings").get("strict", False))
-        expected = run_verdict([c["verdict"] for c in r("clauses")], strict=strict, partial=r("partial"))
-        if r("verdict") != expected:
-            ck.err("verdict", f"{r('verdict')!r} does not follow from the clause verdicts "
-                              f"(they give {expected!r}{', strict' if strict else ''}"
-                              f"{', partial run' if r('partial') else ''})")
-    return ck.errors
-
-
-def _check_relative(ck: _Checker, path: str, value: str) -> None:
-    p = PurePosixPath(value)
-    if not value or value.startswith(("/", "\\")) or p.is_absolute() or ".." in p.parts \
-            or "\\" in value or re.match(r"^[A-Za-z]:", value):
-        ck.err(path, f"{_short(value)} must be a relative path inside the results directory")
-
-
-def _check_clauses(ck: _Checker, clauses: Any, replay_files: set[str]) -> set[str]:
-    ids: set[str] = set()
-    if not ck.arr("clauses", clauses):
-        return ids
-    known = catalogue()
-    for i, c in enumerate(clauses):
-        p = f"clauses[{i}]"
-        if not ck.obj(p, c):
-            continue
-        cid = c.get("id")
-        if ck.string(f"{p}.id", cid):
-            if not _CLAUSE_ID.match(cid):
-                ck.err(f"{p}.id", f"{_short(cid)} is not a clause ID like RH-SRV-4")
-            elif cid not in known:
-                ck.err(f"{p}.id", f"{cid!r} is not a clause of {SPEC_NAME}")
-            if cid in ids:
-                ck.err(f"{p}.id", f"{cid!r} appears more than once")
-            ids.add(cid)
-        ck.one_of(f"{p}.verdict", c.get("verdict"), CLAUSE_VERDICTS)
-        ck.string(f"{p}.reason", c.get("reason"))
-        if ck.one_of(f"{p}.level", c.get("level"), LEVELS) and cid in known \
-                and known[cid].level != c["level"]:
-            ck.err(f"{p}.level", f"{c['level']!r}, but {SPEC_NAME} makes {cid} a {known[cid].level}")
-        ck.str_list(f"{p}.cases", c.get("cases"))
-        if ck.typed(f"{p}.offending_count", c.get("offending_count"), (int,), "an integer") \
-                and c["offending_count"] < 0:
-            ck.err(f"{p}.offending_count", "must be ≥ 0")
-        evidence = c.get("evidence")
-        if ck.arr(f"{p}.evidence", evidence):
-            for j, ev in enumerate(evidence):
-                q = f"{p}.evidence[{j}]"
-                if ck.obj(q, ev):
-                    ck.number(f"{q}.t", ev.get("t"))
-                    ck.one_of(f"{q}.dir", ev.get("dir"), DIRECTIONS)
-                    ck.string(f"{q}.line", ev.get("line"))
-        if "replay" not in c:
-            ck.err(f"{p}.replay", "missing (use null when there is no replay)")
-        elif ck.string(f"{p}.replay", c["replay"], optional=True) and c["replay"] not in replay_files:
-            ck.err(f"{p}.replay", f"{c['replay']!r} is not listed in replays")
-    return ids
-
-
-def _check_replays(ck: _Checker, replays: Any) -> set[str]:
-    files: set[str] = set()
-    if not ck.arr("replays", replays):
-        return files
-    for i, rep in enumerate(replays):
-        p = f"replays[{i}]"
-        if not ck.obj(p, rep):
-            continue
-        if ck.string(f"{p}.file", rep.get("file")):
-            _check_relative(ck, f"{p}.file", rep["file"])
-            if rep["file"] in files:
-                ck.err(f"{p}.file", f"{rep['file']!r} appears more than once")
-            files.add(rep["file"])
-        ck.string(f"{p}.clause", rep.get("clause"))
-        steps = rep.get("steps")
-        if not ck.arr(f"{p}.steps", steps):
-            continue
-        for j, step in enumerate(steps):
-            q = f"{p}.steps[{j}]"
-            if not ck.obj(q, step):
-                continue
-            actions = [a for a in _STEP_ACTIONS if a in step]
-            if len(actions) != 1:
-                ck.err(q, f"needs exactly one of send, wait, expect (has {', '.join(actions) or 'none'})")
-                continue
-            if actions[0] == "wait":
-                ck.number(f"{q}.wait", step["wait"])
-            else:
-                ck.string(f"{q}.{actions[0]}", step[actions[0]])
-            if "t" in step:
-                ck.number(f"{q}.t", step["t"])
-    return files
-
-
-def _check_coverage(ck: _Checker, cov: Any) -> None:
-    if not ck.obj("coverage", cov):
-        return
-    for key, length in (("modes", None), ("transitions", 3), ("interrupt_pairs", 2)):
-        value = cov.get(key)
-        if value is None:
-            ck.err(f"coverage.{key}", "missing")
-            continue
-        if key == "modes":
-            ck.str_list("coverage.modes", value)
-        elif ck.arr(f"coverage.{key}", value):
-            for i, item in enumerate(value):
-                ck.str_list(f"coverage.{key}[{i}]", item, length)
-
-
-def _check_timeline(ck: _Checker, timeline: Any) -> None:
-    if not ck.arr("timeline", timeline):
-        return
-    last = -math.inf
-    for i, point in enumerate(timeline):
-        p = f"timeline[{i}]"
-        if not ck.obj(p, point):
-            continue
-        if ck.number(f"{p}.t", point.get("t")):
-            if point["t"] < last:
-                ck.err(f"{p}.t", f"{point['t']!r} is earlier than the point before it ({last!r})")
-            last = point["t"]
-        ck.string(f"{p}.mode", point.get("mode"))
-
-
-def _check_events(ck: _Checker, events: Any) -> None:
-    if not ck.arr("events", events):
-        return
-    for i, ev in enumerate(events):
-        p = f"events[{i}]"
-        if ck.obj(p, ev):
-            ck.number(f"{p}.t", ev.get("t"))
-            ck.one_of(f"{p}.kind", ev.get("kind"), EVENT_KINDS)
-            ck.string(f"{p}.label", ev.get("label"))
 
 
 # --------------------------------------------------------------------------- load / save

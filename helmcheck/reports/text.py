@@ -31,7 +31,7 @@ def plain(markdown: str) -> str:
 def short_title(markdown: str, limit: int = 72) -> str:
     """The first sentence of a clause text, plain, cut at a word boundary to *limit* chars."""
     text = plain(markdown)
-    m = re.search(r"(?<=[a-z0-9)\]])(?<!e\.g)(?<!i\.e)\.(\s|$)", text)
+    m = re.search(r"(?<=[A-Za-z0-9)\]])(?<!e\.g)(?<!i\.e)\.(\s|$)", text)
     if m and m.start() + 1 <= limit:
         return text[: m.start()]
     if len(text) <= limit:

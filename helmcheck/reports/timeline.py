@@ -30,7 +30,7 @@ _ROW = 18
 
 
 def _e(value: object) -> str:
-    return printable(value)
+    return escape(printable(value), quote=True)
 
 
 def _nice_step(span: float, target: int = 10) -> float:

@@ -11,7 +11,7 @@ from typing import Any, Mapping
 
 from helmcheck.clauses import catalogue
 
-from .results import CLAUSE_VERDICTS
+from .verdicts import CLAUSE_VERDICTS
 
 __all__ = ["VERDICT_LABEL", "NON_PASS", "counts", "clause_rows", "sections", "replay_for", "non_pass_rows"]
 

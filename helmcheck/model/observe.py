@@ -1,0 +1,182 @@
+"""What a conforming vehicle may report at a given time: the observation API (RH-OUT-4, RH-TIM-1).
+
+A tester mirrors every command it sent into a :class:`~helmcheck.model.vehicle.VehicleModel`
+(``receive(cmd, t)``) and, for an ``$OSI`` it received, asks ``expectation(model, t, slack)``
+(or ``model.expectation(t, slack)``); :meth:`Expectation.check` lists ``(clause, message)`` for
+every judged field (mode, next waypoint, park time, error state, SRP flag) no acceptable state
+explains.
+
+Approach: skewed shadows
+------------------------
+RH-TIM-1 lets every duration (timeouts, lockout, parks) be off by ``max(0.5 s, 5 %)`` of itself,
+and the observer adds the slack it cannot see (serial transmit time, polling interval, jitter).
+Between two inputs the model's future is fixed: only timers change the state, and (remote
+control freezing the mission, a violation ending remote control) at most one state-changing
+timer runs at a time, so the states form one chain ``s0 → s1 → …``. Two shadow copies of the
+model run that chain:
+
+* the *fast* shadow, in which every timer (already armed or armed on the way) expires
+  ``tolerance(d) + slack`` early, and
+* the *slow* shadow, in which every timer expires that much late.
+
+Each is advanced from the model's last input to ``now``, recording the states it passes
+through. The slow one is at some ``s_j``, the fast one at ``s_k`` (``j ≤ k``); every state
+``s_j … s_k`` is acceptable — so near a timeout both the old and the new mode are. A shadow's
+countdowns *display* its own clock's count (start + duration − now, unskewed), so the park time
+of each acceptable state is the interval between what the two shadows show (the fast shadow in
+it now or as it left it; the slow shadow in it now or the fast one as it entered it), widened by
+``slack`` and rounded outwards to whole seconds (field 10 is rounded up, RH-RD-5).
+
+So that the slow shadow can still be "before" a timer the model itself already ran, the model
+keeps a checkpoint: a copy of itself taken just before the first timer fires after a
+state-changing input (``VehicleModel.checkpoints``, on by default). Shadows start from it.
+
+Limits (documented, deliberate): a command that arrives within the tolerance of a timer is
+applied to the nominal state only (the model cannot know which side of the race the vehicle
+was on); in practice the commands that race a timeout (``$OMS`` refresh, ``$OJW``, ``$OMW,Clr``)
+lead to the same state either way.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Optional
+
+from ..grammar import sentences as s
+
+__all__ = ["Acceptable", "Expectation", "expectation"]
+
+
+@dataclass(frozen=True, slots=True)
+class Acceptable:
+    """One state a conforming vehicle may be in, with the park-time interval it may show."""
+
+    mode: str
+    waypoint: int
+    error_state: str
+    srp_active: bool
+    park_lo: int
+    park_hi: int
+
+    def matches(self, osi: s.OSI) -> bool:
+        return (osi.mode == self.mode and osi.next_waypoint == self.waypoint
+                and osi.error_state == self.error_state
+                and self.park_lo <= osi.park_time <= self.park_hi
+                and (osi.srp_active is None or osi.srp_active == ("True" if self.srp_active else "False")))
+
+
+@dataclass(frozen=True, slots=True)
+class Expectation:
+    """The acceptable states at ``now`` (with ``slack`` seconds of observer uncertainty)."""
+
+    now: float
+    slack: float
+    states: tuple[Acceptable, ...]
+
+    @property
+    def modes(self) -> tuple[str, ...]:
+        return tuple(dict.fromkeys(a.mode for a in self.states))
+
+    def check(self, osi: s.OSI) -> list[tuple[str, str]]:
+        """``[]`` when some acceptable state explains ``osi``; else one finding per field."""
+        if any(a.matches(osi) for a in self.states):
+            return []
+        at = f"at t={self.now:.3f} (slack {self.slack:g} s)"
+        out: list[tuple[str, str]] = []
+        cands = [a for a in self.states if a.mode == osi.mode]
+        if not cands:
+            return [("RH-OUT-4", f"mode {osi.mode!r} {at}; a conforming vehicle reports "
+                                 f"{' or '.join(self.modes)}")]
+        wp = [a for a in cands if a.waypoint == osi.next_waypoint]
+        if not wp:
+            want = sorted({a.waypoint for a in cands})
+            out.append(("RH-OUT-4", f"next waypoint {osi.next_waypoint} in mode {osi.mode} {at}; "
+                                    f"expected {' or '.join(map(str, want))}"))
+            wp = cands
+        err = [a for a in wp if a.error_state == osi.error_state]
+        if not err:
+            want = sorted({a.error_state for a in wp})
+            out.append(("RH-OUT-4", f"error state {osi.error_state!r} {at}; expected "
+                                    f"{' or '.join(want)}"))
+            err = wp
+        park = [a for a in err if a.park_lo <= osi.park_time <= a.park_hi]
+        if not park:
+            ranges = ", ".join(f"P{a.park_lo}..P{a.park_hi}" for a in err)
+            out.append(("RH-OUT-4", f"park time P{osi.park_time} in mode {osi.mode} {at}; "
+                                    f"expected {ranges}"))
+            park = err
+        if osi.srp_active is not None and not any(
+                osi.srp_active == ("True" if a.srp_active else "False") for a in park):
+            out.append(("RH-OUT-4", f"SRP active {osi.srp_active} {at}; expected "
+                                    f"{'True' if park[0].srp_active else 'False'}"))
+        if not out:  # each field fits some state, but no single state fits them all
+            out.append(("RH-OUT-4", f"mode {osi.mode}, waypoint {osi.next_waypoint}, error "
+                                    f"{osi.error_state}, P{osi.park_time} {at} fit no single "
+                                    f"state a conforming vehicle can be in"))
+        return out
+
+
+@dataclass
+class _Visit:
+    sig: tuple
+    entry_park: Optional[float]
+    exit_park: Optional[float] = None
+
+
+def _sig(m) -> tuple:
+    return (m.mode, m.osi_waypoint, m.error_state, m.srp_active)
+
+
+def _run(shadow, now: float) -> list[_Visit]:
+    """Advance ``shadow`` to ``now`` one expiry at a time, recording distinct states."""
+    t0 = shadow.now if shadow.now is not None else now
+    visits = [_Visit(_sig(shadow), shadow.park_remaining(t0))]
+    timers = shadow.timers
+    while timers.due is not None and timers.due <= now:
+        d = timers.due
+        before = shadow.park_remaining(d)
+        shadow._run_due(d)
+        sig = _sig(shadow)
+        if sig != visits[-1].sig:
+            visits[-1].exit_park = before
+            visits.append(_Visit(sig, shadow.park_remaining(d)))
+    shadow._run_due(now)
+    return visits
+
+
+def _shadow(model, sign: float, slack: float):
+    sh = model.clone()
+    sh.checkpoints = False
+    sh.timers.set_skew(sign, slack)
+    return sh
+
+
+def expectation(model, now: float, slack: float = 0.0) -> Expectation:
+    """The :class:`Expectation` for an ``$OSI`` produced at ``now`` (see the module docstring)."""
+    base = model._base if model._base is not None else model
+    if base.now is not None and now < base.now:
+        now = base.now
+    fast, slow = _shadow(base, -1.0, slack), _shadow(base, +1.0, slack)
+    fv, sv = _run(fast, now), _run(slow, now)
+    k, j = len(fv) - 1, len(sv) - 1
+    aligned = j <= k and all(fv[i].sig == sv[i].sig for i in range(j + 1))
+    states: list[Acceptable] = []
+    if aligned:
+        for i in range(j, k + 1):
+            values = [fast.park_remaining(now) if i == k else fv[i].exit_park,
+                      slow.park_remaining(now) if i == j else fv[i].entry_park]
+            states.append(_acceptable(fv[i].sig, values, slack))
+    else:  # pragma: no cover - only if two state-changing timers ever race
+        for v in fv + sv:
+            states.append(_acceptable(v.sig, [v.entry_park, v.exit_park], slack))
+    return Expectation(now, slack, tuple(dict.fromkeys(states)))
+
+
+def _acceptable(sig: tuple, values: list[Optional[float]], slack: float) -> Acceptable:
+    vals = [0.0 if v is None else v for v in values]
+    lo, hi = min(vals), max(vals)
+    if hi > 0:
+        lo, hi = max(0.0, lo - slack), hi + slack
+    mode, wp, err, srp = sig
+    return Acceptable(mode, wp, err, srp, max(0, math.floor(lo)), math.ceil(hi))
