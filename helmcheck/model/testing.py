@@ -18,7 +18,7 @@ from .missions import BadMission, InMemoryCatalog, Mission, Waypoint
 __all__ = [
     "conformance_mission", "srp_mission", "catalog", "D", "oms", "omp", "ojw", "opk", "omw",
     "omw_clear", "omstop", "omload", "omstart", "omstart_paper", "opos", "osd", "ologl", "ologd",
-    "orwset", "odvl", "oxflt", "BASE_LAT", "BASE_LON",
+    "orwset", "odvl", "oxflt", "BASE_LAT", "BASE_LON", "oxflt_profile", "started",
 ]
 
 BASE_LAT = 41.52
@@ -120,3 +120,18 @@ def odvl(x=0.5, y=0.0, timeout=5) -> s.ODVL:
 
 def oxflt(code: str = "Sle") -> s.OXFLT:
     return s.OXFLT(code)
+
+
+def oxflt_profile(**changes):
+    """The default profile with the ``$OXFLT`` test extension declared (RH-SAF-5)."""
+    from ..profile import DEFAULT
+    return DEFAULT.replace(fault_injection="oxflt", **changes)
+
+
+def started(profile=None, now: float = 0.0, **start):
+    """A model (``$OXFLT`` enabled) whose test mission was started at ``now``."""
+    from .vehicle import VehicleModel
+    m = VehicleModel(profile or oxflt_profile(), catalog())
+    replies = m.receive(omstart(**start), now)
+    assert replies == [s.ACK(3, 0, 0)], replies
+    return m

@@ -189,7 +189,7 @@ def _build() -> tuple[Row, ...]:
     row(("S", "M"), "OMW", STAY, ("RH-OMW-1", "RH-ACK-4"), error=36)
     row(("N", "P"), "OMW_CLEAR", STAY, ("RH-OMW-3", "RH-RD-4"))
     resume(("mP", "A", "W", "M"), "OMW_CLEAR", ("RH-OMW-3", "RH-RD-4"), otherwise_error=36,
-           otherwise_sources=("S", "M"))
+           otherwise_sources=("S", "mP", "A", "M", "W"))
     row(("N", "P", "mP", "A", "W"), "OMW_CLEAR_WP", "W", ("RH-OMW-3", "RH-RD-4", "RH-INT-1"))
     row(("M",), "OMW_CLEAR_WP", "W", ("RH-OMW-3", "RH-RD-4", "RH-RD-1"), guard=("running",))
     row(("S", "M"), "OMW_CLEAR_WP", STAY, ("RH-OMW-1", "RH-ACK-4"), error=36)

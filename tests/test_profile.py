@@ -1,0 +1,55 @@
+"""Profile files (§10): every [D] a key, unknown keys and bad values refused with a clear error."""
+
+from __future__ import annotations
+
+import pytest
+
+from helmcheck.profile import DEFAULT, ProfileError, load_profile
+
+
+def _write(tmp_path, text):
+    p = tmp_path / "p.toml"
+    p.write_text(text)
+    return p
+
+
+def test_defaults_are_rh5():
+    assert (DEFAULT.protocol, DEFAULT.osi_fields, DEFAULT.lockout_s, DEFAULT.depth_unit) == ("rh5", 21, 20.0, "m")
+
+
+def test_the_section_10_example_loads(tmp_path):
+    from importlib import resources
+    text = resources.files("helmcheck.spec").joinpath("reference-profile.md").read_text()
+    example = text.split("```toml", 1)[1].split("```", 1)[0]
+    p = load_profile(_write(tmp_path, example))
+    assert p.bench_safety.max_motor_byte == 0x90 and p.commands[0] == "OMS"
+
+
+@pytest.mark.parametrize("text,needle", [
+    ("protocl = 'rh5'", "unknown key 'protocl'"),
+    ("protocol = 'rh9'", "key 'protocol'"),
+    ("lockout_s = -1", "key 'lockout_s'"),
+    ("timeout_range = [5, 1]", "key 'timeout_range'"),
+    ("commands = ['OMS', 'OFOO']", "unknown command 'OFOO'"),
+    ("[bench_safety]\nmax_motor_byte = 300", "max_motor_byte"),
+    ("[bench_safety]\nspeed = 1", "unknown key 'bench_safety.speed'"),
+    ("baud = 12345", "key 'baud'"),
+    ("osi_fields = 17", "expects" if False else "osi_fields"),
+    ("protocol = = 'rh5'", "not valid TOML"),
+])
+def test_bad_profiles_name_file_and_key(tmp_path, text, needle):
+    path = _write(tmp_path, text)
+    with pytest.raises(ProfileError) as e:
+        load_profile(path)
+    assert str(path) in str(e.value) and needle in str(e.value)
+
+
+def test_missing_profile_file_is_a_clear_error(tmp_path):
+    with pytest.raises(ProfileError, match="cannot read profile"):
+        load_profile(tmp_path / "nope.toml")
+
+
+def test_rh4_defaults_to_feet_and_shorter_osi(tmp_path):
+    p = load_profile(_write(tmp_path, "protocol = 'rh4'"))
+    assert p.depth_unit == "ft" and p.osi_fields == 17
+    assert abs(p.max_depth - 328.08) < 0.01
