@@ -252,6 +252,7 @@ class SerialLink(Link):
             self.ser = serial.serial_for_url(spec, **kwargs)
         else:
             self.ser = serial.Serial(spec, **kwargs)
+        self._empty = 0
         try:
             self._fd: Optional[int] = self.ser.fileno()
         except Exception:  # noqa: BLE001 - URL handlers without a descriptor (loop://)
@@ -273,14 +274,26 @@ class SerialLink(Link):
 
         try:
             if self._fd is not None:
-                data, closed = _read_fd(self._fd, max_bytes)
-                if closed:
-                    raise LinkClosed(errno.EIO, f"{self.name}: device closed")
+                # A tty read with VMIN=0 returns b"" when nothing is there: that is not an
+                # end of file. A device that goes away raises EIO/ENXIO instead.
+                try:
+                    data = os.read(self._fd, max_bytes)
+                except (BlockingIOError, InterruptedError):
+                    data = b""
+                except OSError as e:
+                    raise LinkClosed(errno.EIO, f"{self.name}: {e.strerror or e}") from None
             else:
                 data = self.ser.read(min(self.ser.in_waiting, max_bytes))
         except serial.SerialException as e:
             raise LinkClosed(errno.EIO, f"{self.name}: {e}") from None
-        return [LinkEvent("data", data)] if data else []
+        if data:
+            self._empty = 0
+            return [LinkEvent("data", data)]
+        if self._fd is not None and select.select([self._fd], [], [], 0)[0]:
+            self._empty += 1  # readable yet nothing to read: a hung-up line
+            if self._empty > 1000:
+                raise LinkClosed(errno.EIO, f"{self.name}: line hung up")
+        return []
 
     def write_some(self, data: bytes) -> int:
         import serial

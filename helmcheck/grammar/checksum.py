@@ -5,24 +5,37 @@ from __future__ import annotations
 __all__ = ["checksum", "checksum_hex"]
 
 
+def _shifts(n: int) -> tuple[int, ...]:
+    width = 1
+    while width < n:
+        width <<= 1
+    out = []
+    while width > 1:
+        width >>= 1
+        out.append(width * 8)
+    return tuple(out)
+
+
+#: For a body of n bytes, the bit shifts that fold it onto its lowest byte.
+_SHIFTS = tuple(_shifts(n) for n in range(1025))
+
+
 def checksum(body: bytes | str) -> int:
     """XOR of the bytes of ``body`` (the text between ``$`` and ``*``), 0..255."""
     if isinstance(body, str):
         body = body.encode("latin-1")
     n = len(body)
-    if n == 0:
-        return 0
-    # Fold the bytes as one big integer: XOR-ing halves keeps the per-byte XOR. This runs in
-    # O(log n) big-integer steps instead of a Python loop per byte.
-    width = 1
-    while width < n:
-        width <<= 1
+    if n <= 16:
+        x = 0
+        for c in body:
+            x ^= c
+        return x
+    # Fold the bytes as one big integer: x ^= x >> half, halving down to one byte, leaves the
+    # XOR of every byte in the lowest byte. O(log n) integer steps instead of one per byte.
     x = int.from_bytes(body, "big")
-    bits = width * 8
-    while bits > 8:
-        bits >>= 1
-        x = (x >> bits) ^ (x & ((1 << bits) - 1))
-    return x
+    for k in _SHIFTS[n] if n < 1025 else _shifts(n):
+        x ^= x >> k
+    return x & 0xFF
 
 
 def checksum_hex(body: bytes | str) -> str:

@@ -26,7 +26,7 @@ from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput
 from ..profile import DEFAULT, Profile
 from . import sentences as S
 from .checksum import checksum
-from .compile import build_sentence, lark_parser, specs
+from .compile import build_sentence, fast_builder, lark_parser, specs
 from .errors import FRAMING, SYNTAX, Finding, SentenceError
 from .ranges import check_ranges
 
@@ -68,8 +68,11 @@ def _first_literal(rule_pattern: str) -> str:
 
 
 _RULES_BY_ID: dict[str, list] = {}
+_FAST: dict[str, list] = {}  # ID -> [(body regex, builder)]
 for _spec in specs().values():
     _RULES_BY_ID.setdefault(_first_literal(_spec.regex.pattern), []).append(_spec)
+    _FAST.setdefault(_first_literal(_spec.regex.pattern), []).append(
+        (_spec.regex.fullmatch, fast_builder(_spec.rule)))
 KNOWN_IDS = frozenset(_RULES_BY_ID)
 _COMMAND_ERR = {cls.ID: (cls.ACK_TYPE, cls.ERR) for cls in S.COMMAND_CLASSES if cls.ACK_TYPE}
 _REPLY_CLAUSE = {"OSI": "RH-OUT-1", "ACK": "RH-ACK-1"}
@@ -89,9 +92,46 @@ def _fail(raw: bytes, err: SentenceError, findings=(), sid=None, term="") -> Dec
     return Decoded(raw, None, err, tuple(findings), sid, term)
 
 
+#: The shape of a clean line: printable body without "$" or "*", upper-case checksum, CR LF.
+_CLEAN = re.compile(rb"\$([ -#%-)+-~]*)\*([0-9A-F]{2})\r\n")
+_RANGES = check_ranges
+_HEX_UPPER = {b"%02X" % i: i for i in range(256)}
+
+
+def _fast(raw: bytes, profile: Profile) -> Optional[S.Sentence]:
+    """The sentence of a clean, valid line, or None to send the line through the full reading.
+
+    This is only a shortcut: it accepts nothing the full reading would refuse.
+    """
+    m = _CLEAN.fullmatch(raw)
+    if m is None or len(raw) > profile.max_line_bytes:
+        return None
+    body, cks = m.groups()
+    if checksum(body) != _HEX_UPPER[cks]:
+        return None
+    text = body.decode("ascii")
+    comma = text.find(",")
+    head = text if comma < 0 else text[:comma]
+    candidates = _FAST.get(head)
+    if candidates is None:
+        if head[:1] != "C" or head[1:2] not in "-0123456789":
+            return None
+        candidates = _FAST["C"]
+    for fullmatch, build in candidates:
+        mm = fullmatch(text)
+        if mm is not None:
+            s = build(mm)
+            return s if _RANGES(s, profile) is None else None
+    return None
+
+
 def decode(line: bytes | str, profile: Profile = DEFAULT, engine: str = "fast") -> Decoded:
     """Read one line (with or without its terminator). Never raises for bad input."""
     raw = line.encode("latin-1", "replace") if isinstance(line, str) else bytes(line)
+    if engine == "fast":
+        s = _fast(raw, profile)
+        if s is not None:
+            return Decoded(raw, s, None, (), s.ID, "\r\n")
     findings: list[Finding] = []
     if raw.endswith(b"\r\n"):
         term, data = "\r\n", raw[:-2]
@@ -149,6 +189,10 @@ def decode(line: bytes | str, profile: Profile = DEFAULT, engine: str = "fast") 
 
 def parse(line: bytes | str, profile: Profile = DEFAULT, engine: str = "fast") -> S.Sentence:
     """The sentence on this line; raises :class:`SentenceError` naming clause and column."""
+    if engine == "fast" and type(line) is bytes:
+        s = _fast(line, profile)
+        if s is not None:
+            return s
     d = decode(line, profile, engine)
     if d.error is not None:
         raise d.error
@@ -157,10 +201,10 @@ def parse(line: bytes | str, profile: Profile = DEFAULT, engine: str = "fast") -
 
 def _read_body(body: str, sid: str, engine: str):
     if engine == "fast":
-        for spec in _RULES_BY_ID[sid]:
-            m = spec.regex.fullmatch(body)
+        for fullmatch, build in _FAST[sid]:
+            m = fullmatch(body)
             if m is not None:
-                return build_sentence(spec, m.groupdict())
+                return build(m)
         return _locate_error(body, sid)
     if engine == "lark":
         try:

@@ -353,3 +353,76 @@ def _init_tables() -> None:
 
 
 _init_tables()
+
+
+# --------------------------------------------------------------------------- fast builders
+
+def _items(f: FieldSpec, text: Optional[str]) -> tuple:
+    if not text:
+        return ()
+    out = []
+    convs = f.item_converts
+    single = len(convs) == 1
+    for m in f.item_regex.finditer(text):
+        if single:
+            g = m.group(1)
+            out.append("" if g is None else convs[0](g))
+        else:
+            out.append(tuple(("" if g is None else c(g)) for g, c in zip(m.groups(), convs)))
+    return tuple(out)
+
+
+def _builder_expr(spec: SentenceSpec, index: dict, env: dict, tag: str) -> str:
+    """Source of an expression building ``spec.cls`` from ``t`` (the groups of a match whose
+    group numbers are ``index``); embedded sentences are built inline from the same groups."""
+    cls = spec.cls
+    env[f"cls{tag}"] = cls
+    by_attr = {f.attr: f for f in spec.fields}
+    required = dict(_REQUIRED.get(cls, ()))
+    subs = _SUBS.get(cls, {})
+    hints = typing.get_type_hints(cls)
+    args = []
+    for i, fld in enumerate(fields(cls)):
+        name, k = fld.name, f"{tag}_{i}"
+        if name in subs:
+            sub_spec = _SPEC_BY_CLASS[subs[name]]
+            first = index[sub_spec.fields[0].rule] - 1
+            args.append(f"({_builder_expr(sub_spec, index, env, k)} if t[{first}] is not None else None)")
+            continue
+        f = by_attr.get(name)
+        if f is None:
+            args.append(repr(fld.default))
+            continue
+        env[f"c{k}"] = f.convert
+        conv = f"c{k}" if f.convert is not str else ""
+        g = f"t[{index[f.rule] - 1}]"
+        if f.kind == "flag":
+            args.append(f"({g} is not None)")
+        elif f.kind == "items":
+            env[f"f{k}"] = f
+            args.append(f"_items(f{k}, {g})")
+        elif f.kind == "opt":
+            empty = "''" if f.convert is str else "None"
+            args.append(f"(None if (v{k} := {g}) is None else ({conv}(v{k}[1:]) if len(v{k}) > 1 else {empty}))")
+        elif name in required and typing.get_origin(hints[name]) is not typing.Union:
+            # required and never None: the grammar always supplies it (text may be empty)
+            args.append(f"({g} or '')" if f.convert is str else f"{conv}({g})")
+        else:
+            absent = ("''" if required[name] else "None") if name in required else repr(fld.default)
+            args.append(f"(({conv}(v{k})) if (v{k} := {g}) is not None else {absent})")
+    return f"cls{tag}(" + ", ".join(args) + ")"
+
+
+@lru_cache(maxsize=None)
+def fast_builder(rule: str) -> Callable[[re.Match], S.Sentence]:
+    """A function ``match -> sentence`` generated from the rule's field layout.
+
+    It does what :func:`build_sentence` does, without interpreting the layout per line: the
+    fast path calls it once per line. ``tests/test_grammar_roundtrip.py`` checks both agree.
+    """
+    spec = specs()[rule]
+    env: dict[str, Any] = {"_items": _items}
+    expr = _builder_expr(spec, spec.regex.groupindex, env, "")
+    src = "def build(m):\n    t = m.groups()\n    return " + expr + "\n"
+    exec(compile(src, f"<builder {rule}>", "exec"), env)
+    return env["build"]

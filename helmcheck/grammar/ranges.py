@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import re
 from decimal import Decimal
+from functools import lru_cache
 from typing import Callable, Iterator, Optional
 
 from ..profile import Profile, SAFETY_CODES
@@ -53,6 +54,7 @@ def _between(v, lo, hi, clause, field, hi_open=False) -> Iterator[Problem]:
         yield clause, field, f"{field} {v} is outside [{lo}, {hi}{right}"
 
 
+@lru_cache(maxsize=64)
 def _num(x: float) -> Decimal:
     return _D(repr(float(x)))
 
@@ -206,9 +208,9 @@ def _compass(s: S.Compass, p: Profile) -> Iterator[Problem]:
 
 
 def _gprmc(s: S.GPRMC, p: Profile) -> Iterator[Problem]:
-    if s.lat and (int(s.lat[:2]) > 90 or _D(s.lat[2:]) >= 60):
+    if s.lat and (int(s.lat[:2]) > 90 or float(s.lat[2:]) >= 60):
         yield "RH-OUT-3", "lat", f"latitude {s.lat} is not a valid ddmm.mmmm"
-    if s.lon and (int(s.lon[:3]) > 180 or _D(s.lon[3:]) >= 60):
+    if s.lon and (int(s.lon[:3]) > 180 or float(s.lon[3:]) >= 60):
         yield "RH-OUT-3", "lon", f"longitude {s.lon} is not a valid dddmm.mmmm"
 
 

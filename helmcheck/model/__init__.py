@@ -5,7 +5,9 @@ Modules, one concern each:
 * :mod:`~helmcheck.model.transitions` — the transition table (the one source of truth) and its
   fast dispatch index; :mod:`~helmcheck.model.chart` — the python-statemachine statechart built
   from it; :mod:`~helmcheck.model.docs` — generated Graphviz/Markdown docs.
-* :mod:`~helmcheck.model.vehicle` — :class:`VehicleModel` (``receive``/``advance``/``plant``).
+* :mod:`~helmcheck.model.vehicle` — :class:`VehicleModel` (``receive``/``advance``/``plant``);
+  :mod:`~helmcheck.model.handlers` — what each accepted event does to the data;
+  :mod:`~helmcheck.model.records` — logged rows and ``$OPOS`` outcomes.
 * :mod:`~helmcheck.model.validate` — field ranges; :mod:`~helmcheck.model.settings` — the
   ``$ORWSET`` store; :mod:`~helmcheck.model.data` — data sentences; :mod:`~helmcheck.model.timers`.
 * :mod:`~helmcheck.model.missions` — missions and the catalogue protocol;

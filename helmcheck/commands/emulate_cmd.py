@@ -1,0 +1,177 @@
+"""``helmcheck emulate``: the reference vehicle on a pty, a serial device or a TCP serial server.
+
+The emulator answers exactly as the reference model does (:mod:`helmcheck.model`); it adds
+plant dynamics, mission files, the settings store and the main log
+(:mod:`helmcheck.conformance.emulator`). The first line on standard output is
+``port: <what to open>`` (flushed), so scripts and backseats can connect; everything else goes
+to standard error (or the live view with ``--tui``). SIGINT/SIGTERM stop it with exit 0;
+bad arguments or a malformed profile exit 64 with a one-line reason.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+from datetime import datetime, timezone
+from pathlib import Path
+
+from .. import exitcodes
+
+EPILOG = """\
+examples:
+  helmcheck emulate                                   # pty, prints 'port: /dev/pts/N'
+  helmcheck emulate --time-scale 50 --log wire.log    # 50x faster vehicle clock (RH-TIM-2)
+  helmcheck emulate --port socket://127.0.0.1:4001    # a serial server, one client at a time
+  helmcheck emulate --port /dev/ttyUSB0 --baud 19200  # a real serial line, 8N1
+  helmcheck emulate --tui                             # live view: traffic, fins, mode, timers
+
+--baud paces the output at the line rate (10 bits per byte); --baud 0 sends unpaced (pty and
+socket only). Built-in missions: conformance.mis (the profile's test mission), short.mis,
+srp.mis; --missions DIR adds a directory that overrides them. $OXFLT,<code> (RH-SAF-5) is
+honoured unless --no-fault-injection.
+"""
+
+
+def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
+    p = sub.add_parser("emulate", help="run the reference vehicle emulator on a serial port",
+                       description=__doc__.split("\n\n")[0].split(": ", 1)[1],
+                       epilog=EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--port", default="pty", metavar="PORT",
+                   help="pty (default), a device path, or socket://HOST:PORT (port 0: any free port)")
+    p.add_argument("--baud", type=int, metavar="N",
+                   help="line rate for pacing and for a device (default: the profile's, 19200; 0 = unpaced)")
+    p.add_argument("--profile", metavar="FILE", help="TOML profile (default: rh5)")
+    p.add_argument("--time-scale", type=float, metavar="K",
+                   help="vehicle clock runs K times faster than wall time (default: the profile's, 1)")
+    p.add_argument("--missions", metavar="DIR", help="extra mission directory (overrides the built-in missions)")
+    p.add_argument("--log", metavar="FILE", help="wire log of both directions (helmcheck wire-log 1)")
+    p.add_argument("--main-log", metavar="FILE",
+                   help="CSV for $OLOGD rows (default: <log stem>.mainlog.csv next to --log)")
+    p.add_argument("--settings", metavar="FILE", help="JSON file that keeps $ORWSET settings across runs")
+    p.add_argument("--tui", action="store_true", help="live view in the terminal")
+    p.add_argument("--fault-injection", action=argparse.BooleanOptionalAction, default=True,
+                   help="honour $OXFLT,<code> (RH-SAF-5); default on")
+    p.set_defaults(func=run)
+    return p
+
+
+def _usage(msg: str) -> int:
+    print(f"helmcheck emulate: {msg}", file=sys.stderr)
+    return exitcodes.USAGE
+
+
+def run(args: argparse.Namespace) -> int:  # noqa: C901 - argument checks, then one call
+    from ..profile import ProfileError, load_profile
+    from ..conformance.transport import BAUD_RATES, parse_port_spec
+
+    try:
+        profile = load_profile(args.profile)
+    except ProfileError as e:
+        return _usage(str(e))
+    scale = args.time_scale if args.time_scale is not None else profile.time_scale
+    if not (isinstance(scale, float) or isinstance(scale, int)) or not math.isfinite(scale) or scale <= 0:
+        return _usage(f"--time-scale must be a positive number (got {args.time_scale})")
+    baud = args.baud if args.baud is not None else profile.baud
+    if baud != 0 and baud not in BAUD_RATES:
+        return _usage(f"--baud must be 0 or one of {', '.join(map(str, BAUD_RATES))} (got {baud})")
+    try:
+        spec = parse_port_spec(args.port)
+    except ValueError as e:
+        return _usage(f"--port: {e}")
+    if spec.kind in ("device", "url") and baud == 0:
+        return _usage("--baud 0 (unpaced) needs --port pty or socket://")
+    missions_dir = None
+    if args.missions is not None:
+        missions_dir = Path(args.missions)
+        if not missions_dir.is_dir():
+            return _usage(f"--missions: {args.missions} is not a directory")
+    profile = profile.replace(time_scale=float(scale), baud=baud if baud else profile.baud,
+                              fault_injection="oxflt" if args.fault_injection else "none")
+    log_file = main_log_file = None
+    try:
+        if args.log:
+            log_file = open(args.log, "w", encoding="utf-8")
+        main_log_path = args.main_log
+        if main_log_path is None and args.log:
+            lp = Path(args.log)
+            main_log_path = str(lp.with_name(lp.stem + ".mainlog.csv"))
+        if main_log_path:
+            main_log_file = open(main_log_path, "w", encoding="utf-8", newline="")
+    except OSError as e:
+        for f in (log_file, main_log_file):
+            if f is not None:
+                f.close()
+        return _usage(f"cannot write {e.filename}: {e.strerror or e}")
+    return _serve(args, profile, spec, baud, missions_dir, log_file, main_log_file)
+
+
+def _serve(args, profile, spec, baud, missions_dir, log_file, main_log_file) -> int:
+    import signal
+    import time
+
+    # Stop cleanly even if a signal arrives while the grammar is still loading.
+    stopping: dict = {"now": False}
+
+    def early(*_):
+        stopping["now"] = True
+        if "server" in stopping:
+            stopping["server"].stop(0)
+
+    signal.signal(signal.SIGINT, early)
+    signal.signal(signal.SIGTERM, early)
+
+    from ..conformance.transport import open_link
+    from ..grammar.capture import WireLogWriter
+    from ..conformance.emulator.core import EmulatorCore, MainLog
+    from ..conformance.emulator.missionfile import DirectoryCatalog, builtin_dir
+    from ..conformance.emulator.server import Server
+
+    try:
+        link = open_link(spec, role="server", baud=baud if baud else 19200)
+    except (OSError, ValueError) as e:
+        return _usage(f"cannot open {args.port}: {getattr(e, 'strerror', None) or e}")
+    dirs = ([missions_dir] if missions_dir is not None else []) + [builtin_dir()]
+    catalog = DirectoryCatalog(dirs)
+    started = datetime.now(timezone.utc)
+    log = None
+    if log_file is not None:
+        log = WireLogWriter(log_file, meta=(f"started {started.strftime('%Y-%m-%dT%H:%M:%S.%fZ')}  "
+                                            f"port {link.name}  baud {baud}  time_scale {profile.time_scale:g}"))
+    core = EmulatorCore(profile, catalog, start=time.monotonic(), baud=baud, log=log,
+                        main_log=MainLog(main_log_file) if main_log_file is not None else None,
+                        settings_path=Path(args.settings) if args.settings else None,
+                        utc0=started.timestamp())
+    try:
+        sys.stdout.write(f"port: {link.name}\n")
+        sys.stdout.flush()
+    except OSError:
+        pass
+    print(f"helmcheck emulate: {link.description}, profile {profile.name}, time scale "
+          f"{profile.time_scale:g}, baud {baud or 'unpaced'}, fault injection "
+          f"{profile.fault_injection}, missions {', '.join(str(d) for d in dirs)}", file=sys.stderr)
+    ui = None
+    if args.tui:
+        from ..conformance.emulator.tui import LiveView
+        ui = LiveView(core, link.name)
+    server = Server(link, core, ui=ui)
+    stopping["server"] = server
+    if stopping["now"]:
+        server.stop(0)
+    status = 0
+    try:
+        if ui is not None:
+            ui.start()
+        status = server.run()
+    finally:
+        if ui is not None:
+            ui.close()
+        link.close()
+        if log is not None:
+            log.note(time.monotonic() - core.start, "emulator stopped")
+            log.close()
+        if main_log_file is not None:
+            main_log_file.close()
+    if status == 0:
+        print("helmcheck emulate: stopped", file=sys.stderr)
+    return status if status in (0, exitcodes.INCONCLUSIVE) else exitcodes.INCONCLUSIVE

@@ -1,0 +1,20 @@
+"""The reference vehicle emulator: the model's behaviour on a real serial line.
+
+Modules, one concern each:
+
+* :mod:`.core` — :class:`~.core.EmulatorCore`, the sans-IO core (model + plant + framer + logs).
+* :mod:`.plant` — plant dynamics (motion, depth, battery) that feed the model's plant events.
+* :mod:`.missionfile` — the mission file format and the directory catalogue (RH-MSN-1).
+* :mod:`.server` — the I/O loop on a pty, serial device or TCP serial server.
+* :mod:`.tui` — the optional live view in the spirit of the UVC remote-helm debug window.
+* :mod:`.process` — start an emulator subprocess and learn its port (tests, benchmarks, tools).
+
+The protocol behaviour is the model's (:mod:`helmcheck.model`), exactly; this package adds only
+physics, files, logs and I/O.
+"""
+
+from .core import EmulatorCore, HistoryEntry, MainLog
+from .missionfile import DirectoryCatalog, builtin_dir, parse_mission
+
+__all__ = ["EmulatorCore", "HistoryEntry", "MainLog", "DirectoryCatalog", "builtin_dir",
+           "parse_mission"]

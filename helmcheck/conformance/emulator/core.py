@@ -1,0 +1,436 @@
+"""The emulator's sans-IO core: bytes and wall-clock times in, bytes out.
+
+:class:`EmulatorCore` owns one emulated vehicle: the reference model
+(:class:`~helmcheck.model.vehicle.VehicleModel`, which alone decides every reply), the plant
+(:mod:`.plant`), the line framer, output pacing, the wire log and the main log. It never reads a
+clock and never touches a descriptor: the I/O loop (:mod:`.server`) passes ``now`` (wall
+seconds, any monotonic origin) into every call and writes what comes back.
+
+* ``feed(data, now) -> bytes`` — bytes from the backseat; returns the bytes the line can carry
+  now (the rest waits for :meth:`tick`).
+* ``tick(now) -> bytes`` — time passed: runs model timers and plant events due by ``now``.
+* ``next_wakeup() -> float | None`` — the wall time at which ``tick`` has something to do.
+
+Input handling: the framer cuts lines (RH-FRM-6/7); each line is decoded against the profile.
+A valid command goes to the model; a well-framed known command with bad fields goes to the
+model as its :class:`~helmcheck.grammar.errors.SentenceError` so it is answered with the
+error ACK (RH-ACK-3); framing errors and unknown IDs are discarded silently (RH-FRM-4/5).
+
+Time (RH-TIM-2): vehicle time is ``time_scale × (now - start)``; the model and the plant run on
+vehicle time, so every protocol duration shrinks by the time scale in wall time. Output pacing
+(10 bits per byte at ``baud``, RH-ACK-2's transmit time) is wall time. ``baud = 0`` sends
+everything at once.
+
+Logs: the wire log (``helmcheck.grammar.capture`` format) records every input line or
+discarded run (``>``/``>~``), every sentence sent (``<``) and notes (``!``) for plant and model
+events, injected faults and link changes; times are wall seconds since ``start``. Accepted
+``$OLOGD`` rows (RH-LOG-2) go to the main log, a CSV file.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+from collections import deque
+from dataclasses import dataclass, fields as dc_fields
+from pathlib import Path
+from typing import IO, Any, Callable, Optional
+
+from ...grammar import Decoded, Discard, Framer, decode, format as format_sentence
+from ...grammar import sentences as s
+from ...grammar.capture import FROM_VEHICLE, NOTE, TO_VEHICLE, WireLogWriter, escape
+from ...grammar.errors import SentenceError
+from ...model.missions import MissionCatalog
+from ...model.plant import SafetyViolation
+from ...model.vehicle import VehicleModel
+from ...profile import SAFETY_CODES, Profile
+from ..transport import LinePacer
+from .plant import Plant, PlantParams
+
+__all__ = ["EmulatorCore", "HistoryEntry", "MainLog", "MAX_OUTBOX_BYTES", "DEFAULT_UTC0"]
+
+#: Replies waiting for the line are capped; beyond this a flood's replies are dropped (noted).
+MAX_OUTBOX_BYTES = 64 * 1024
+#: Model lists that grow per command are trimmed to this many entries (bounded memory).
+_KEEP_RECORDS = 256
+DEFAULT_UTC0 = 1_767_225_600.0  # 2026-01-01T00:00:00Z
+
+
+@dataclass(frozen=True, slots=True)
+class HistoryEntry:
+    """One line for a live view: wall seconds since start, direction, text, verdict."""
+
+    t: float
+    direction: str  #: ">" in, "<" out, "!" note
+    text: str
+    verdict: str = ""
+
+
+class MainLog:
+    """The vehicle's main log as CSV: a header row whenever the ``$OLOGL`` labels change,
+    then one row per accepted ``$OLOGD`` (RH-LOG-1, RH-LOG-2)."""
+
+    def __init__(self, stream: IO[str]):
+        self._f = stream
+        self._w = csv.writer(stream, lineterminator="\n")
+        self._labels: Optional[tuple[str, ...]] = None
+
+    def write(self, vehicle_t: float, utc: float, lat: float, lon: float, depth: float,
+              labels: tuple[str, ...], values: tuple[str, ...]) -> None:
+        if labels != self._labels:
+            self._w.writerow(["vehicle_time_s", "utc", "lat", "lon", "depth_m", *labels])
+            self._labels = labels
+        self._w.writerow([f"{vehicle_t:.3f}", f"{utc:.3f}", f"{lat:.8f}", f"{lon:.8f}",
+                          f"{depth:.2f}", *values])
+        self._f.flush()
+
+    def close(self) -> None:
+        self._f.close()
+
+
+def _event_text(e: Any) -> str:
+    parts = [f"{f.name}={getattr(e, f.name)!r}" for f in dc_fields(e) if f.name != "at"]
+    clause = getattr(e, "clause", "")
+    inner = ", ".join(parts)
+    return f"{type(e).__name__}({inner})" + (f" [{clause}]" if clause else "")
+
+
+class EmulatorCore:
+    """One emulated vehicle behind a byte stream. See the module docstring."""
+
+    def __init__(self, profile: Profile, missions: Optional[MissionCatalog] = None, *,
+                 start: float = 0.0, time_scale: Optional[float] = None, baud: Optional[int] = None,
+                 log: Optional[WireLogWriter] = None, main_log: Optional[MainLog] = None,
+                 settings_path: Optional[Path] = None, utc0: float = DEFAULT_UTC0,
+                 params: Optional[PlantParams] = None, history: int = 400,
+                 on_error: Optional[Callable[[str], None]] = None):
+        self.profile = profile
+        self.time_scale = float(time_scale if time_scale is not None else profile.time_scale)
+        if self.time_scale <= 0:
+            raise ValueError("time scale must be positive")
+        self.start = start
+        self.utc0 = utc0
+        self.plant = Plant(profile, params or PlantParams())
+        self.model = VehicleModel(profile, missions)
+        self.framer = Framer(profile.max_line_bytes)
+        self.pacer = LinePacer(profile.baud if baud is None else baud)
+        self.log = log
+        self.main_log = main_log
+        self.settings_path = settings_path
+        self.history: deque[HistoryEntry] = deque(maxlen=history)
+        self.v = 0.0  #: vehicle time the model and plant have reached
+        self._out: deque[bytes] = deque()
+        self._out_bytes = 0
+        self._on_error = on_error
+        self.stats = {"lines_in": 0, "commands": 0, "answered_errors": 0, "discarded": 0,
+                      "sentences_out": 0, "bytes_in": 0, "bytes_out": 0, "dropped_out": 0,
+                      "model_errors": 0, "faults": 0}
+        self.last_command: Optional[s.Command] = None
+        self.last_command_v: float = 0.0
+        if settings_path is not None:
+            self._load_settings(settings_path)
+        self._push_snapshot()
+
+    # ================================================================ clocks
+    def vehicle_time(self, now: float) -> float:
+        """Vehicle seconds at wall time ``now`` (RH-TIM-2)."""
+        return (now - self.start) * self.time_scale
+
+    def wall_time(self, vehicle_t: float) -> float:
+        return self.start + vehicle_t / self.time_scale
+
+    # ================================================================ public API
+    def feed(self, data: bytes, now: float) -> bytes:
+        """Bytes from the backseat at wall time ``now``; returns bytes to send now."""
+        self.stats["bytes_in"] += len(data)
+        v = self._catch_up(now)
+        for ev in self.framer.feed(data):
+            if isinstance(ev, Discard):
+                self._discard(ev, now)
+            else:
+                self._line(ev.raw, now, v)
+        return self._release(now)
+
+    def tick(self, now: float) -> bytes:
+        """Run whatever is due by ``now``; returns bytes to send now."""
+        self._catch_up(now)
+        return self._release(now)
+
+    def next_wakeup(self) -> Optional[float]:
+        """Wall time of the next thing :meth:`tick` must do, or ``None`` (wait for input)."""
+        best: Optional[float] = None
+        md = self.model.next_deadline()
+        if md is not None:
+            best = self.wall_time(max(md, self.v))
+        pb = self.plant.next_event_in(self.model)
+        if pb is not None:
+            w = self.wall_time(self.v + max(pb, self.plant.params.dt / 4))
+            best = w if best is None else min(best, w)
+        if self._out:
+            w = self.pacer.free_at
+            best = w if best is None else min(best, w)
+        return best
+
+    def inject_fault(self, code: str, now: float, source: str = "key") -> bytes:
+        """Raise safety violation ``code`` on the vehicle at once (RH-SAF-1, RH-SAF-5)."""
+        if code not in SAFETY_CODES:
+            raise ValueError(f"unknown safety code {code!r}")
+        v = self._catch_up(now)
+        self.stats["faults"] += 1
+        self._note(now, f"fault injected ({source}): {code}")
+        self._model_call(lambda: self.model.plant(SafetyViolation(code), v), now)
+        self._after_model(now)
+        return self._release(now)
+
+    def connect(self, now: float, info: str = "") -> None:
+        """A peer connected (TCP); the model's state carries on."""
+        self._note(now, f"link: client connected {info}".rstrip())
+
+    def disconnect(self, now: float, info: str = "") -> None:
+        """The peer went away: pending input is discarded, unsent replies are dropped."""
+        for ev in self.framer.close():
+            self._discard(ev, now)
+        if self._out:
+            self._note(now, f"link: {len(self._out)} unsent sentences dropped")
+            self.stats["dropped_out"] += self._out_bytes
+        self._out.clear()
+        self._out_bytes = 0
+        self.pacer.reset(now)
+        self._note(now, f"link: client disconnected {info}".rstrip())
+
+    def note(self, now: float, text: str) -> None:
+        """Write a ``!`` note in the wire log (and the live history)."""
+        self._note(now, text)
+
+    @property
+    def pending_output(self) -> int:
+        return self._out_bytes
+
+    # ================================================================ input
+    def _discard(self, ev: Discard, now: float) -> None:
+        self.stats["discarded"] += 1
+        if self.log is not None:
+            self.log.bytes(now - self.start, TO_VEHICLE, ev.raw)
+            if ev.length > len(ev.raw):
+                self.log.note(now - self.start, f"{ev.clause}: {ev.length} bytes discarded, "
+                                                f"first {len(ev.raw)} logged")
+        self.history.append(HistoryEntry(now - self.start, ">", escape(ev.raw[:120]),
+                                         f"discard {ev.clause}: {ev.reason}"))
+
+    def _line(self, raw: bytes, now: float, v: float) -> None:
+        self.stats["lines_in"] += 1
+        if self.log is not None:
+            self.log.bytes(now - self.start, TO_VEHICLE, raw)
+        d: Decoded = decode(raw, self.profile)
+        item: Any = None
+        if d.sentence is not None:
+            if isinstance(d.sentence, s.Command):
+                item = d.sentence
+                verdict = f"ok {type(item).__name__}"
+            else:
+                verdict = f"ignored: {type(d.sentence).__name__} is not a command"
+        elif d.error is not None and d.error.answered:
+            item = d.error
+            verdict = f"error ACK: {d.error}"
+        else:
+            verdict = f"discard {d.error}" if d.error is not None else "discard"
+        text = escape(raw.rstrip(b"\r\n")[:160])
+        self.history.append(HistoryEntry(now - self.start, ">", text, verdict))
+        if item is None:
+            self.stats["discarded"] += 1
+            return
+        if isinstance(item, SentenceError):
+            self.stats["answered_errors"] += 1
+        else:
+            self.stats["commands"] += 1
+        self._command(item, now, v)
+
+    def _command(self, item: Any, now: float, v: float) -> None:
+        m = self.model
+        snap_before = m.snapshot
+        if isinstance(item, s.OXFLT):
+            if self.profile.fault_injection == "oxflt":
+                self.stats["faults"] += 1
+                self._note(now, f"fault injected ($OXFLT): {item.code}")
+        replies = self._model_call(lambda: m.receive(item, v), now)
+        if replies is None:
+            return
+        if isinstance(item, s.Command) and type(item) is not s.OSD:
+            self.last_command = item
+            self.last_command_v = v
+        accepted = bool(replies) and isinstance(replies[-1], s.ACK) and replies[-1].status == 0
+        if accepted:
+            if isinstance(item, s.OPOS) and m.snapshot is not snap_before:
+                self.plant.apply_fix(m.snapshot)
+            elif isinstance(item, s.OLOGD):
+                self._write_main_log()
+            elif isinstance(item, s.ORWSET) and item.access == "W" and self.settings_path is not None:
+                self._save_settings(self.settings_path)
+        for r in replies:
+            self._send(format_sentence(r), now)
+        self._after_model(now)
+
+    def _model_call(self, fn: Callable[[], Any], now: float) -> Any:
+        """Call into the model; a model exception is logged, never fatal to the emulator."""
+        try:
+            return fn()
+        except Exception as e:  # noqa: BLE001 - keep serving; the note names the failure
+            self.stats["model_errors"] += 1
+            text = f"model error: {type(e).__name__}: {e}"
+            self._note(now, text)
+            if self._on_error is not None:
+                self._on_error(text)
+            return None
+
+    def _after_model(self, now: float) -> None:
+        """Flush the model's pending events to the log and let the plant see the new goal."""
+        evs = self._model_call(lambda: self.model.advance(self.v), now) or ()
+        for e in evs:
+            self._note(now, f"model: {_event_text(e)}")
+        self.plant.sync(self.model)
+        m = self.model
+        if len(m.log_rows) > 2 * _KEEP_RECORDS:
+            del m.log_rows[:-_KEEP_RECORDS]
+            self._log_written = len(m.log_rows)
+        if len(m.opos_records) > 2 * _KEEP_RECORDS:
+            del m.opos_records[:-_KEEP_RECORDS]
+
+    _log_written = 0
+
+    def _write_main_log(self) -> None:
+        rows = self.model.log_rows
+        if self.main_log is not None:
+            p = self.plant
+            for row in rows[self._log_written:]:
+                self.main_log.write(row.at, self.utc0 + row.at, p.lat, p.lon, p.depth,
+                                    row.labels, row.values)
+        self._log_written = len(rows)
+
+    # ================================================================ time
+    def _catch_up(self, now: float) -> float:
+        """Bring plant and model to vehicle time ``vehicle_time(now)``, events in time order."""
+        target = self.vehicle_time(now)
+        if target < self.v:
+            target = self.v
+        m, p = self.model, self.plant
+        for _ in range(100_000):  # a hard bound; each pass consumes time, an event or a timer
+            md = m.next_deadline()
+            if md is not None and md <= self.v:
+                self._push_snapshot()
+                wall = self.wall_time(self.v)
+                for me in self._model_call(lambda: m.advance(self.v), wall) or ():
+                    self._note(wall, f"model: {_event_text(me)}")
+                p.sync(m)
+                continue
+            seg_end = target if md is None or md > target else md
+            if self.v >= seg_end:
+                break
+            evs = p.step(m, seg_end - self.v)
+            if not evs:
+                self.v = seg_end
+                continue
+            self.v = min(seg_end, self.v + p.consumed)
+            self._push_snapshot()
+            wall = self.wall_time(self.v)
+            for e in evs:
+                self._note(wall, f"plant: {_event_text(e)} at v={self.v:.3f}")
+                for me in self._model_call(lambda e=e: m.plant(e, self.v), wall) or ():
+                    self._note(wall, f"model: {_event_text(me)}")
+            p.sync(m)
+        self._push_snapshot()
+        return self.v
+
+    def _push_snapshot(self) -> None:
+        m = self.model
+        snap = self.plant.snapshot(m, self.v, self.utc0, m.snapshot)
+        out = self._model_call(lambda: m.update_plant(snap), self.wall_time(self.v)) or ()
+        for me in out:
+            self._note(self.wall_time(self.v), f"model: {_event_text(me)}")
+
+    # ================================================================ output
+    def _send(self, raw: bytes, now: float) -> None:
+        if self._out_bytes + len(raw) > MAX_OUTBOX_BYTES:
+            self.stats["dropped_out"] += len(raw)
+            if self.stats["dropped_out"] == len(raw):
+                self._note(now, "output overflow: replies dropped (the line is slower than the requests)")
+            return
+        self._out.append(raw)
+        self._out_bytes += len(raw)
+
+    def _release(self, now: float) -> bytes:
+        if not self._out:
+            return b""
+        out = bytearray()
+        pacer = self.pacer
+        while self._out:
+            if pacer.baud and pacer.free_at > now + 1e-9:
+                break
+            raw = self._out.popleft()
+            self._out_bytes -= len(raw)
+            pacer.reserve(len(raw), now)
+            out += raw
+            self.stats["sentences_out"] += 1
+            if self.log is not None:
+                self.log.bytes(now - self.start, FROM_VEHICLE, raw)
+            self.history.append(HistoryEntry(now - self.start, "<", escape(raw.rstrip(b"\r\n")[:160])))
+        self.stats["bytes_out"] += len(out)
+        return bytes(out)
+
+    def _note(self, now: float, text: str) -> None:
+        if self.log is not None:
+            self.log.note(now - self.start, text)
+        self.history.append(HistoryEntry(now - self.start, NOTE, text))
+
+    # ================================================================ settings store
+    def _load_settings(self, path: Path) -> None:
+        """Restore ``$ORWSET`` settings saved by an earlier run (RH-SET-2); a bad file is ignored."""
+        try:
+            data = json.loads(Path(path).read_text(encoding="utf-8"))
+        except (OSError, ValueError):
+            return
+        if not isinstance(data, dict):
+            return
+        store = self.model.settings
+        known = store.as_dict()
+        for name, value in data.items():
+            if name not in known or not isinstance(value, list) or len(value) != 2:
+                continue
+            state, values = value
+            if state in (0, 1) and isinstance(values, list) and all(isinstance(x, str) for x in values):
+                store.write(name, state, tuple(values[:3]))
+
+    def _save_settings(self, path: Path) -> None:
+        data = {k: [st, list(vals)] for k, (st, vals) in self.model.settings.as_dict().items()}
+        tmp = Path(str(path) + ".tmp")
+        try:
+            tmp.write_text(json.dumps(data, indent=1) + "\n", encoding="utf-8")
+            tmp.replace(path)
+        except OSError as e:
+            self._note(self.wall_time(self.v), f"settings not saved: {e}")
+
+    # ================================================================ live view
+    def view(self) -> dict[str, Any]:
+        """What a live display shows (mode, set-points, countdowns, position)."""
+        m = self.model
+        t = m.timers
+        v = self.v
+        osi = None
+        try:
+            osi = m.osi(v)
+        except Exception:  # noqa: BLE001
+            pass
+        remote_left = t.remaining("remote", v) if t.armed("remote") else None
+        lockout_left = t.remaining("lockout", v) if t.armed("lockout") else None
+        p = self.plant
+        return {
+            "v": v, "time_scale": self.time_scale, "mode": m.mode, "phase": m.phase,
+            "error_state": m.error_state, "next_wp": m.osi_waypoint,
+            "mission": (m.mission or m.loaded).name if (m.mission or m.loaded) else "",
+            "actuators": osi.actuators if osi is not None else "",
+            "park_left": m.park_remaining(v), "remote_left": remote_left,
+            "lockout_left": lockout_left, "queue": len(m.queue),
+            "lat": p.lat, "lon": p.lon, "depth": p.depth, "heading": p.heading,
+            "speed": p.speed_kn, "battery": 100.0 * p.energy_wh / p.params.capacity_wh,
+            "distance": float(osi.distance) if osi is not None else 0.0,
+            "last_command": self.last_command, "stats": dict(self.stats),
+        }
