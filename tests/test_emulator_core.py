@@ -208,6 +208,7 @@ def test_RH_SAF_1_fault_key_lockout_ascent_and_surface_park():
     core.feed(frame("OMSTART,0,0,0,0,conformance.mis"), 0.0)
     run_until(core, 0.0, 0.5)  # dive to 2 m
     core.inject_fault("Sle", 0.5)
+    assert any("SafetyRaised(code='Sle')" in h.text for h in core.history)
     o = osi(core, 0.51)
     assert (o.mode, o.error_state) == ("N", "Sle")
     assert acks(core.feed(frame("OMP,8080808080,00,5"), 0.52)) == [(10, 1, 26)]

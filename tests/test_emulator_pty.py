@@ -8,10 +8,14 @@ time and a 10 s servo timeout 0.5 s. The soak test's duration is ``HELMCHECK_SOA
 
 from __future__ import annotations
 
+import atexit
 import os
 import random
+import shutil
+import tempfile
 import time
 from decimal import Decimal
+from pathlib import Path
 
 import pytest
 
@@ -23,9 +27,9 @@ K = 20.0  # time scale
 SOAK_S = float(os.environ.get("HELMCHECK_SOAK_S", "8"))
 
 
-@pytest.fixture(scope="module")
-def missions_dir(tmp_path_factory):
-    root = tmp_path_factory.mktemp("emu")
+def _missions_dir() -> Path:
+    root = Path(tempfile.mkdtemp(prefix="helmcheck-emu-"))
+    atexit.register(shutil.rmtree, root, True)
     d = root / "missions"
     d.mkdir()
     (root / "secret.mis").write_text("helmcheck-mission 1\n41.52 -71.32 1 2 0\n")
@@ -34,29 +38,38 @@ def missions_dir(tmp_path_factory):
     return d
 
 
+# Launched at import, so the emulator loads while other modules are collected and run.
+_MISSIONS = _missions_dir()
+_LOG = _MISSIONS.parent / "wire.log"
+_EMU = EmulatorProcess(["--missions", str(_MISSIONS), "--log", str(_LOG)], time_scale=K, baud=115200).launch()
+atexit.register(_EMU.stop)
+
+
 @pytest.fixture(scope="module")
-def emulator(missions_dir):
-    log = missions_dir.parent / "wire.log"
-    emu = EmulatorProcess(["--missions", str(missions_dir), "--log", str(log)], time_scale=K, baud=115200)
-    emu.start()
-    emu.log_path = log
-    yield emu
-    status = emu.stop()
-    assert status == 0, emu.stderr_text()
-    assert "Traceback" not in emu.stderr_text()
+def emulator():
+    _EMU.wait_ready()
+    _EMU.log_path = _LOG
+    yield _EMU
+    status = _EMU.stop()
+    assert status == 0, _EMU.stderr_text()
+    assert "Traceback" not in _EMU.stderr_text()
+
+
+def reset(c: HelmClient) -> None:
+    """Back to S; waits out a lockout left by an earlier test (OMSTOP is refused during it)."""
+    c.drain(0.02)
+    for _ in range(100):
+        if c.ack("OMSTOP,0", 1).status == 0:
+            break
+        time.sleep(0.1)
+    assert c.osi().mode == "S"
 
 
 @pytest.fixture
 def helm(emulator):
     link = emulator.connect(baud=115200)
     c = HelmClient(link)
-    c.drain(0.02)
-    for _ in range(100):  # start from S; wait out a lockout left by an earlier test
-        a = c.ack("OMSTOP,0", 1)
-        if a.status == 0:
-            break
-        time.sleep(0.1)
-    assert c.osi().mode == "S"
+    reset(c)
     yield c
     link.close()
 
@@ -92,14 +105,16 @@ def test_RH_SRV_4_servo_timeout_and_resume(helm):
     assert helm.osi().mode == "A"  # RH-SRV-3
     for _ in range(3):  # refreshed within the timeout: stays A (RH-SRV-3)
         time.sleep(0.15)
+        t_sent = time.monotonic()  # the timer restarts between this and the ACK
         assert ok(helm.ack("OMS,180,3,20,2,10", 9)) == (9, 0, 0)
+        t_acked = time.monotonic()
         assert helm.osi().mode == "A"
-    t_last = time.monotonic()
     o = wait_for(helm, lambda o: o.mode != "A", timeout=3.0, every=0.01)
-    elapsed_vehicle = (time.monotonic() - t_last) * K
+    t_seen = time.monotonic()
     assert (o.mode, o.next_waypoint) == ("N", wp)  # RH-SRV-4 -> RH-INT-2: the same waypoint
-    assert 10 - 0.5 <= elapsed_vehicle <= 10 + 0.5 + 0.2 * K  # tolerance plus polling
-    assert time.monotonic() - t0 < 3.0
+    assert (t_seen - t_sent) * K >= 10 - 0.5  # not before the timeout (RH-TIM-1 tolerance)
+    assert (t_seen - t_acked) * K <= 10 + 0.5 + 0.3 * K  # nor long after (plus polling slack)
+    assert time.monotonic() - t0 < 5.0
 
 
 def test_RH_PRM_1_RH_PRM_4_primitive_from_stopped(helm):
@@ -263,8 +278,7 @@ def test_RH_FRM_7_soak_random_bytes_reconnects_and_flat_memory(emulator):
     rng = random.Random(20261121)
     link = emulator.connect(baud=115200)
     c = HelmClient(link)
-    c.drain(0.02)
-    assert c.ack("OMSTOP,0", 1).status == 0 or True
+    reset(c)
     start = time.monotonic()
     warm = start + min(2.0, SOAK_S * 0.25)
     end = start + SOAK_S
@@ -311,15 +325,6 @@ def test_RH_FRM_7_soak_random_bytes_reconnects_and_flat_memory(emulator):
     print(f"soak: {sent} commands in {SOAK_S:.0f} s, {reconnects} reconnects, RSS {rss0} -> {rss1} KiB")
 
 
-def test_wire_log_is_written_per_record(emulator):
-    text = emulator.log_path.read_text()
-    assert text.startswith("# helmcheck wire-log 1\n# started ")
-    assert " > $OSD,S*27" in text and " < $ACK,8,0,0*5D" in text
-    assert " ! fault injected ($OXFLT): Sle" in text
-    assert " ! plant: " in text and " ! model: " in text
-    assert ">~ " in text  # discarded runs are logged whole
-
-
 def test_osi_values_stay_physical(helm):
     start_mission(helm)
     time.sleep(0.2)
@@ -329,3 +334,16 @@ def test_osi_values_stay_physical(helm):
     o = got[2]
     assert 0 <= o.true_heading < 360 and o.speed >= 0 and Decimal("0") <= Decimal(o.battery) <= 100
     assert o.field_count == 21
+
+
+def test_wire_log_is_written_per_record(emulator, helm):
+    helm.send_raw(b"noise" + frame("OSD,S"))
+    helm.until_ack(8)
+    helm.send("OXFLT,Sop")
+    assert helm.osi().error_state == "Sop"
+    text = emulator.log_path.read_text()
+    assert text.startswith("# helmcheck wire-log 1\n# started ")
+    assert " > $OSD,S*27" in text and " < $ACK,8,0,0*5D" in text
+    assert " ! fault injected ($OXFLT): Sop" in text
+    assert " ! plant: " in text and " ! model: " in text
+    assert " >~ noise" in text  # discarded runs are logged whole

@@ -3,11 +3,11 @@
 from __future__ import annotations
 
 from helmcheck.grammar import sentences as S
-from helmcheck.grammar.compile import lark_parser, specs
+from helmcheck.grammar.compile import grammar_defs, specs
 
 
 def _sentence_rules() -> set[str]:
-    body = next(t for n, _p, t, _o in lark_parser().grammar.rule_defs if str(n) == "body")
+    body = next(t for n, _p, t, _o in grammar_defs().rule_defs if str(n) == "body")
     return {str(v.children[0].name) for v in body.iter_subtrees() if v.data == "value"}
 
 

@@ -122,15 +122,16 @@ def _serve(args, profile, spec, baud, missions_dir, log_file, main_log_file) -> 
     signal.signal(signal.SIGTERM, early)
 
     from ..conformance.transport import open_link
-    from ..grammar.capture import WireLogWriter
-    from ..conformance.emulator.core import EmulatorCore, MainLog
-    from ..conformance.emulator.missionfile import DirectoryCatalog, builtin_dir
-    from ..conformance.emulator.server import Server
 
-    try:
+    try:  # before the grammar loads, so a bad port fails fast
         link = open_link(spec, role="server", baud=baud if baud else 19200)
     except (OSError, ValueError) as e:
         return _usage(f"cannot open {args.port}: {getattr(e, 'strerror', None) or e}")
+
+    from ..conformance.emulator.core import EmulatorCore, MainLog
+    from ..conformance.emulator.missionfile import DirectoryCatalog, builtin_dir
+    from ..conformance.emulator.server import Server
+    from ..grammar.capture import WireLogWriter
     dirs = ([missions_dir] if missions_dir is not None else []) + [builtin_dir()]
     catalog = DirectoryCatalog(dirs)
     started = datetime.now(timezone.utc)

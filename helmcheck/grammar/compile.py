@@ -41,8 +41,25 @@ def grammar_text() -> str:
 
 @lru_cache(maxsize=1)
 def lark_parser() -> Lark:
-    """The reference parser (LALR, contextual lexer) with ``line`` and ``body`` start rules."""
-    return Lark(grammar_text(), parser="lalr", start=["line", "body"], maybe_placeholders=True)
+    """The reference parser (LALR, contextual lexer) with ``line`` and ``body`` start rules.
+
+    Building the LALR tables takes seconds, so it happens only when first needed (the Lark
+    engine, locating an error, the property tests) and is cached on disk by Lark between runs.
+    """
+    try:
+        return Lark(grammar_text(), parser="lalr", start=["line", "body"], maybe_placeholders=True,
+                    cache=True)
+    except OSError:  # no writable temp directory: build without the cache
+        return Lark(grammar_text(), parser="lalr", start=["line", "body"], maybe_placeholders=True)
+
+
+@lru_cache(maxsize=1)
+def grammar_defs():
+    """The grammar's rule and terminal definitions, loaded without building a parser."""
+    from lark.load_grammar import load_grammar
+
+    grammar, _used = load_grammar(grammar_text(), GRAMMAR_FILE, None, False)
+    return grammar
 
 
 def sentence_classes_by_rule() -> dict[str, type[S.Sentence]]:
@@ -121,9 +138,9 @@ def _attr_for(cls: type, rule: str) -> tuple[str, str]:
 class _Deriver:
     """Translates Lark's EBNF rule trees into Python regular expressions."""
 
-    def __init__(self, lark: Lark):
-        self.rules = {str(name): tree for name, _params, tree, _opts in lark.grammar.rule_defs}
-        self.terms = {str(name): tree for name, (tree, _prio) in lark.grammar.term_defs}
+    def __init__(self, grammar):
+        self.rules = {str(name): tree for name, _params, tree, _opts in grammar.rule_defs}
+        self.terms = {str(name): tree for name, (tree, _prio) in grammar.term_defs}
         self.field_rules: list[str] = []
 
     # Terminals ---------------------------------------------------------------------------
@@ -242,8 +259,7 @@ class _Deriver:
 @lru_cache(maxsize=1)
 def specs() -> dict[str, SentenceSpec]:
     """Every sentence rule of the grammar, compiled. Keyed by rule name."""
-    lark = lark_parser()
-    d = _Deriver(lark)
+    d = _Deriver(grammar_defs())
     by_rule = sentence_classes_by_rule()
     out: dict[str, SentenceSpec] = {}
     for rule, cls in by_rule.items():

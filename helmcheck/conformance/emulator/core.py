@@ -178,7 +178,8 @@ class EmulatorCore:
         v = self._catch_up(now)
         self.stats["faults"] += 1
         self._note(now, f"fault injected ({source}): {code}")
-        self._model_call(lambda: self.model.plant(SafetyViolation(code), v), now)
+        for e in self._model_call(lambda: self.model.plant(SafetyViolation(code), v), now) or ():
+            self._note(now, f"model: {_event_text(e)}")
         self._after_model(now)
         return self._release(now)
 

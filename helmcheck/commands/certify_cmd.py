@@ -1,0 +1,39 @@
+"""``helmcheck certify vehicle|backseat``: dispatches to the two certifiers.
+
+Each role lives in its own subpackage (``helmcheck.conformance.vehicle`` and
+``helmcheck.conformance.backseat``) exposing ``add_arguments(parser)`` and ``run(args) -> int``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+
+ROLES = {
+    "vehicle": ("helmcheck.conformance.vehicle.cli",
+                "certify a vehicle: helmcheck plays the backseat and judges every reply"),
+    "backseat": ("helmcheck.conformance.backseat.cli",
+                 "certify a backseat: helmcheck plays the vehicle and judges every command"),
+}
+
+
+def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
+    p = sub.add_parser("certify", help="certify a vehicle or a backseat over a serial port",
+                       description="Certify an implementation of the remote helm protocol against "
+                                   "the reference profile. Exit 0 conformant, 1 non-conformant, "
+                                   "2 inconclusive, 64 usage.")
+    roles = p.add_subparsers(dest="role", metavar="ROLE", parser_class=type(p))
+    for role, (module, help_) in ROLES.items():
+        try:
+            mod = importlib.import_module(module)
+        except ModuleNotFoundError as e:
+            if not module.startswith(e.name or "\0"):
+                raise
+            continue
+        rp = roles.add_parser(role, help=help_, description=help_,
+                              formatter_class=argparse.RawDescriptionHelpFormatter,
+                              epilog=getattr(mod, "EPILOG", None))
+        mod.add_arguments(rp)
+        rp.set_defaults(func=mod.run)
+    p.set_defaults(func=lambda args: (p.print_help(), 64)[1])
+    return p

@@ -1,0 +1,274 @@
+"""The oracle: the reference model mirrored from what the tester sent and saw (RH-OUT-4, RH-TIM-1).
+
+:class:`Mirror` holds a :class:`~helmcheck.model.vehicle.VehicleModel` fed with every command
+the vehicle read, at the vehicle time its ACK came back (RH-RD-15; vehicle time is wall time ×
+the declared time scale k, RH-TIM-2). It answers two questions:
+
+* :meth:`Mirror.receive` — which replies a conforming vehicle sends for a command. When the
+  command lands within the RH-TIM-1 tolerance of a model timer, both sides of the race are
+  acceptable: the mirror tries the state before and after the timer and keeps the one the
+  vehicle's ACK shows.
+* :meth:`Mirror.check_osi` — whether an ``$OSI`` is one a conforming vehicle may report at that
+  moment (:func:`helmcheck.model.observe.expectation`, widened by the observer's slack: the
+  poll's round trip, the ACK latency of the commands that armed the timers, scheduling jitter).
+
+What the tester cannot see is the plant (motion). The model needs plant events (a mission
+waypoint reached, on station at an ``$OPK`` position, a queued waypoint reached, the surface);
+the mirror *adopts* one when, and only when, the vehicle's ``$OSI`` is explained by it and not
+without it, at the earliest moment it can have happened (the previous poll). It also learns the
+test mission's park times from the first mission park it sees: the tester knows the mission
+only by name and waypoint count (profile ``mission``, ``mission_waypoints``).
+
+Decision (spec open): an ``$OPK`` countdown starts when the vehicle shows it counting (the
+tester cannot see "on station"); the uncertainty this adds is part of the slack.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Optional
+
+from ...grammar import sentences as s
+from ...model.missions import Mission, MissingMission, Waypoint, normalise_name
+from ...model.plant import OnStation, QueueWaypointReached, WaypointReached
+from ...model.timers import tolerance
+from ...model.vehicle import VehicleModel
+from ...profile import Profile
+
+__all__ = ["Mirror", "StubCatalog", "same_replies", "JITTER_S"]
+
+#: Wall seconds of scheduling jitter the observer allows on top of what it measures.
+JITTER_S = 0.03
+_FT = 0.3048
+
+
+@dataclass
+class StubCatalog:
+    """The vehicle's missions as the tester knows them: the profile's test mission, by name.
+
+    Waypoint positions are unknown (the model does not need them to judge); park times are
+    learnt from observation (``None`` = not seen yet, taken as 0 until then).
+    """
+
+    name: str
+    waypoints: int
+    parks: dict = field(default_factory=dict)
+    _cache: Optional[Mission] = None
+
+    @classmethod
+    def for_profile(cls, profile: Profile) -> "StubCatalog":
+        return cls(normalise_name(profile.mission), max(1, profile.mission_waypoints))
+
+    def mission(self) -> Mission:
+        if self._cache is None:
+            wps = tuple(Waypoint(41.52 + 0.002 * (i + 1), -71.32, 2.0, 2.0, float(self.parks.get(i) or 0.0))
+                        for i in range(self.waypoints))
+            self._cache = Mission(self.name, wps)
+        return self._cache
+
+    def learn_park(self, index: int, seconds: float) -> None:
+        if self.parks.get(index) is None:
+            self.parks[index] = max(0.0, float(seconds))
+            self._cache = None
+
+    @property
+    def park_waypoint(self) -> Optional[int]:
+        """The first waypoint seen to have a mission park."""
+        for i in sorted(self.parks):
+            if self.parks[i]:
+                return i
+        return None
+
+    def lookup(self, name: str):
+        if normalise_name(name) == self.name:
+            return self.mission()
+        return MissingMission(name)
+
+
+def _key(r: s.Reply) -> tuple:
+    if isinstance(r, s.ACK):
+        return ("ACK", r.type, r.status, r.err)
+    return (type(r).__name__,)
+
+
+def same_replies(want: list, got: list) -> bool:
+    """Do two reply lists agree on what is judged: ACK type/status/err, data sentence kinds."""
+    return [_key(r) for r in want] == [_key(r) for r in got]
+
+
+class Mirror:
+    """The model mirrored from the wire. See the module docstring."""
+
+    def __init__(self, profile: Profile, time_scale: float):
+        self.profile = profile
+        self.k = float(time_scale)
+        self.stub = StubCatalog.for_profile(profile)
+        self.model = VehicleModel(profile, self.stub)
+        self.cmd_latency = 0.0  #: wall seconds: largest ACK latency since the last reset
+        self.plant_slack = 0.0  #: vehicle seconds of uncertainty from adopted plant events
+        self.last_obs: Optional[float] = None  #: wall time of the last judged $OSI
+        self.adopted: list[str] = []
+
+    # ------------------------------------------------------------------ housekeeping
+    def v(self, t: float) -> float:
+        """Vehicle seconds at link time ``t`` (RH-TIM-2)."""
+        return self.k * t
+
+    def fresh(self) -> None:
+        """Forget everything but what was learnt about the mission (after a verified reset)."""
+        settings = self.model.settings
+        self.model = VehicleModel(self.profile, self.stub)
+        self.model.settings = settings
+        self.settle()
+
+    def settle(self) -> None:
+        self.cmd_latency = 0.0
+        self.plant_slack = 0.0
+        self.last_obs = None
+
+    @property
+    def mode(self) -> str:
+        return self.model.mode
+
+    def slack(self, wall: float) -> float:
+        """Vehicle seconds of observer uncertainty for an observation with ``wall`` s of its own."""
+        return self.k * (wall + self.cmd_latency + JITTER_S) + self.plant_slack
+
+    def deadline(self, name: Optional[str] = None) -> Optional[tuple[float, float, str]]:
+        """(vehicle deadline, duration, timer name) of the named (or the next) model timer."""
+        t = self.model.timers
+        if name is None:
+            e = t.earliest()
+            if e is None:
+                return None
+            name = e[1]
+        d = t.deadline(name)
+        if d is None:
+            return None
+        return d, t.duration(name) or 0.0, name
+
+    # ------------------------------------------------------------------ commands
+    def receive(self, item, t_ack: float, latency: float, observed: Optional[list] = None) -> list:
+        """Feed ``item`` at link time ``t_ack``; returns the replies a conforming vehicle sends.
+
+        ``observed`` (the vehicle's replies) picks the side of a timer race (RH-TIM-1); when
+        neither side explains it, the nominal replies are returned and the mirror keeps them.
+        """
+        self.cmd_latency = max(self.cmd_latency, latency)
+        vt = self.v(t_ack)
+        m = self.model
+        candidates = [(m.clone(), vt)]
+        dl = self.deadline()
+        if dl is not None:
+            due, dur, _ = dl
+            win = tolerance(dur, self.slack(latency))
+            if abs(due - vt) <= win:
+                before = min(vt, due - 1e-6)
+                if m.now is None or before >= m.now:
+                    candidates.append((m.clone(), before))
+                candidates.append((m.clone(), max(vt, due + 1e-6)))
+        results = []
+        for c, at in candidates:
+            replies = c.receive(item, at)
+            if observed is None or same_replies(replies, observed):
+                self._adopt(c, item)
+                return replies
+            results.append((c, replies))
+        c, replies = results[0]
+        self._adopt(c, item)
+        return replies
+
+    def _adopt(self, c: VehicleModel, item) -> None:
+        if isinstance(item, s.OPK) and c.mode == "mP" and c.timers.armed("opk"):
+            c.timers.disarm("opk")  # countdown adopted when the vehicle shows it (module doc)
+        self.model = c
+
+    # ------------------------------------------------------------------ observations
+    def _plant_from(self, m: VehicleModel, osi: s.OSI) -> None:
+        snap = m.snapshot
+        changes = {"lat": float(osi.lat), "lon": float(osi.lon), "speed_kn": float(osi.speed)}
+        if osi.depth is not None:
+            d = float(osi.depth)
+            changes["depth_m"] = d * _FT if self.profile.depth_unit == "ft" else d
+        m.update_plant(snap.with_(**changes))
+
+    def expectation(self, t: float, wall_slack: float):
+        return self.model.expectation(self.v(t), self.slack(wall_slack))
+
+    def check_osi(self, osi: s.OSI, t: float, wall_slack: float) -> tuple[list, object]:
+        """Judge an ``$OSI`` seen at link time ``t``: ``([], exp)`` or ``([(clause, msg)…], exp)``."""
+        vt = self.v(t)
+        slack = self.slack(wall_slack)
+        exp = self.model.expectation(vt, slack)
+        problems = exp.check(osi)
+        prev = self.last_obs
+        if problems:
+            adopted = self._closure(osi, t, wall_slack, prev)
+            if adopted is not None:
+                problems = []
+        if not problems:
+            self.last_obs = t
+            if self.model.phase != "ascent":
+                self._plant_from(self.model, osi)
+        return problems, exp
+
+    def _closure(self, osi: s.OSI, t: float, wall_slack: float, prev: Optional[float]) -> Optional[str]:
+        """Adopt the plant event that explains ``osi`` (module docstring); its name or ``None``."""
+        m = self.model
+        vt = self.v(t)
+        tp_wall = prev if prev is not None else t
+        tp = max(m.now if m.now is not None else 0.0, self.v(tp_wall))
+        gap = max(0.0, vt - tp)
+
+        def trial(name: str, build) -> Optional[str]:
+            c = build()
+            if c is None:
+                return None
+            slack = self.slack(wall_slack) + gap
+            if not c.expectation(vt, slack).check(osi):
+                self.model = c
+                self.plant_slack = max(self.plant_slack, gap)
+                self.adopted.append(f"{name} at v={tp:.1f}")
+                return name
+            return None
+
+        def surfaced():
+            c = m.clone()
+            c.advance(vt)
+            self._plant_from(c, osi)
+            c._base = None
+            return c
+
+        def events(*evs):
+            def build():
+                c = m.clone()
+                for e in evs:
+                    c.plant(e, tp)
+                return c
+            return build
+
+        def learn_park():
+            wp = m.mission_wp
+            if m.mission is None or m.mode != "N" or self.stub.parks.get(wp) is not None:
+                return None
+            if osi.mode == "P" and osi.next_waypoint == wp:
+                self.stub.learn_park(wp, osi.park_time + gap)
+            elif osi.mode == "N" and osi.next_waypoint == wp + 1:
+                self.stub.learn_park(wp, 0.0)
+            else:
+                return None
+            mission = self.stub.mission()
+            c = m.clone()
+            c.mission = mission
+            c.loaded = mission
+            c.plant(WaypointReached(wp), tp)
+            return c
+
+        for name, build in (("surface/depth", surfaced), ("waypoint reached", events(WaypointReached())),
+                            ("learnt mission park", learn_park), ("on station", events(OnStation())),
+                            ("queue waypoint reached", events(QueueWaypointReached())),
+                            ("two waypoints reached", events(WaypointReached(), WaypointReached()))):
+            got = trial(name, build)
+            if got:
+                return got
+        return None

@@ -1,0 +1,92 @@
+"""The bench-safety interlock: what the tester refuses to send while the vehicle is on the bench.
+
+With ``[bench_safety] in_water = false`` (the default) the tester never sends an ``$OMP`` whose
+motor byte is above ``max_motor_byte``, nor an ``$OMS``/``$OPK``/``$OMW`` whose speed is above
+``max_speed_kn`` — whatever a case or a hypothesis strategy asks for. The check runs on the raw
+bytes at the link's one send function (:meth:`helmcheck.conformance.vehicle.link.TesterLink.send`),
+and it reads malformed lines too (a bad checksum or an unknown case of the ID): a faulty vehicle
+might act on a line it should have discarded, so such a line must be safe as well.
+"""
+
+from __future__ import annotations
+
+from decimal import Decimal, InvalidOperation
+from typing import Optional
+
+from ...profile import Profile
+
+__all__ = ["BenchGuard", "BenchSafetyRefused"]
+
+#: field index (1 = first field after the ID) of the speed in each motion command
+_SPEED_FIELD = {"OMS": 4, "OPK": 4, "OMW": 6}
+
+
+class BenchSafetyRefused(Exception):
+    """A line the interlock would not send; ``str()`` says why."""
+
+
+def _number(text: str) -> Optional[Decimal]:
+    try:
+        v = Decimal(text.strip())
+    except (InvalidOperation, ValueError):
+        return None
+    return v if v.is_finite() else None
+
+
+class BenchGuard:
+    """Checks outgoing bytes against the profile's ``[bench_safety]`` limits."""
+
+    def __init__(self, profile: Profile):
+        b = profile.bench_safety
+        self.active = not b.in_water
+        self.max_motor = int(b.max_motor_byte)
+        self.max_speed = Decimal(str(b.max_speed_kn))
+        self.refused = 0
+
+    def describe(self) -> dict:
+        return {"enforced": self.active, "max_motor_byte": self.max_motor,
+                "max_speed_kn": float(self.max_speed), "refused_lines": self.refused}
+
+    def problem(self, raw: bytes) -> Optional[str]:
+        """Why ``raw`` must not be sent, or ``None``. Every ``$`` sentence in ``raw`` is read."""
+        if not self.active:
+            return None
+        text = raw.decode("latin-1")
+        for chunk in text.split("$")[1:]:
+            why = self._sentence(chunk)
+            if why:
+                return why
+        return None
+
+    def _sentence(self, chunk: str) -> Optional[str]:
+        body = chunk.split("*", 1)[0].rstrip("\r\n")
+        fields = body.split(",")
+        sid = fields[0].strip().upper()
+        if sid == "OMP" and len(fields) > 1:
+            hexes = fields[1].strip()
+            if len(hexes) >= 10:
+                try:
+                    motor = int(hexes[8:10], 16)
+                except ValueError:
+                    motor = None
+                if motor is not None and motor > self.max_motor:
+                    return (f"$OMP motor byte 0x{motor:02X} is above the bench limit "
+                            f"0x{self.max_motor:02X} ([bench_safety] max_motor_byte)")
+            return None
+        idx = _SPEED_FIELD.get(sid)
+        if idx is None:
+            return None
+        if sid == "OMW" and len(fields) > 1 and fields[1].strip().upper() in ("CLR", "CLEAR", "STOP"):
+            idx += 1  # CLEAR,<waypoint fields>
+        if len(fields) > idx:
+            v = _number(fields[idx])
+            if v is not None and v > self.max_speed:
+                return (f"${sid} speed {fields[idx].strip()} kn is above the bench limit "
+                        f"{self.max_speed} kn ([bench_safety] max_speed_kn)")
+        return None
+
+    def check(self, raw: bytes) -> None:
+        why = self.problem(raw)
+        if why:
+            self.refused += 1
+            raise BenchSafetyRefused(why)
