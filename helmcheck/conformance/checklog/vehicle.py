@@ -206,8 +206,13 @@ class VehicleJudge:
         self.pending: deque[_Pending] = deque()
         self.on_mode = on_mode
         self.on_event = on_event
+        self.on_answer: Optional[Callable[[Any, s.ACK], None]] = None
+        self.pre_command: list = []  # evidence of vehicle sentences before the first command
+        self.pre_command_count = 0
         self.recorder_plant = False
         self.inferred = 0
+        self.inferred_safety = 0
+        self.lockout_inferred = False
         self.saw_commands = False
         self.saw_vehicle = False
         self.first_command_t: Optional[float] = None
@@ -302,6 +307,8 @@ class VehicleJudge:
         pre = m.clone() if mission_dep else None
         mode_before = m.mode
         replies = m.receive(item, self.v(t))
+        if isinstance(item, s.OXFLT):
+            self.lockout_inferred = False
         if isinstance(item, s.OXFLT) and m.phase == "lockout" and self.on_event:
             self.on_event(t, "lockout", f"$OXFLT,{item.code}")
         if not replies:
@@ -334,7 +341,9 @@ class VehicleJudge:
         self.pending.append(_Pending(t, lineno, text, ack, data, clauses, mission_dep, pre, item,
                                      tx_bytes=nbytes))
         if len(self.pending) > 256:
-            self._missing(self.pending.popleft(), "no $ACK while 256 later commands were sent")
+            old = self.pending.popleft()
+            if self.saw_vehicle:
+                self._missing(old, "no $ACK while 256 later commands were sent")
         self._mode_changed(t)
 
     # ---------------------------------------------------------------- vehicle sentences
@@ -356,6 +365,8 @@ class VehicleJudge:
         else:
             self.book.ok("RH-ACK-6")
         p = self.pending.popleft()
+        if self.on_answer is not None:
+            self.on_answer(p, a)
         cev = Evidence(p.t, ">", p.lineno, p.text)
         self.book.ok("RH-ACK-1")
         # RH-ACK-2: within the window plus transmit time (wall time, RH-TIM-2)
@@ -391,6 +402,11 @@ class VehicleJudge:
                 self.book.inconclusive(c, "the answer depends on the vehicle's mission files, which the "
                                           "log does not carry (use --missions)", [cev, ev])
             self._adopt(p, a)
+            return
+        if p.ack.err == 26 and self.lockout_inferred:
+            for c in p.clauses:
+                self.book.inconclusive(c, "the lockout was inferred from an $OSI report; its start, and "
+                                          "so its end, is not known precisely", [cev, ev])
             return
         for c in p.clauses or ("RH-ACK-3",):
             self.book.fail(c, reason, [cev, ev])
@@ -442,6 +458,13 @@ class VehicleJudge:
         m = self.model if live else p.snapshot
         if live and not self.recorder_plant:
             self._update_snapshot(osi)
+            if (osi.error_state in SAFETY_CODES and m.error_state == "N" and m.phase == "none"):
+                m.plant(SafetyViolation(osi.error_state), max(self.v(p.t), m.now or 0.0))
+                self.inferred_safety += 1
+                self.lockout_inferred = True
+                if self.on_event:
+                    self.on_event(p.t, "lockout", f"safety violation {osi.error_state} (inferred)")
+                self._mode_changed(t)
         t0 = p.t
         now_v = self.v((t0 + t) / 2)
         slack_v = self.v((t - t0) / 2 + self.r)
@@ -529,9 +552,8 @@ class VehicleJudge:
 
     # ---------------------------------------------------------------- bookkeeping
     def _unmatched(self, a: s.ACK, t: float, ev: Evidence) -> None:
-        if self.first_command_t is None or t < self.first_command_t:
-            self.book.inconclusive("RH-ACK-1", "an $ACK before the first command in the log (the command "
-                                               "may predate the capture)", [ev])
+        if self.first_command_t is None:
+            self._pre_command("RH-ACK-1", ev)
             return
         for (_t, ln, txt, at) in reversed(self.silent_recent):
             if at == a.type or at is None:
@@ -548,10 +570,15 @@ class VehicleJudge:
         self.book.fail("RH-ACK-1", f"{_ack_text(a)} answers no outstanding command of type {a.type}", [ev])
 
     def _unmatched_data(self, cls: type, t: float, ev: Evidence) -> None:
-        if self.first_command_t is None or t < self.first_command_t:
-            self.book.inconclusive("RH-ACK-5", "a data sentence before the first command in the log", [ev])
+        if self.first_command_t is None:
+            self._pre_command("RH-ACK-5", ev)
             return
         self.book.fail("RH-ACK-5", f"${cls.ID} with no outstanding $OSD (data must precede its $ACK,8)", [ev])
+
+    def _pre_command(self, cid: str, ev: Evidence) -> None:
+        self.pre_command_count += 1
+        if len(self.pre_command) < 5:
+            self.pre_command.append((cid, ev))
 
     def _missing(self, p: _Pending, why: str) -> None:
         self.recent_missing.append((p.lineno, p.ack.type))
@@ -568,12 +595,20 @@ class VehicleJudge:
             else:
                 self.book.inconclusive("RH-ACK-1", "the log ended inside the command's $ACK window",
                                        [Evidence(p.t, ">", p.lineno, p.text)])
+        if self.saw_commands:
+            for cid, ev in self.pre_command:
+                self.book.inconclusive(cid, "a vehicle sentence before the first command in the log (its "
+                                            "command may predate the capture)", [ev])
         for c in self.book.order:
             if c in UNJUDGEABLE:
                 self.book.untested(c, UNJUDGEABLE[c])
         if self.inferred:
             self.book.note("RH-OUT-4", f"{self.inferred} plant event(s) were inferred from $OSI reports "
                                        f"(the log carries no plant notes).")
+        if self.inferred_safety:
+            self.book.note("RH-SAF-1", f"{self.inferred_safety} safety violation(s) were inferred from "
+                                       f"$OSI field 8; their start (and the lockout's end) is known only "
+                                       f"to the request before the report.")
         if not self.mission_known:
             for c in ("RH-OUT-4", "RH-MSN-4", "RH-JW-1"):
                 self.book.note(c, "Mission files were not given (--missions): mission-dependent answers "
