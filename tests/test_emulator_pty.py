@@ -1,6 +1,6 @@
 """End-to-end over a real pty: ``python -m helmcheck emulate --port pty`` in a subprocess.
 
-One emulator serves the module (starting one costs the grammar build); each test begins from
+One emulator serves the module and keeps its state between tests; each test begins from
 ``S`` with ``$OMSTOP``. The vehicle clock runs at x20, so the 20 s lockout lasts 1 s of wall
 time and a 10 s servo timeout 0.5 s. The soak test's duration is ``HELMCHECK_SOAK_S``
 (default 8 s; the issue's full soak is 60 s).
@@ -8,14 +8,10 @@ time and a 10 s servo timeout 0.5 s. The soak test's duration is ``HELMCHECK_SOA
 
 from __future__ import annotations
 
-import atexit
 import os
 import random
-import shutil
-import tempfile
 import time
 from decimal import Decimal
-from pathlib import Path
 
 import pytest
 
@@ -27,9 +23,9 @@ K = 20.0  # time scale
 SOAK_S = float(os.environ.get("HELMCHECK_SOAK_S", "8"))
 
 
-def _missions_dir() -> Path:
-    root = Path(tempfile.mkdtemp(prefix="helmcheck-emu-"))
-    atexit.register(shutil.rmtree, root, True)
+@pytest.fixture(scope="module")
+def missions_dir(tmp_path_factory):
+    root = tmp_path_factory.mktemp("emu")
     d = root / "missions"
     d.mkdir()
     (root / "secret.mis").write_text("helmcheck-mission 1\n41.52 -71.32 1 2 0\n")
@@ -38,21 +34,16 @@ def _missions_dir() -> Path:
     return d
 
 
-# Launched at import, so the emulator loads while other modules are collected and run.
-_MISSIONS = _missions_dir()
-_LOG = _MISSIONS.parent / "wire.log"
-_EMU = EmulatorProcess(["--missions", str(_MISSIONS), "--log", str(_LOG)], time_scale=K, baud=115200).launch()
-atexit.register(_EMU.stop)
-
-
 @pytest.fixture(scope="module")
-def emulator():
-    _EMU.wait_ready()
-    _EMU.log_path = _LOG
-    yield _EMU
-    status = _EMU.stop()
-    assert status == 0, _EMU.stderr_text()
-    assert "Traceback" not in _EMU.stderr_text()
+def emulator(missions_dir):
+    log = missions_dir.parent / "wire.log"
+    emu = EmulatorProcess(["--missions", str(missions_dir), "--log", str(log)], time_scale=K, baud=115200)
+    emu.start()
+    emu.log_path = log
+    yield emu
+    status = emu.stop()
+    assert status == 0, emu.stderr_text()
+    assert "Traceback" not in emu.stderr_text()
 
 
 def reset(c: HelmClient) -> None:

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import atexit
 import signal
 import socket
 
@@ -11,16 +10,11 @@ import pytest
 from helmcheck.conformance.emulator.process import EmulatorProcess, HelmClient, frame
 from helmcheck.conformance.transport import open_link
 
-# Launched at import so the emulator loads while other modules are collected and run.
-_EMU = EmulatorProcess(port="socket://127.0.0.1:0", time_scale=20, baud=0).launch()
-atexit.register(_EMU.stop)
-
-
 @pytest.fixture(scope="module")
 def emulator():
-    _EMU.wait_ready()
-    yield _EMU
-    _EMU.stop()
+    emu = EmulatorProcess(port="socket://127.0.0.1:0", time_scale=20, baud=0).start()
+    yield emu
+    emu.stop()
 
 
 def test_RH_FRM_9_port_line_names_the_bound_socket(emulator):

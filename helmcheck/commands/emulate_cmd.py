@@ -127,6 +127,11 @@ def _serve(args, profile, spec, baud, missions_dir, log_file, main_log_file) -> 
         link = open_link(spec, role="server", baud=baud if baud else 19200)
     except (OSError, ValueError) as e:
         return _usage(f"cannot open {args.port}: {getattr(e, 'strerror', None) or e}")
+    try:
+        link.fileno()
+    except OSError:
+        link.close()
+        return _usage(f"--port {args.port}: not selectable (use pty, a device or socket://)")
 
     from ..conformance.emulator.core import EmulatorCore, MainLog
     from ..conformance.emulator.missionfile import DirectoryCatalog, builtin_dir

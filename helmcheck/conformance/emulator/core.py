@@ -127,6 +127,7 @@ class EmulatorCore:
                       "model_errors": 0, "faults": 0}
         self.last_command: Optional[s.Command] = None
         self.last_command_v: float = 0.0
+        self._log_written = 0  #: model log rows already in the main log
         if settings_path is not None:
             self._load_settings(settings_path)
         self._push_snapshot()
@@ -295,8 +296,6 @@ class EmulatorCore:
             self._log_written = len(m.log_rows)
         if len(m.opos_records) > 2 * _KEEP_RECORDS:
             del m.opos_records[:-_KEEP_RECORDS]
-
-    _log_written = 0
 
     def _write_main_log(self) -> None:
         rows = self.model.log_rows

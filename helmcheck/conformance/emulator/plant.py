@@ -149,7 +149,7 @@ class Plant:
             c = m.opk
             return Target("goto", speed_kn=float(c.speed), lat=float(c.lat), lon=float(c.lon),
                           max_pitch=self.params.default_max_pitch_deg, arrive="station",
-                          key=("opk", c))
+                          key=("opk", id(c), c))
         if mode == "A" and m.servo is not None:
             c = m.servo
             return Target("course", depth=self._depth_m(float(c.depth)), speed_kn=float(c.speed),
@@ -164,7 +164,7 @@ class Plant:
             depth = d if d >= 0 else max(0.0, self.params.water_depth_m + d)
             return Target("goto", depth=depth, speed_kn=float(c.speed), lat=float(c.lat),
                           lon=float(c.lon), max_pitch=float(c.max_pitch), arrive="queue",
-                          key=("queue", c, len(m.queue)))
+                          key=("queue", id(c), c, len(m.queue)))
         return Target("hold")
 
     def _primitive(self, c: Any, hold_depth: bool) -> Target:

@@ -1,0 +1,172 @@
+"""``helmcheck check-log``: check recorded serial logs against the reference model, offline.
+
+The command owns the command line only; the work is :mod:`helmcheck.conformance.checklog`.
+Exit status, like the certifiers: 0 conformant (every judged clause passes, or non-strict
+without ``--strict``), 1 a clause failed, 2 inconclusive (nothing failed, something could not be
+judged), 64 usage (bad option, unreadable or unrecognised log file, bad profile) with a one-line
+error naming the file. With several files each is checked on its own; the exit status is the
+worst of them.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import shlex
+import sys
+from pathlib import Path
+
+from .. import exitcodes
+
+EPILOG = """\
+formats (detected): helmcheck wire-log 1 (helmcheck emulate --log), socat -v, socat -x, socat -v -x.
+
+examples:
+  helmcheck check-log wire.log
+  helmcheck check-log capture.txt --missions missions/ --time-scale 1
+  socat -v /dev/ttyUSB0,raw,b19200 PTY,link=/tmp/vehicle 2> capture.txt   # record a capture
+  helmcheck check-log capture.txt --role backseat --report-dir reports/bs
+
+The report directory (default reports/check-log-<stem>) gets results.json (role "log"), a copy
+of the log, report.html, junit.xml and report.md. Each violation names its log line numbers.
+"""
+
+
+def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
+    p = sub.add_parser("check-log", help="check a recorded serial log against the model",
+                       description="Replay a two-direction capture through the reference model and "
+                                   "report per clause. Exit 0 conformant, 1 non-conformant, "
+                                   "2 inconclusive, 64 usage.",
+                       epilog=EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("files", nargs="+", metavar="FILE", help="log file(s) to check")
+    p.add_argument("--profile", metavar="FILE", help="TOML profile (default: rh5)")
+    p.add_argument("--report-dir", metavar="DIR",
+                   help="results directory (default reports/check-log-<stem>; with several files, "
+                        "DIR/<stem> each)")
+    p.add_argument("--role", choices=("vehicle", "backseat", "both"), default="both",
+                   help="whose behaviour to judge (default both)")
+    p.add_argument("--missions", metavar="DIR",
+                   help="the vehicle's mission directory (mission-dependent answers are otherwise "
+                        "inconclusive)")
+    p.add_argument("--time-scale", type=float, metavar="K",
+                   help="vehicle clock rate (default: the log header's, else the profile's)")
+    p.add_argument("--swap-directions", action="store_true",
+                   help="socat's '>' is vehicle→backseat (socat started with the vehicle side first)")
+    p.add_argument("--strict", action="store_true", help="a SHOULD not met fails the run")
+    p.add_argument("--no-render", action="store_true", help="write results.json only")
+    p.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None,
+                   help="progress bar on stderr (default: for files over 4 MiB on a terminal)")
+    p.set_defaults(func=run)
+    return p
+
+
+def _usage(msg: str) -> int:
+    print(f"helmcheck check-log: {msg}", file=sys.stderr)
+    return exitcodes.USAGE
+
+
+def run(args: argparse.Namespace) -> int:
+    from ..profile import ProfileError, load_profile
+    from ..reports import results as R
+    from ..reports.results import ReportError
+    from ..conformance.checklog.checker import LogFormatError, check_log
+    from ..conformance.checklog.report import write_report_dir
+
+    try:
+        profile = load_profile(args.profile)
+    except ProfileError as e:
+        return _usage(str(e))
+    if args.profile is None:
+        # Without a declared profile, $OXFLT is taken as honoured, as helmcheck emulate does.
+        profile = profile.replace(fault_injection="oxflt")
+    if args.time_scale is not None and not (args.time_scale > 0):
+        return _usage(f"--time-scale must be positive (got {args.time_scale})")
+    catalog = None
+    if args.missions is not None:
+        from ..conformance.emulator.missionfile import DirectoryCatalog
+        if not Path(args.missions).is_dir():
+            return _usage(f"--missions: {args.missions} is not a directory")
+        catalog = DirectoryCatalog([Path(args.missions)])
+    files = [Path(f) for f in args.files]
+    for f in files:
+        if not f.is_file() or not os.access(f, os.R_OK):
+            why = "no such file" if not f.exists() else ("not a regular file" if not f.is_file() else "not readable")
+            return _usage(f"cannot read {f}: {why}")
+    worst = exitcodes.OK
+    command = "helmcheck check-log " + " ".join(shlex.quote(a) for a in sys.argv[2:])
+    for f in files:
+        if args.report_dir is None:
+            rdir = Path("reports") / f"check-log-{f.stem}"
+        elif len(files) > 1:
+            rdir = Path(args.report_dir) / f.stem
+        else:
+            rdir = Path(args.report_dir)
+        try:
+            with _progress(f, args.progress) as prog:
+                out = check_log(f, profile=profile, role=args.role, catalog=catalog,
+                                time_scale=args.time_scale, swap=args.swap_directions, progress=prog)
+        except LogFormatError as e:
+            return _usage(str(e))
+        except OSError as e:
+            return _usage(f"cannot read {f}: {e.strerror or e}")
+        try:
+            res = write_report_dir(rdir, out, profile, command, strict=args.strict, render=not args.no_render)
+        except (OSError, ReportError) as e:
+            print(f"helmcheck check-log: {e}", file=sys.stderr)
+            return exitcodes.INCONCLUSIVE
+        _summary(f, out, res, rdir)
+        worst = max(worst, R.exit_code(res["verdict"], args.strict), key=_rank)
+    return worst
+
+
+def _rank(code: int) -> int:
+    return {0: 0, 2: 1, 1: 2}.get(code, 3)
+
+
+def _summary(f: Path, out, res: dict, rdir: Path) -> None:
+    counts: dict[str, int] = {}
+    for c in res["clauses"]:
+        counts[c["verdict"]] = counts.get(c["verdict"], 0) + 1
+    print(f"{f}: {res['verdict'].upper()} — {res['verdict_reason']}")
+    print(f"  format {out.format}, {out.stats['records']} records, time scale {out.time_scale:g}, "
+          f"timestamp step {out.resolution:g} s; clauses: "
+          + ", ".join(f"{v} {n}" for v, n in sorted(counts.items())))
+    if out.one_direction:
+        print(f"  one-direction log ({out.one_direction} side only): the other side's clauses are not tested")
+    for c in res["clauses"]:
+        if c["verdict"] in ("fail", "non-strict"):
+            lines = ", ".join(map(str, c.get("lines", [])[:8]))
+            print(f"  {c['id']} {c['verdict']}: lines {lines}")
+    print(f"  report: {rdir}")
+
+
+class _progress:
+    """A rich progress bar on stderr, by bytes read; a no-op for small files or no terminal."""
+
+    def __init__(self, path: Path, wanted):
+        self.size = path.stat().st_size
+        self.on = wanted if wanted is not None else (self.size > 4 * 1024 * 1024 and sys.stderr.isatty())
+        self.bar = None
+        self._acc = 0
+
+    def __enter__(self):
+        if not self.on:
+            return None
+        from rich.console import Console
+        from rich.progress import BarColumn, DownloadColumn, Progress, TimeRemainingColumn
+        self.bar = Progress("[progress.description]{task.description}", BarColumn(), DownloadColumn(),
+                            TimeRemainingColumn(), console=Console(stderr=True), transient=True)
+        self.bar.start()
+        self.task = self.bar.add_task("checking", total=self.size)
+
+        def step(n: int) -> None:
+            self._acc += n
+            if self._acc >= 262144:
+                self.bar.update(self.task, advance=self._acc)
+                self._acc = 0
+        return step
+
+    def __exit__(self, *exc):
+        if self.bar is not None:
+            self.bar.stop()
+        return False

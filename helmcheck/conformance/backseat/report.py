@@ -1,0 +1,69 @@
+"""From a finished (or cut short) run to ``results.json`` and every report format.
+
+The document is schema 1 (:mod:`helmcheck.reports.results`) with ``"role": "backseat"``: one
+entry per §9 clause (RH-BS-1..8) with its verdict, reason, ``offending_count`` and the first
+offending lines quoted as evidence; the scenarios staged, the mode timeline, the staged events.
+A MUST not met is ``fail``; a SHOULD not met ``non-strict`` (``fail`` with ``--strict``). A run
+that never started or was cut short (the backseat never connected, closed the port, crashed,
+or Ctrl-C) is ``partial`` and cannot certify: INCONCLUSIVE, with the reason first in
+``verdict_reason`` — unless a MUST already failed, which stands.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any, Optional
+
+from ...clauses import backseat_clauses
+from ...profile import Profile
+from ...reports import render_all
+from ...reports.results import add_clause, add_event, add_mode, finish, new_results, write_results_atomic
+from .judge import BS_CLAUSES
+from .runner import Outcome
+
+__all__ = ["build_results", "write_reports"]
+
+
+def build_results(outcome: Optional[Outcome], *, profile: Profile, settings: dict[str, Any],
+                  command: str, port: str, started: str, reason: str = "") -> dict[str, Any]:
+    """The results document of a run (``outcome`` None: the run could not start at all)."""
+    strict = bool(settings.get("strict", False))
+    results = new_results("backseat", command=command, started=started,
+                          implementation={"port": port, "protocol": profile.protocol},
+                          profile=profile.as_dict(), settings=settings)
+    levels = {c.id: c.level for c in backseat_clauses()}
+    status = outcome.status if outcome is not None else "link-error"
+    why = outcome.reason if outcome is not None else reason
+    if outcome is None or outcome.status == "never-connected":
+        for cid in BS_CLAUSES:
+            add_clause(results, cid, "not-tested", f"not judged: {why}", level=levels[cid])
+    else:
+        for r in outcome.judge.results(levels):
+            add_clause(results, r.id, r.verdict, r.reason, cases=r.cases, evidence=r.evidence,
+                       offending_count=r.offending_count, level=r.level)
+        for t, kind, label in outcome.events:
+            add_event(results, round(t, 6), kind, label)
+        seen: list[str] = []
+        for t, mode in outcome.modes:
+            add_mode(results, round(t, 6), mode)
+            if mode not in seen:
+                seen.append(mode)
+        results["coverage"]["modes"] = seen
+        results["scenarios"] = list(outcome.scenarios_run)
+        results["run"] = {"status": outcome.status, "connected_at": outcome.connected_at,
+                          "ended_at": round(outcome.ended_at, 3), "planned_s": round(outcome.planned, 3),
+                          "bytes_from_backseat": outcome.judge.stats["bytes"],
+                          "lines_from_backseat": outcome.judge.stats["lines"],
+                          "vehicle": outcome.vehicle_stats}
+    partial = status != "complete"
+    finish(results, partial=partial, strict=strict,
+           duration_s=round(outcome.ended_at - (outcome.connected_at or 0.0), 3) if outcome else 0.0)
+    if partial:
+        results["verdict_reason"] = f"{why[:1].upper()}{why[1:]}. {results['verdict_reason']}"
+    return results
+
+
+def write_reports(directory: Path, results: dict[str, Any]) -> list[Path]:
+    """Write ``results.json`` atomically, then every report format (each atomically)."""
+    path = write_results_atomic(directory, results)
+    return [path, *render_all(directory)]

@@ -1,0 +1,343 @@
+"""The I/O loop of ``certify backseat``: one link, the reference vehicle, the judge, the plan.
+
+This module owns the clock, the descriptors and the wire log; the vehicle's behaviour is the
+emulator core's (:class:`~helmcheck.conformance.emulator.core.EmulatorCore`, exactly the
+model's), the judging is :class:`~.judge.BackseatJudge`'s and the staging is
+:mod:`.scenarios`'. Every byte from the backseat goes first to the judge, which hands back
+complete lines; each line then goes to the vehicle unless a scenario says otherwise (a
+``silence`` drops it, a ``reject`` window answers it with an error ``$ACK`` in the vehicle's
+place, in order and paced like the vehicle's own output). Every byte the vehicle writes is
+shown to the judge when it goes out (what the backseat could know).
+
+Link life (decisions): the run starts at the backseat's first byte; none within
+``connect_timeout`` is "never connected". On a pty the loop lets go of its own copy of the
+slave side once the backseat is there, so the backseat closing the port (or dying) is seen as
+a hang-up; on a TCP serial server it is the client's disconnect; on a device, a device that
+disappears. Any of these before the run's end is "disconnected" (the report says when). The
+loop waits in ``select`` at most 50 ms at a time; SIGINT/SIGTERM (or :meth:`Runner.stop`)
+end it early as "interrupted".
+"""
+
+from __future__ import annotations
+
+import os
+import select
+import time
+from collections import deque
+from dataclasses import dataclass, field
+from typing import Any, Callable, Optional
+
+from ...grammar import format as format_sentence
+from ...grammar import sentences as s
+from ...grammar.capture import FROM_VEHICLE, TO_VEHICLE, WireLogWriter
+from ...model.missions import MissionCatalog
+from ...profile import Profile
+from ..emulator.core import EmulatorCore
+from ..transport import Link, LinkClosed, PtyLink
+from .judge import BackseatJudge, Piece
+from .scenarios import LOCKOUT_CODE, Plan
+
+__all__ = ["Runner", "Outcome", "HangupPty", "MAX_OUT"]
+
+MAX_OUT = 256 * 1024  #: bytes waiting for a link nobody reads; beyond this they are dropped
+_TICK = 0.05
+
+
+class HangupPty(PtyLink):
+    """A pty that can let go of its own slave descriptor, so the peer's close is a hang-up."""
+
+    def peer_seen(self) -> None:
+        slave = getattr(self, "_slave", -1)
+        if slave is not None and slave >= 0:
+            try:
+                os.close(slave)
+            except OSError:
+                pass
+            self._slave = -1
+
+
+@dataclass
+class Outcome:
+    """How a run ended and what it saw; times are seconds since the certifier started."""
+
+    status: str  #: complete | never-connected | disconnected | interrupted
+    reason: str
+    judge: BackseatJudge
+    connected_at: Optional[float] = None
+    ended_at: float = 0.0
+    planned: float = 0.0
+    events: list[tuple[float, str, str]] = field(default_factory=list)
+    modes: list[tuple[float, str]] = field(default_factory=list)
+    scenarios_run: list[str] = field(default_factory=list)
+    vehicle_stats: dict = field(default_factory=dict)
+
+
+class Runner:
+    """Runs one certification on ``link``. See the module docstring."""
+
+    def __init__(self, link: Link, profile: Profile, plan: Plan, *, time_scale: float,
+                 missions: Optional[MissionCatalog] = None, log: Optional[WireLogWriter] = None,
+                 connect_timeout: float = 30.0, clock: Callable[[], float] = time.monotonic,
+                 progress: Any = None, reaction_s: float = 0.5, jitter_s: float = 0.2):
+        self.link = link
+        self.profile = profile
+        self.plan = plan
+        self.time_scale = time_scale
+        self.log = log
+        self.connect_timeout = connect_timeout
+        self.clock = clock
+        self.progress = progress
+        self.launch = clock()
+        self.core = EmulatorCore(profile.replace(fault_injection="none"), missions, start=self.launch,
+                                 time_scale=time_scale, baud=profile.baud, log=log)
+        self.judge = BackseatJudge(profile, time_scale=time_scale, reaction_s=reaction_s,
+                                   jitter_s=jitter_s)
+        self._stop: Optional[str] = None
+        self._out = bytearray()
+        self._held: deque[Piece] = deque()
+        self._staged: deque[bytes] = deque()
+        self._actions = deque(plan.actions)
+        self._silent = False
+        self._rejecting = False
+        self._silence_noted = False
+        self._lockout = False
+        self._mode = ""
+        self._scenario = ""
+        self._dropped_out = 0
+        self.connected_at: Optional[float] = None
+        self.outcome = Outcome("interrupted", "", self.judge, planned=plan.total)
+
+    # ------------------------------------------------------------------ control
+    def stop(self, why: str = "interrupted") -> None:
+        """End the run early (safe from a signal handler)."""
+        self._stop = why
+
+    def rel(self, now: float) -> float:
+        return now - self.launch
+
+    # ------------------------------------------------------------------ the loop
+    def run(self) -> Outcome:
+        o = self.outcome
+        status, reason = "interrupted", "the run was interrupted"
+        try:
+            while True:
+                now = self.clock()
+                if self._stop is not None:
+                    status, reason = "interrupted", f"the run was {self._stop} after {self._elapsed(now):.1f} s"
+                    break
+                if self.connected_at is None and self.rel(now) > self.connect_timeout:
+                    status = "never-connected"
+                    reason = (f"the backseat never connected: no byte arrived on {self.link.name} "
+                              f"within {self.connect_timeout:g} s")
+                    break
+                if self.connected_at is not None and self.rel(now) >= self.connected_at + self.plan.total:
+                    status, reason = "complete", "the run completed"
+                    break
+                if self.connected_at is not None:
+                    self._due(now)
+                self._service(now)
+                try:
+                    gone = self._wait_and_read(now)
+                except LinkClosed as e:
+                    gone = f"the link was lost ({e})"
+                if gone:
+                    now = self.clock()
+                    if self.connected_at is None:
+                        continue
+                    status = "disconnected"
+                    reason = (f"the backseat closed the port or crashed after {self._elapsed(now):.1f} s "
+                              f"of the {self.plan.total:.1f} s run ({gone})")
+                    break
+        finally:
+            now = self.clock()
+            for piece in self.judge.close(self.rel(now)):
+                self._held.append(piece)
+            self._flush_input_to_vehicle(now)
+            self._note(now, f"run ended: {reason}")
+            o.status, o.reason = status, reason
+            o.connected_at = self.connected_at
+            o.ended_at = self.rel(now)
+            o.vehicle_stats = dict(self.core.stats)
+        return o
+
+    def _elapsed(self, now: float) -> float:
+        return 0.0 if self.connected_at is None else self.rel(now) - self.connected_at
+
+    def _wait_and_read(self, now: float) -> str:
+        """Wait for input (at most one tick) and handle it; a reason when the peer is gone."""
+        fd = self.link.fileno()
+        wfds = [fd] if self._out and self.link.connected else []
+        timeout = _TICK
+        due = self.core.next_wakeup()
+        if due is not None:
+            timeout = max(0.0, min(timeout, due - now))
+        try:
+            r, w, _ = select.select([fd], wfds, [], timeout)
+        except (OSError, ValueError):
+            return "the link's descriptor was closed"
+        if w:
+            self._write(self.clock())
+        if not r:
+            return ""
+        for ev in self.link.poll():
+            t = self.clock()
+            if ev.kind == "data":
+                self._backseat(ev.data, t)
+            elif ev.kind == "connect":
+                self._note(t, f"link: client connected {ev.info}")
+            elif ev.kind == "disconnect":
+                return f"disconnect: {ev.info}".strip()
+        return ""
+
+    # ------------------------------------------------------------------ input
+    def _backseat(self, data: bytes, now: float) -> None:
+        if self.connected_at is None:
+            self.connected_at = self.rel(now)
+            if isinstance(self.link, HangupPty):
+                self.link.peer_seen()
+            self._note(now, "backseat connected (first byte); the judged run starts")
+            self.outcome.events.append((self.rel(now), "note", "backseat connected"))
+            self._actions = deque(a for a in self.plan.actions)
+            if self.progress is not None:
+                self.progress.start(self.plan.total)
+            self._due(now)
+        self._held.extend(self.judge.backseat_bytes(data, self.rel(now)))
+        self._flush_input_to_vehicle(now)
+
+    def _flush_input_to_vehicle(self, now: float) -> None:
+        """Hand complete lines to the vehicle in order; a staged ``$ACK`` holds the queue."""
+        while self._held and not self._staged:
+            piece = self._held.popleft()
+            self._deliver(piece, now)
+            self._after_vehicle(now)
+
+    def _deliver(self, piece: Piece, now: float) -> None:
+        t = piece.t
+        if self._silent:
+            self._log_bytes(t, TO_VEHICLE, piece.raw)
+            if not self._silence_noted:
+                self._silence_noted = True
+                self._note(now, "silence: the vehicle neither reads nor answers")
+            return
+        cmd = piece.command
+        if (self._rejecting and cmd is not None and cmd.ACK_TYPE is not None and not isinstance(cmd, s.OSD)
+                and cmd.ID in self.profile.commands):
+            self._log_bytes(t, TO_VEHICLE, piece.raw)
+            ack = format_sentence(s.ACK(cmd.ACK_TYPE, 1, cmd.ERR))
+            self._staged.append(ack)
+            self.outcome.events.append((t, "ack-error", f"staged rejection of ${cmd.ID}: err {cmd.ERR}"))
+            self._flush_staged(now)
+            return
+        self._emit(self.core.feed(piece.raw, now))
+
+    # ------------------------------------------------------------------ vehicle side
+    def _service(self, now: float) -> None:
+        out = self.core.tick(now)
+        if self._silent:
+            if out:
+                self._note(now, f"silence: {len(out)} bytes of replies not sent")
+        else:
+            self._emit(out)
+        self._flush_staged(now)
+        self._flush_input_to_vehicle(now)
+        self._after_vehicle(now)
+        self._write(now)
+
+    def _flush_staged(self, now: float) -> None:
+        core = self.core
+        while self._staged and core.pending_output == 0 and core.pacer.free_at <= now + 1e-9:
+            raw = self._staged.popleft()
+            core.pacer.reserve(len(raw), now)
+            self._log_bytes(self.rel(now), FROM_VEHICLE, raw)
+            self._emit(raw)
+
+    def _emit(self, data: bytes) -> None:
+        if not data:
+            return
+        if len(self._out) + len(data) > MAX_OUT:
+            if not self._dropped_out:
+                self._note(self.clock(), "link: output dropped, nobody is reading the port")
+            self._dropped_out += len(data)
+            return
+        self._out += data
+        self._write(self.clock())
+
+    def _write(self, now: float) -> None:
+        while self._out:
+            try:
+                n = self.link.write_some(bytes(self._out[:65536]))
+            except OSError:
+                self._out.clear()
+                return
+            if n <= 0:
+                return
+            self.judge.vehicle_bytes(bytes(self._out[:n]), self.rel(now))
+            del self._out[:n]
+        self._dropped_out = 0
+
+    def _after_vehicle(self, now: float) -> None:
+        m = self.core.model
+        lock = m.phase == "lockout"
+        if lock != self._lockout:
+            self._lockout = lock
+            self.judge.lockout(lock, self.rel(now))
+            self.outcome.events.append((self.rel(now), "lockout",
+                                        f"lockout {'starts' if lock else 'ends'} ({m.error_state})"))
+        if m.mode != self._mode:
+            self._mode = m.mode
+            self.outcome.modes.append((self.rel(now), m.mode))
+
+    # ------------------------------------------------------------------ staging
+    def _due(self, now: float) -> None:
+        start = self.launch + (self.connected_at or 0.0)
+        while self._actions and start + self._actions[0].at <= now:
+            self._act(self._actions.popleft(), now)
+        if self.progress is not None:
+            self.progress.update(self._elapsed(now), self._scenario, self.judge.counts)
+
+    def _act(self, a, now: float) -> None:
+        t = self.rel(now)
+        if a.kind == "scenario":
+            self._scenario = a.name
+            self.judge.scenario(a.name, t)
+            self.outcome.scenarios_run.append(a.name)
+            self._note(now, f"scenario {a.name} starts")
+            self.outcome.events.append((t, "note", f"scenario {a.name}"))
+        elif a.kind == "reject":
+            self._rejecting = a.on
+            self._note(now, "reject: every command but $OSD is refused" if a.on else "reject: window ends")
+        elif a.kind == "silence":
+            self._silent = a.on
+            self._silence_noted = False
+            self.judge.silence(a.on, t)
+            self._note(now, "silence starts" if a.on else "silence ends")
+            self.outcome.events.append((t, "note", "silence starts" if a.on else "silence ends"))
+        elif a.kind == "lockout":
+            self._emit(self.core.inject_fault(LOCKOUT_CODE, now, source="scenario lockout"))
+            self.outcome.events.append((t, "lockout", f"safety violation {LOCKOUT_CODE} raised"))
+            self._after_vehicle(now)
+        elif a.kind == "mission-end":
+            self._end_mission(now)
+
+    def _end_mission(self, now: float) -> None:
+        """The running mission ends on the vehicle, off the wire (scenario ``mission-end``)."""
+        core = self.core
+        self._emit(core.tick(now))
+        m = core.model
+        if not m.running:
+            self._note(now, "mission-end: no mission was running; nothing to end")
+            return
+        m.receive(s.OMSTOP(0), core.v)  # the reply is not sent: nobody on the line asked
+        m.advance(core.v)
+        core.plant.sync(m)
+        self._note(now, "mission-end: the mission ended on the vehicle")
+        self.outcome.events.append((self.rel(now), "note", "mission ended on the vehicle"))
+        self._after_vehicle(now)
+
+    # ------------------------------------------------------------------ logs
+    def _note(self, now: float, text: str) -> None:
+        self.core.note(now, text)
+
+    def _log_bytes(self, t: float, direction: str, raw: bytes) -> None:
+        if self.log is not None:
+            self.log.bytes(t, direction, raw)

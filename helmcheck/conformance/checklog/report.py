@@ -1,0 +1,97 @@
+"""Writing a log check's results directory: ``results.json`` (role ``log``), the log, the reports.
+
+This module owns turning a :class:`~.checker.CheckOutcome` into a schema-1 results document
+(:mod:`helmcheck.reports.results`) and a results directory: ``results.json`` (atomic), the
+checked log as ``wire.log`` (a copy for a helmcheck wire log; for a socat capture the copy keeps
+its own name and ``wire.log`` is not written; above :data:`COPY_LIMIT` bytes the log is only
+referenced by path and SHA-256), and every report format (:func:`helmcheck.reports.render_all`).
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import tempfile
+from pathlib import Path
+from typing import Any, Optional
+
+from ...profile import Profile
+from ...reports import results as R
+from ...reports.render import render_all
+from .checker import CheckOutcome
+
+__all__ = ["build_results", "write_report_dir", "COPY_LIMIT"]
+
+COPY_LIMIT = 32 * 1024 * 1024
+
+
+def build_results(out: CheckOutcome, profile: Profile, command: str, *, strict: bool = False,
+                  wire_log: str = "wire.log") -> dict[str, Any]:
+    """The results document for one checked log (finished, so its verdict is valid)."""
+    res = R.new_results("log", command=command,
+                        implementation={"protocol": profile.protocol, "osi_fields": profile.osi_fields,
+                                        "fault_injection": profile.fault_injection},
+                        profile=profile.as_dict(),
+                        settings={"time_scale": out.time_scale, "strict": strict}, wire_log=wire_log)
+    for c in out.clauses:
+        entry = R.add_clause(res, c["id"], c["verdict"], c["reason"], cases=[f"log:{out.path.name}"],
+                             evidence=c["evidence"], offending_count=c["offending_count"])
+        entry["lines"] = c["lines"]
+    res["timeline"] = out.timeline
+    res["events"] = out.events
+    res["log"] = {
+        "source": str(out.path.resolve()), "sha256": out.sha256, "format": out.format,
+        "role": out.role, "time_scale": out.time_scale, "timestamp_resolution_s": out.resolution,
+        "one_direction": out.one_direction, "mission_files": out.mission_known,
+        "header": out.meta.header, "stats": out.stats, "findings": out.findings,
+        "check_seconds": round(out.seconds, 3),
+    }
+    if out.one_direction:
+        res["log"]["one_direction_note"] = (
+            f"The log carries traffic of one side only ({out.one_direction}); clauses that need "
+            f"the other side are NOT-TESTED.")
+    R.finish(res, strict=strict, duration_s=round(out.seconds, 3))
+    return res
+
+
+def _copy_atomic(src: Path, dst: Path) -> None:
+    fd, tmp = tempfile.mkstemp(prefix=f".{dst.name}.", suffix=".tmp", dir=dst.parent)
+    try:
+        with os.fdopen(fd, "wb") as w, open(src, "rb") as r:
+            shutil.copyfileobj(r, w, 1 << 20)
+            w.flush()
+            os.fsync(w.fileno())
+        os.chmod(tmp, 0o644)
+        os.replace(tmp, dst)
+    except BaseException:
+        try:
+            os.unlink(tmp)
+        except FileNotFoundError:
+            pass
+        raise
+
+
+def write_report_dir(directory: Path, out: CheckOutcome, profile: Profile, command: str, *,
+                     strict: bool = False, render: bool = True) -> dict[str, Any]:
+    """Write the results directory; returns the results document. ``OSError``/``ReportError``."""
+    directory.mkdir(parents=True, exist_ok=True)
+    size = out.path.stat().st_size
+    wire_name = "wire.log"
+    copied: Optional[str] = None
+    if size <= COPY_LIMIT:
+        if out.format == "wirelog":
+            copied = wire_name
+        else:
+            copied = "capture-" + out.format + ".log"
+            wire_name = copied
+        if out.path.resolve() != (directory / copied).resolve():
+            _copy_atomic(out.path, directory / copied)
+    res = build_results(out, profile, command, strict=strict, wire_log=wire_name)
+    res["log"]["copy"] = copied
+    if copied is None:
+        res["log"]["copy_note"] = (f"The log ({size} bytes) is larger than {COPY_LIMIT} bytes; it is "
+                                   f"referenced by path and SHA-256, not copied.")
+    R.write_results_atomic(directory, res)
+    if render:
+        render_all(directory)
+    return res

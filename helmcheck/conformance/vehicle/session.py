@@ -1,0 +1,484 @@
+"""Driving a vehicle step by step and judging every reply against the mirrored model.
+
+:class:`Session` is the one place that talks to the vehicle during a run. Its primitives are
+what cases (:mod:`.cases`) and exploration (:mod:`.explore`) are made of:
+
+* :meth:`Session.exchange` — send one line, collect replies up to its ``$ACK`` and judge them:
+  exactly one ACK of the command's type (RH-ACK-1) within the ACK window plus transmit time
+  (RH-ACK-2), data before the ACK (RH-ACK-5), no foreign ACK in between (RH-ACK-6), the ACK's
+  status and error number equal to the model's (RH-ACK-3/4 and the command's own clauses), the
+  data sentence kinds in request order (RH-OSD-1/2), every ``$OSI`` consistent with the model
+  (RH-OUT-4). A line the vehicle must discard (RH-FRM-4/5/6/7) must get no ACK within the window.
+* :meth:`Session.poll` — ``$OSD,S`` and the judged ``$OSI``.
+* :meth:`Session.wait` and :meth:`Session.settle` — protocol time passing (scaled by k,
+  RH-TIM-2), polled and judged all along; ``settle`` waits past a model timer's deadline plus
+  the RH-TIM-1 tolerance widened by the measured slack, and reports INCONCLUSIVE when that
+  slack is too large for the duration to be judged.
+* :meth:`Session.reset` — the verified reset between cases: ``$OMSTOP,0`` (waiting out a
+  lockout), ``$OSI`` shows ``S``; then the profile's mission started by name with the rh5 form
+  ``$OMSTART,0,0,0,0,<mission>,`` and ``N`` verified.
+
+Every received line is also checked on its own (RH-FRM-1/2/3/8, RH-OUT-1/2/3). Lines that are not
+well-framed cannot be attributed (line noise looks the same) and count as garbage; a link that
+carries only garbage, or nothing, is a link fault (INCONCLUSIVE).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Callable, Optional
+
+from ...grammar import SentenceError, checksum_hex, decode
+from ...grammar import sentences as s
+from ...grammar.capture import escape
+from ...model.timers import tolerance
+from ...model.transitions import REMOTE_MODES
+from ...profile import Profile
+from .judge import Book, CaseFail, CaseInconclusive, CaseNotTested
+from .link import LinkLost, Rx, TesterLink
+from .mirror import Mirror, same_replies
+
+__all__ = ["Session", "Exchange", "LinkSilent", "frame", "ACK_GRACE_S"]
+
+#: Wall seconds of host jitter allowed on top of the ACK window and transmit time (RH-ACK-2).
+ACK_GRACE_S = 0.25
+_INTERRUPTS = ("OMS", "OMP", "OPK", "OMW", "OJW")
+_UNSOLICITED_ACKS = (13, 14)
+
+
+class LinkSilent(LinkLost):
+    """The vehicle stopped answering anything at all (a link fault, INCONCLUSIVE)."""
+
+
+def frame(body: str, lowercase: bool = False, terminator: str = "\r\n") -> bytes:
+    """``$body*HH`` + terminator with the body's checksum (RH-FRM-1/2)."""
+    raw = body.encode("latin-1")
+    cks = checksum_hex(raw)
+    return b"$" + raw + b"*" + (cks.lower() if lowercase else cks).encode() + terminator.encode()
+
+
+@dataclass
+class Exchange:
+    """One command and what came back."""
+
+    raw: bytes
+    item: object
+    t_sent: float
+    t_ack: Optional[float] = None
+    ack: Optional[s.ACK] = None
+    data: list = field(default_factory=list)
+    expected: list = field(default_factory=list)
+    osi: Optional[s.OSI] = None
+
+    @property
+    def accepted(self) -> bool:
+        return self.ack is not None and self.ack.status == 0
+
+
+def _ack_text(a) -> str:
+    if a is None:
+        return "no $ACK"
+    extra = "".join("," + x for x in a.extra)
+    return f"$ACK,{a.type},{a.status},{a.err}{extra}"
+
+
+def _replies_text(replies: list) -> str:
+    if not replies:
+        return "nothing (a silent discard)"
+    return ", ".join(_ack_text(r) if isinstance(r, s.ACK) else "$" + r.ID for r in replies)
+
+
+class Session:
+    """One tester session on one link. See the module docstring."""
+
+    def __init__(self, link: TesterLink, profile: Profile, time_scale: float, book: Book,
+                 recorder=None):
+        self.link = link
+        self.profile = profile
+        self.k = float(time_scale)
+        self.book = book
+        self.rec = recorder
+        self.mirror = Mirror(profile, self.k)
+        self.case = ""
+        self.case_t0 = 0.0
+        self.last_osi: Optional[s.OSI] = None
+        self.last_osi_t = 0.0
+        self.poll_gap = max(0.02, min(0.25, 1.0 / self.k))
+        self.forced_wait = 0.0  #: wall seconds spent waiting for protocol durations
+        self.garbage_reported = 0
+        self.trace: Optional[list] = None  #: replay steps while recording
+        self.on_poll: Optional[Callable[[], None]] = None
+
+    # ================================================================ helpers
+    def now(self) -> float:
+        return self.link.now()
+
+    def evidence(self, t0: Optional[float] = None) -> list:
+        return self.link.excerpt(self.case_t0 if t0 is None else t0, self.now())
+
+    def fail(self, clause: str, reason: str, also=()) -> CaseFail:
+        return CaseFail(clause, reason, self.case_t0, also)
+
+    def _trace(self, step: dict) -> None:
+        if self.trace is not None:
+            self.trace.append(step)
+
+    # ================================================================ per-line checks
+    def _judge_line(self, rx: Rx) -> None:
+        """RH-FRM-1/2/3/8, RH-OUT-1/2/3 for one line the vehicle sent."""
+        d = rx.decoded
+        if d is None or (d.error is not None and d.error.clause in ("RH-FRM-1", "RH-FRM-2", "RH-FRM-4",
+                                                                     "RH-FRM-5", "RH-FRM-6", "RH-FRM-7")):
+            self.garbage_reported += 1
+            return
+        ev = [{"t": round(rx.t, 6), "dir": "<", "line": escape(rx.raw.rstrip(b"\r\n"))}]
+        if d.error is not None:
+            self.book.add(d.error.clause, "fail", f"the vehicle sent an invalid {d.sentence_id or 'line'}: "
+                                                  f"{d.error}", self.case, ev)
+            return
+        for f in d.findings:
+            if f.clause == "RH-FRM-3":
+                self.book.add("RH-FRM-3", "fail", f"the vehicle emitted lower-case checksum hex: {f.message}",
+                              self.case, ev)
+            elif f.clause == "RH-FRM-7":
+                self.book.add("RH-FRM-1", "fail", "the vehicle ended a sentence with a bare LF, not CR LF",
+                              self.case, ev)
+        if not d.findings:
+            self.book.ok("RH-FRM-1")
+            self.book.ok("RH-FRM-2")
+            self.book.ok("RH-FRM-3")
+        sent = d.sentence
+        if isinstance(sent, s.OSI):
+            self.book.ok("RH-OUT-1")
+        elif isinstance(sent, s.Compass):
+            self.book.ok("RH-FRM-8")
+        if not isinstance(sent, s.ACK):
+            self.book.ok("RH-OUT-3")
+            if not isinstance(sent, s.OSI):
+                self.book.ok("RH-OUT-2")
+
+    def _unsolicited(self, rxs: list[Rx]) -> None:
+        for rx in rxs:
+            self._judge_line(rx)
+            sent = rx.sentence
+            if isinstance(sent, s.ACK) and sent.type not in _UNSOLICITED_ACKS:
+                raise self.fail("RH-ACK-1", f"an $ACK,{sent.type} arrived that answers no pending command "
+                                            f"(a second ACK for one command, or a late one)")
+
+    # ================================================================ exchange
+    def item_of(self, raw: bytes):
+        """What a conforming vehicle reads from ``raw``: a command, an answered error, or None."""
+        d = decode(raw, self.profile)
+        if d.sentence is not None and isinstance(d.sentence, s.Command):
+            if d.sentence.ID not in self.profile.commands and not isinstance(d.sentence, s.OXFLT):
+                return None
+            return d.sentence
+        if d.error is not None and d.error.answered:
+            return d.error
+        return None
+
+    def exchange(self, raw: bytes, clause: Optional[str] = None, *, judge: bool = True) -> Exchange:
+        """Send ``raw`` and judge the replies (module docstring). ``clause``: whom a wrong answer fails."""
+        item = self.item_of(raw)
+        self._unsolicited(self.link.drain())
+        mode_before = self.mirror.mode
+        t_sent = self.link.send(raw)
+        self._trace({"send": escape(raw), "t": round(t_sent, 6)})
+        ex = Exchange(raw, item, t_sent)
+        ack_type = None
+        if isinstance(item, s.Command):
+            ack_type = item.ACK_TYPE
+        elif isinstance(item, SentenceError):
+            ack_type = item.ack_type
+        if self.rec is not None:
+            self.rec.command(t_sent, raw)
+        if ack_type is None:
+            self._silent(ex, clause, item)
+            return ex
+        self._collect(ex, ack_type, clause)
+        latency = ex.t_ack - t_sent  # type: ignore[operator]
+        observed = ex.data + [ex.ack]
+        ex.expected = self.mirror.receive(item, ex.t_ack, latency, observed)  # type: ignore[arg-type]
+        self._trace({"expect": _replies_text(ex.expected)})
+        if self.rec is not None:
+            self.rec.answered(ex, mode_before, self.mirror.mode)
+        if judge and not same_replies(ex.expected, observed):
+            want, got = ex.expected, observed
+            wa = next((r for r in want if isinstance(r, s.ACK)), None)
+            target = clause or self._clause_for(item)
+            if wa is not None and ex.ack is not None and (wa.status, wa.err) == (ex.ack.status, ex.ack.err):
+                target = "RH-OSD-2" if isinstance(item, s.OSD) and not want[:-1] else "RH-OSD-1"
+            raise self.fail(target, f"sent {escape(raw.rstrip(bytes([13, 10])))}: a conforming vehicle in mode "
+                                    f"{mode_before} answers {_replies_text(want)}; got {_replies_text(got)}")
+        if judge and isinstance(item, s.ORWSET) and ex.ack is not None and ex.ack.status == 0:
+            self._check_orwset_reply(ex, clause)
+        if ex.osi is not None:
+            self._judge_osi(ex.osi, ex.t_sent, ex.t_ack, clause)  # type: ignore[arg-type]
+        return ex
+
+    def _clause_for(self, item) -> str:
+        row = self.mirror.model.last_row
+        if isinstance(item, SentenceError):
+            return "RH-ACK-3"
+        if row is not None:
+            for c in row.clauses:
+                if not c.startswith("RH-RD"):
+                    return c
+        return "RH-ACK-3"
+
+    def _check_orwset_reply(self, ex: Exchange, clause: Optional[str]) -> None:
+        """RH-SET-1: ``$ACK,12,0,0,<setting>,<n>,<values…>`` with n counting what follows."""
+        a = ex.ack
+        extra = a.extra  # type: ignore[union-attr]
+        ok = (len(extra) >= 2 and extra[0] == ex.item.setting  # type: ignore[union-attr]
+              and extra[1].isdigit() and int(extra[1]) == len(extra) - 2)
+        if not ok:
+            raise self.fail(clause or "RH-SET-1", f"$ORWSET reply {_ack_text(a)} is not "
+                                                  f"$ACK,12,0,0,<setting>,<n>,<state>,<values…>")
+        self.book.ok("RH-SET-1")
+
+    def _silent(self, ex: Exchange, clause: Optional[str], item) -> None:
+        """A line with no ACK due (discard, or $OXFLT): nothing may answer it within the window."""
+        window = self.profile.ack_window_s + self.link.transmit_time(len(ex.raw)) + ACK_GRACE_S
+        end = ex.t_sent + window
+        while True:
+            rx = self.link.next(end)
+            if rx is None:
+                break
+            self._judge_line(rx)
+            sent = rx.sentence
+            if isinstance(sent, s.ACK) and sent.type not in _UNSOLICITED_ACKS:
+                what = "RH-SAF-5" if isinstance(item, s.OXFLT) else (clause or "RH-FRM-4")
+                raise self.fail(what, f"sent {escape(ex.raw.rstrip(bytes([13, 10])))}: no $ACK is due "
+                                      f"(it must be discarded silently), got {_ack_text(sent)}")
+        self.forced_wait += 0.0
+        if isinstance(item, s.OXFLT):
+            self.mirror.receive(item, self.now(), 0.0)
+            if self.rec is not None:
+                self.rec.event(ex.t_sent, "lockout", f"$OXFLT,{item.code} sent")
+        self._trace({"expect": "nothing (a silent discard)"})
+
+    def _collect(self, ex: Exchange, ack_type: int, clause: Optional[str]) -> None:
+        window = self.profile.ack_window_s
+        tx = self.link.transmit_time(len(ex.raw))
+        hard = ex.t_sent + 3 * window + tx + 1.0
+        want_data = 0
+        if isinstance(ex.item, s.OSD):
+            letters = ex.item.requested
+            if all(x in "GCSPYDTI" for x in letters):
+                want_data = sum(1 for x in letters if x in self.profile.osd_letters)
+        got_bytes = 0
+        while True:
+            rx = self.link.next(hard)
+            if rx is None:
+                break
+            got_bytes += len(rx.raw)
+            self._judge_line(rx)
+            sent = rx.sentence
+            if sent is None:
+                continue
+            if isinstance(sent, s.ACK):
+                if sent.type == ack_type:
+                    ex.ack, ex.t_ack = sent, rx.t
+                    break
+                if sent.type in _UNSOLICITED_ACKS:
+                    continue
+                raise self.fail("RH-ACK-6", f"sent {escape(ex.raw.rstrip(bytes([13, 10])))}: an $ACK,{sent.type} "
+                                            f"came before its own $ACK,{ack_type} (ACKs out of order or "
+                                            f"for the wrong command)")
+            ex.data.append(sent)
+            if isinstance(sent, s.OSI):
+                ex.osi = sent
+        if ex.ack is None:
+            if not self._alive():
+                raise LinkSilent(f"the vehicle answered nothing at all for {hard - ex.t_sent:.1f} s "
+                                 f"(device off, wrong port or baud?)")
+            raise self.fail("RH-ACK-1", f"sent {escape(ex.raw.rstrip(bytes([13, 10])))}: no $ACK,{ack_type} "
+                                        f"within {hard - ex.t_sent:.1f} s, though the vehicle still answers")
+        allowed = window + tx + self.link.transmit_time(got_bytes) + ACK_GRACE_S
+        latency = ex.t_ack - ex.t_sent
+        if latency > allowed:
+            if latency <= 2 * allowed + 0.5:
+                self.book.add("RH-ACK-2", "inconclusive", f"an $ACK came {latency:.2f} s after the command, "
+                              f"over the {allowed:.2f} s allowed by a margin host load can explain",
+                              self.case, self.evidence(ex.t_sent))
+            else:
+                raise self.fail("RH-ACK-2", f"$ACK,{ack_type} came {latency:.2f} s after the command; the "
+                                            f"window with transmit time is {allowed - ACK_GRACE_S:.2f} s")
+        else:
+            self.book.ok("RH-ACK-2")
+        self.book.ok("RH-ACK-1")
+        if want_data and len(ex.data) < want_data and ex.ack.status == 0:
+            late_end = self.now() + min(0.5, window)
+            while len(ex.data) < want_data:
+                rx = self.link.next(late_end)
+                if rx is None:
+                    break
+                self._judge_line(rx)
+                if rx.sentence is not None and not isinstance(rx.sentence, s.ACK):
+                    raise self.fail("RH-ACK-5", f"$OSD data ${rx.sentence.ID} came after $ACK,8 "
+                                                f"(data must come before the ACK)")
+        if want_data and ex.ack.status == 0 and len(ex.data) >= want_data:
+            self.book.ok("RH-ACK-5")
+
+    def _alive(self) -> bool:
+        """Does the vehicle still answer anything? (an ``$OSD,S`` probe, not judged)."""
+        self.link.note("liveness probe")
+        self.link.send(frame("OSD,S"))
+        end = self.now() + 2 * self.profile.ack_window_s + 0.5
+        alive = False
+        while True:
+            rx = self.link.next(end)
+            if rx is None:
+                break
+            if rx.valid:
+                alive = True
+                if isinstance(rx.sentence, s.ACK) and rx.sentence.type == 8:
+                    break
+        self.link.sleep(0.05)
+        self.link.drain()
+        self.mirror_dirty = True
+        return alive
+
+    # ================================================================ $OSI
+    def _judge_osi(self, osi: s.OSI, t_sent: float, t_recv: float, clause: Optional[str]) -> None:
+        """RH-OUT-4: the ``$OSI`` is one a conforming vehicle may report then."""
+        half = max(0.0, (t_recv - t_sent) / 2)
+        t = t_sent + half
+        problems, exp = self.mirror.check_osi(osi, t, half)
+        if self.rec is not None:
+            self.rec.mode(t, osi.mode)
+        self.last_osi, self.last_osi_t = osi, t
+        if problems:
+            cid, msg = problems[0]
+            raise self.fail(clause or cid, msg, also=(cid,))
+        self.book.ok("RH-OUT-4")
+
+    def poll(self, clause: Optional[str] = None) -> s.OSI:
+        ex = self.exchange(frame("OSD,S"), clause)
+        if ex.osi is None:
+            if "S" not in self.profile.osd_letters:
+                raise CaseNotTested("the profile's osd_letters lack S: the state cannot be observed")
+            raise self.fail("RH-OSD-1", "$OSD,S was acknowledged without an $OSI")
+        if self.on_poll is not None:
+            self.on_poll()
+        return ex.osi
+
+    # ================================================================ time
+    def wait(self, vehicle_s: float, clause: Optional[str] = None, probe: Optional[bytes] = None) -> None:
+        """Let ``vehicle_s`` of protocol time pass (÷k in wall time), polling and judging."""
+        end = self.now() + vehicle_s / self.k
+        self._trace({"wait": round(vehicle_s, 3)})
+        t0 = self.now()
+        while self.now() < end:
+            nxt = min(end, self.now() + self.poll_gap)
+            self.link.sleep(max(0.0, nxt - self.now()))
+            if probe is not None:
+                self.exchange(probe, clause)
+            self.poll(clause)
+        self.forced_wait += self.now() - t0
+
+    def settle(self, clause: str, timer: Optional[str] = None, probe: Optional[bytes] = None,
+               after_v: float = 0.0) -> None:
+        """Poll past the deadline of a model timer + RH-TIM-1 tolerance + slack (module docstring)."""
+        dl = self.mirror.deadline(timer)
+        if dl is None:
+            raise CaseInconclusive(f"the model has no {timer or ''} timer running to wait for", clause)
+        due, dur, name = dl
+        t0 = self.now()
+        worst = 0.0
+        while True:
+            osi = self.poll(clause) if probe is None else None
+            if probe is not None:
+                self.exchange(probe, clause)
+                self.poll(clause)
+            slack = self.mirror.slack(self.poll_gap)
+            worst = max(worst, slack)
+            if self.mirror.v(self.now()) > due + tolerance(dur, slack) + after_v:
+                break
+            self.link.sleep(self.poll_gap)
+            if self.now() - t0 > (dur + 60.0) / self.k + 30.0:
+                raise CaseInconclusive(f"waited {self.now() - t0:.1f} s for the {name} timer", clause)
+        self.forced_wait += self.now() - t0
+        self.poll(clause)
+        if worst > 0.5 * max(dur, 1.0):
+            self.book.add("RH-TIM-1", "inconclusive", f"timing too noisy to judge a {dur:g} s duration: the "
+                          f"observer's slack reached {worst:.1f} s of vehicle time", self.case)
+            raise CaseInconclusive(f"timing too noisy: slack {worst:.1f} s for a {dur:g} s duration", clause)
+        self.book.add("RH-TIM-1", "pass", f"the {name} duration ({dur:g} s) held within "
+                      f"max(0.5 s, 5 %) + {worst:.2f} s of measured slack", self.case)
+
+    def until(self, what: str, pred: Callable[[s.OSI], bool], budget_v: float,
+              clause: Optional[str] = None, wall_cap: float = 60.0) -> s.OSI:
+        """Poll until ``pred(osi)``; NOT-TESTED when the vehicle does not get there in the budget."""
+        t0 = self.now()
+        end = t0 + min(budget_v / self.k, wall_cap)
+        while True:
+            osi = self.poll(clause)
+            if pred(osi):
+                return osi
+            if self.now() > end:
+                raise CaseNotTested(f"the vehicle did not reach {what} within {self.now() - t0:.1f} s "
+                                    f"({budget_v:g} s of vehicle time budgeted)")
+            self.link.sleep(max(self.poll_gap, 0.05))
+
+    # ================================================================ reset
+    def reset(self, mission: bool = True, park: bool = False) -> None:
+        """The verified reset: ``$OMSTOP,0`` → ``S``; optionally the mission by name → ``N``."""
+        t0 = self.now()
+        self._unsolicited_quiet()
+        end = t0 + (self.profile.lockout_s * 1.5 + 60.0) / self.k + 5.0
+        while True:
+            ex = self.exchange(frame("OMSTOP,0"), "RH-MSN-3", judge=False)
+            if ex.ack is not None and ex.ack.status == 0:
+                break
+            if ex.ack is not None and ex.ack.err == 26 and self.now() < end:
+                self.link.sleep(max(0.05, self.poll_gap))
+                continue
+            raise CaseInconclusive(f"verified reset failed: $OMSTOP,0 answered {_ack_text(ex.ack)}", "RH-MSN-3")
+        self.mirror.fresh()
+        self.mirror.receive(s.OMSTOP(0), ex.t_ack, ex.t_ack - ex.t_sent)  # type: ignore[operator]
+        osi = self.poll("RH-MSN-3")
+        if osi.mode != "S":
+            raise self.fail("RH-MSN-3", f"after an accepted $OMSTOP,0 the vehicle reports mode {osi.mode}, not S")
+        if mission:
+            ex = self.exchange(frame(f"OMSTART,0,0,0,0,{self.profile.mission},"), "RH-MSN-2")
+            if not ex.accepted:
+                raise CaseInconclusive(f"the profile's mission {self.profile.mission!r} did not start: "
+                                       f"{_ack_text(ex.ack)}", "RH-MSN-2")
+            osi = self.poll("RH-MSN-2")
+            if osi.mode != "N" or osi.next_waypoint != 0:
+                raise self.fail("RH-MSN-2", f"after $OMSTART the vehicle reports mode {osi.mode} waypoint "
+                                            f"{osi.next_waypoint}, not N waypoint 0")
+        if park:
+            self.reach_park()
+        self.mirror.settle()
+        self.forced_wait += 0.0
+
+    def _unsolicited_quiet(self) -> None:
+        try:
+            self._unsolicited(self.link.drain())
+        except CaseFail:
+            self.link.drain()
+
+    def reach_park(self) -> s.OSI:
+        """From ``N``: get to the mission's park (``P``), jumping straight to its waypoint once known."""
+        wp = self.mirror.stub.park_waypoint
+        if wp is not None and wp > 0:
+            self.exchange(frame(f"OJW,{wp + self.profile.waypoint_base}"), "RH-JW-2")
+        budget = 3600.0
+        osi = self.until("a mission park (mode P) on the test mission", lambda o: o.mode == "P", budget,
+                         wall_cap=max(20.0, 900.0 / self.k))
+        return osi
+
+    # ================================================================ context
+    def here(self) -> tuple[str, str]:
+        """The vehicle's last reported position, as sentence fields."""
+        o = self.last_osi
+        if o is None:
+            o = self.poll()
+        return f"{float(o.lat):.6f}", f"{float(o.lon):.6f}"
+
+    @property
+    def remote_active(self) -> bool:
+        return self.mirror.mode in REMOTE_MODES
