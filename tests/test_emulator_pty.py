@@ -17,6 +17,7 @@ import pytest
 
 from helmcheck.conformance.emulator.process import EmulatorProcess, HelmClient, frame
 from helmcheck.grammar import Framer, Line, decode
+from helmcheck.grammar import format as format_sentence
 from helmcheck.grammar import sentences as s
 
 K = 20.0  # time scale
@@ -338,3 +339,24 @@ def test_wire_log_is_written_per_record(emulator, helm):
     assert " ! fault injected ($OXFLT): Sop" in text
     assert " ! plant: " in text and " ! model: " in text
     assert " >~ noise" in text  # discarded runs are logged whole
+
+
+def test_RH_FRM_9_device_path_opened_with_pyserial():
+    from helmcheck.conformance.transport import PtyLink
+
+    line = PtyLink(19200)  # stands in for a serial cable: the emulator opens its device end
+    emu = EmulatorProcess(["--port", line.name], baud=19200).start()
+    try:
+        assert emu.port == line.name
+        c = HelmClient(line)
+        assert [type(g).__name__ for g in c.request("OSD,S", 8, timeout=5.0)] == ["OSI", "ACK"]
+        t0 = time.monotonic()
+        got = c.request("OSD,G,C,S,P,Y,D,T,I", 8, timeout=5.0)
+        elapsed = time.monotonic() - t0
+        assert len(got) == 9
+        # paced at 19200 baud (1920 bytes/s): after the first sentence, the rest take line time
+        size = sum(len(format_sentence(g)) for g in got[1:])
+        assert elapsed >= 0.9 * size / 1920, (elapsed, size)
+    finally:
+        assert emu.stop() == 0
+        line.close()

@@ -147,7 +147,9 @@ def _serve(args, profile, spec, baud, missions_dir, log_file, main_log_file) -> 
     core = EmulatorCore(profile, catalog, start=time.monotonic(), baud=baud, log=log,
                         main_log=MainLog(main_log_file) if main_log_file is not None else None,
                         settings_path=Path(args.settings) if args.settings else None,
-                        utc0=started.timestamp())
+                        utc0=started.timestamp(),
+                        on_error=None if args.tui else lambda text: print(f"helmcheck emulate: {text}",
+                                                                          file=sys.stderr))
     try:
         sys.stdout.write(f"port: {link.name}\n")
         sys.stdout.flush()

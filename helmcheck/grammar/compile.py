@@ -43,14 +43,10 @@ def grammar_text() -> str:
 def lark_parser() -> Lark:
     """The reference parser (LALR, contextual lexer) with ``line`` and ``body`` start rules.
 
-    Building the LALR tables takes seconds, so it happens only when first needed (the Lark
-    engine, locating an error, the property tests) and is cached on disk by Lark between runs.
+    Built on first use only (the Lark engine, locating an error, the property tests): the fast
+    path needs just the rule definitions (:func:`grammar_defs`).
     """
-    try:
-        return Lark(grammar_text(), parser="lalr", start=["line", "body"], maybe_placeholders=True,
-                    cache=True)
-    except OSError:  # no writable temp directory: build without the cache
-        return Lark(grammar_text(), parser="lalr", start=["line", "body"], maybe_placeholders=True)
+    return Lark(grammar_text(), parser="lalr", start=["line", "body"], maybe_placeholders=True)
 
 
 @lru_cache(maxsize=1)

@@ -29,6 +29,7 @@ Knowledge and reaction (decisions where §9 is silent; each is a constructor set
 
 from __future__ import annotations
 
+import re
 from collections import OrderedDict, deque
 from dataclasses import dataclass, field
 from typing import Optional
@@ -55,6 +56,7 @@ _NEED_RUNNING = frozenset({"OMS", "OJW", "OPK", "OMW"})
 _NEED_STOPPED = frozenset({"OLOGL", "ORWSET"})
 #: Commands that end servo control when the backseat sends them (RH-INT-1, RH-MSN-3).
 _ENDS_SERVO = frozenset({"OMP", "OJW", "OPK", "OMW", "OMSTOP", "OMSTART"})
+_ID = re.compile(rb"\$([A-Z]+)[,*]")
 _BODY_MEMORY = 1024  #: command texts remembered for the resend rule (bounded memory)
 
 
@@ -254,9 +256,10 @@ class BackseatJudge:
         else:
             self._rejected.pop(sent.body, None)
             if sent.sid == "OMS" and sent.timeout is not None:
-                wall = sent.timeout / self.time_scale
-                tol = max(0.5, 0.05 * sent.timeout) / self.time_scale + self.jitter_s
-                self._servo = (t + wall, tol)
+                deadline, tol = self._servo_window(t, sent.timeout)
+                if self._servo is not None and self._servo[0] > deadline:
+                    deadline, tol = self._servo  # a later refresh is already on its way
+                self._servo = (deadline, tol)
                 self.stats["servo_accepted"] += 1
                 self.judged["RH-BS-6"] += 1
         for piece, sid, need_running, at in sent.deferred:
@@ -294,6 +297,8 @@ class BackseatJudge:
         """The run (or the link) ended at ``t``: pending bytes are a discarded run."""
         out: list[Piece] = []
         self._framer.close()  # a line cut short by the end of the run is nobody's fault
+        if self._over_unclaimed:  # RH-BS-4: an over-budget second that completed no line
+            self._claim_budget(t, bytes(self._pending[:self.profile.max_line_bytes]))
         if self._pending:
             out.append(Piece(bytes(self._pending), t))
             self._pending.clear()
@@ -362,7 +367,8 @@ class BackseatJudge:
                 self._offend("RH-BS-2", t, raw, str(d.error))
             if d.error.answered and not self._silent:
                 self._expect_ack(piece, d.error.sentence_id or "", d.error.ack_type, raw, t)
-            self._lockout_rule(piece, d.error.sentence_id or "", t)
+            m = _ID.match(raw)  # a damaged $OSD is still a poll attempt, not a command
+            self._lockout_rule(piece, d.error.sentence_id or (m.group(1).decode() if m else ""), t)
             return
         cmd = d.sentence
         if not isinstance(cmd, s.Command):
@@ -467,8 +473,9 @@ class BackseatJudge:
     # ---------------------------------------------------------------- RH-BS-6
     def _servo_rule(self, piece: Piece, cmd: s.Command, t: float) -> None:
         """RH-BS-6 (SHOULD): an ``$OMS`` that follows an accepted ``$OMS`` after that one's
-        timeout ran out (``timeout / time_scale`` wall seconds after its ACK, plus the RH-TIM-1
-        tolerance and ``jitter_s``) came too late: servo control had lapsed. Another control
+        timeout ran out (``timeout / time_scale`` wall seconds after its ACK — or after a later
+        refresh arrived in time — plus the RH-TIM-1 tolerance and ``jitter_s``) came too late:
+        servo control had lapsed. Another control
         command, a stop or start, a reported stop, a rejection, a lockout or a silence ends
         the tracking (the backseat then no longer holds servo control by its own choice)."""
         sid = cmd.ID
@@ -483,6 +490,13 @@ class BackseatJudge:
                          f"$OMS refresh {t - deadline:.2f} s after the previous one's timeout ran out "
                          f"(servo control had lapsed)")
             self._servo = None
+        elif isinstance(cmd, s.OMS):  # in time: the vehicle restarts its timeout (RH-SRV-3)
+            self._servo = max(self._servo, self._servo_window(t, cmd.timeout))
+
+    def _servo_window(self, t: float, timeout: int) -> tuple[float, float]:
+        """Wall deadline and tolerance of a servo timeout restarted at ``t`` (RH-TIM-1/2)."""
+        tol = max(0.5, 0.05 * timeout) / self.time_scale + self.jitter_s
+        return t + timeout / self.time_scale, tol
 
     # ---------------------------------------------------------------- RH-BS-8
     def _poll(self, piece: Piece, t: float) -> None:

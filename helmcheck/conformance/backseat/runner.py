@@ -20,7 +20,6 @@ end it early as "interrupted".
 
 from __future__ import annotations
 
-import os
 import select
 import time
 from collections import deque
@@ -33,27 +32,15 @@ from ...grammar.capture import FROM_VEHICLE, TO_VEHICLE, WireLogWriter
 from ...model.missions import MissionCatalog
 from ...profile import Profile
 from ..emulator.core import EmulatorCore
-from ..transport import Link, LinkClosed, PtyLink
+from ..transport import Link, LinkClosed
 from .judge import BackseatJudge, Piece
+from .link import HangupPty
 from .scenarios import LOCKOUT_CODE, Plan
 
 __all__ = ["Runner", "Outcome", "HangupPty", "MAX_OUT"]
 
 MAX_OUT = 256 * 1024  #: bytes waiting for a link nobody reads; beyond this they are dropped
 _TICK = 0.05
-
-
-class HangupPty(PtyLink):
-    """A pty that can let go of its own slave descriptor, so the peer's close is a hang-up."""
-
-    def peer_seen(self) -> None:
-        slave = getattr(self, "_slave", -1)
-        if slave is not None and slave >= 0:
-            try:
-                os.close(slave)
-            except OSError:
-                pass
-            self._slave = -1
 
 
 @dataclass
@@ -212,7 +199,7 @@ class Runner:
             self._after_vehicle(now)
 
     def _deliver(self, piece: Piece, now: float) -> None:
-        t = piece.t
+        t = self.rel(now)
         if self._silent:
             self._log_bytes(t, TO_VEHICLE, piece.raw)
             if not self._silence_noted:
@@ -225,7 +212,8 @@ class Runner:
             self._log_bytes(t, TO_VEHICLE, piece.raw)
             ack = format_sentence(s.ACK(cmd.ACK_TYPE, 1, cmd.ERR))
             self._staged.append(ack)
-            self.outcome.events.append((t, "ack-error", f"staged rejection of ${cmd.ID}: err {cmd.ERR}"))
+            if len(self.outcome.events) < 500:
+                self.outcome.events.append((t, "ack-error", f"staged rejection of ${cmd.ID}: err {cmd.ERR}"))
             self._flush_staged(now)
             return
         self._emit(self.core.feed(piece.raw, now))

@@ -16,6 +16,7 @@ Verdict of a clause (reference profile preamble, RH-TIM-1):
 
 from __future__ import annotations
 
+from collections import Counter
 from dataclasses import dataclass, field
 from typing import Iterable, Optional
 
@@ -62,15 +63,15 @@ class ClauseBook:
         self.order = [c for c in clauses if c in self.known]
         self._e: dict[str, _Entry] = {c: _Entry() for c in self.order}
         self._untested: dict[str, str] = {}
+        #: pass counts by clause; hot paths may add to it directly (unknown clauses are ignored)
+        self.passes: Counter = Counter()
         self._notes: dict[str, list[str]] = {}
 
     def _get(self, cid: str) -> Optional[_Entry]:
         return self._e.get(cid)
 
     def ok(self, cid: str, n: int = 1) -> None:
-        e = self._e.get(cid)
-        if e is not None:
-            e.passes += n
+        self.passes[cid] += n
 
     def fail(self, cid: str, reason: str, evidence: Iterable[Evidence] = ()) -> None:
         e = self._e.get(cid)
@@ -114,7 +115,7 @@ class ClauseBook:
 
     def count(self, cid: str) -> tuple[int, int, int]:
         e = self._e.get(cid)
-        return (e.passes, e.fails, e.inconclusive) if e else (0, 0, 0)
+        return (self.passes[cid], e.fails, e.inconclusive) if e else (0, 0, 0)
 
     def lines(self, cid: str) -> list[int]:
         e = self._e.get(cid)
@@ -125,6 +126,7 @@ class ClauseBook:
         out = []
         for cid in self.order:
             e = self._e[cid]
+            e.passes = self.passes[cid]
             level = self.known[cid].level
             judged = e.passes + e.fails + e.inconclusive
             if e.fails:

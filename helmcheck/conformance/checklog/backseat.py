@@ -172,10 +172,14 @@ class BackseatJudge:
     def oms_accepted(self, t: float, timeout_s: int) -> None:
         self._last_oms = (t, timeout_s)
 
+    def control_changed(self) -> None:
+        """Another command ended servo control: the next ``$OMS`` is no refresh (RH-BS-6)."""
+        self._last_oms = None
+
     def _servo_refresh(self, t: float, ev: Evidence) -> None:
         """RH-BS-6: a refresh that comes after the previous timeout lapsed (within 2× of it)."""
         last = self._last_oms
-        if last is None:
+        if last is None or self.in_lockout():
             return
         t0, timeout = last
         wall = timeout / self.time_scale

@@ -377,12 +377,12 @@ class VehicleJudge:
                 self.book.ok("RH-ACK-2")
             else:
                 self.book.fail("RH-ACK-2", f"$ACK after {dt:.3f} s; window {window:.3f} s "
-                                           f"(ack_window_s + transmit time)", [cev, ev])
+                                           f"(ack_window_s + transmit time)", [ev, cev])
         elif dt - 2 * self.r > window:
-            self.book.fail("RH-ACK-2", f"$ACK after at least {dt - 2 * self.r:.3f} s; window {window:.3f} s", [cev, ev])
+            self.book.fail("RH-ACK-2", f"$ACK after at least {dt - 2 * self.r:.3f} s; window {window:.3f} s", [ev, cev])
         else:
             self.book.inconclusive("RH-ACK-2", f"timestamps step {self.r:g} s cannot bound a {window:.3f} s "
-                                               f"window (RH-TIM-1)", [cev, ev])
+                                               f"window (RH-TIM-1)", [ev, cev])
         # data before ACK (RH-ACK-5, RH-OSD-1/2)
         if p.ack.type == 8:
             self._judge_osd_data(p, a, cev, ev)
@@ -392,7 +392,7 @@ class VehicleJudge:
             for c in p.clauses:
                 self.book.ok(c)
             if a.status == 0 and a.extra and not isinstance(p.cmd, s.ORWSET):
-                self.book.fail("RH-ACK-1", "extra fields on an $ACK that is not an $ORWSET reply", [cev, ev])
+                self.book.fail("RH-ACK-1", "extra fields on an $ACK that is not an $ORWSET reply", [ev, cev])
             return
         mission_related = p.mission_dependent and (a.err in _MISSION_ERRS or p.ack.err in _MISSION_ERRS
                                                     or isinstance(p.cmd, _MISSION_CMDS))
@@ -400,16 +400,16 @@ class VehicleJudge:
         if mission_related:
             for c in p.clauses or ("RH-ACK-3",):
                 self.book.inconclusive(c, "the answer depends on the vehicle's mission files, which the "
-                                          "log does not carry (use --missions)", [cev, ev])
+                                          "log does not carry (use --missions)", [ev, cev])
             self._adopt(p, a)
             return
         if p.ack.err == 26 and self.lockout_inferred:
             for c in p.clauses:
                 self.book.inconclusive(c, "the lockout was inferred from an $OSI report; its start, and "
-                                          "so its end, is not known precisely", [cev, ev])
+                                          "so its end, is not known precisely", [ev, cev])
             return
         for c in p.clauses or ("RH-ACK-3",):
-            self.book.fail(c, reason, [cev, ev])
+            self.book.fail(c, reason, [ev, cev])
 
     def _adopt(self, p: _Pending, a: s.ACK) -> None:
         """Follow the vehicle where only the mission files could decide."""
@@ -423,7 +423,7 @@ class VehicleJudge:
         got = tuple(p.got)
         if a.status == 1:
             if got:
-                self.book.fail("RH-OSD-2", f"a rejected $OSD carried {len(got)} data sentence(s)", [cev, ev])
+                self.book.fail("RH-OSD-2", f"a rejected $OSD carried {len(got)} data sentence(s)", [ev, cev])
             return
         want = p.data if p.ack.status == 0 else ()
         if got == want:
@@ -433,10 +433,10 @@ class VehicleJudge:
         names = lambda xs: ",".join("$" + c.ID for c in xs) or "none"  # noqa: E731
         if len(got) < len(want) and got == want[:len(got)]:
             self.book.fail("RH-ACK-5", f"$ACK,8 came before all requested data: got {names(got)}, "
-                                       f"expected {names(want)}", [cev, ev])
+                                       f"expected {names(want)}", [ev, cev])
         else:
             self.book.fail("RH-OSD-1", f"$OSD replies {names(got)}; expected {names(want)} in request order",
-                           [cev, ev])
+                           [ev, cev])
 
     def data(self, cls: type, sentence: Optional[s.Reply], t: float, lineno: int, text: str) -> None:
         """A data sentence from the vehicle: belongs to the oldest unanswered ``$OSD``."""
@@ -475,25 +475,30 @@ class VehicleJudge:
             exp = _expect(self.model, now_v, slack_v)
         cev = Evidence(p.t, ">", p.lineno, p.text)
         if not findings:
+            rr = self.recent_release
+            if rr is not None and osi.mode != rr[1]:
+                self.book.ok(rr[0])
+            if m.error_state != "N":
+                self.book.ok("RH-SAF-1")  # field 8 shows the violation's code
             if self.precise or (len(exp.states) == 1 and exp.states[0].park_lo >= exp.states[0].park_hi - 1):
                 self.book.ok("RH-OUT-4")
             else:
                 self.book.inconclusive("RH-OUT-4", f"timestamps step {self.r:g} s (×{self.scale:g}) cannot "
-                                                   f"bound the timing tolerance (RH-TIM-1)", [cev, ev])
+                                                   f"bound the timing tolerance (RH-TIM-1)", [ev, cev])
             return
-        mm = m
-        if not self.mission_known and (mm.mode in ("N", "P") or osi.mode in ("N", "P", "S")
-                                       or self.mission_desync):
+        mission_modes = ("N", "P", "S")
+        if not self.mission_known and osi.mode in mission_modes and all(
+                a.mode in mission_modes for a in exp.states):
             self.book.inconclusive("RH-OUT-4", f"{findings[0][1]} — depends on the mission file, which the "
-                                               f"log does not carry (use --missions)", [cev, ev])
+                                               f"log does not carry (use --missions)", [ev, cev])
             return
         msg = findings[0][1]
         if not self.precise:
             msg += " (mismatch beyond the widest timing the coarse timestamps allow)"
-        self.book.fail("RH-OUT-4", msg, [cev, ev])
+        self.book.fail("RH-OUT-4", msg, [ev, cev])
         blame = self._blame(osi, m)
         if blame:
-            self.book.fail(blame, msg, [cev, ev])
+            self.book.fail(blame, msg, [ev, cev])
 
     def _blame(self, osi: s.OSI, m: VehicleModel) -> Optional[str]:
         if osi.error_state != m.error_state:

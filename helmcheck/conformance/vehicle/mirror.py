@@ -116,9 +116,12 @@ class Mirror:
 
     def fresh(self) -> None:
         """Forget everything but what was learnt about the mission (after a verified reset)."""
-        settings = self.model.settings
+        old = self.model
         self.model = VehicleModel(self.profile, self.stub)
-        self.model.settings = settings
+        # what a vehicle keeps across $OMSTOP: settings, log labels, the loaded mission
+        self.model.settings = old.settings
+        self.model.log_labels = old.log_labels
+        self.model.loaded = old.loaded
         self.settle()
 
     def settle(self) -> None:
@@ -199,6 +202,7 @@ class Mirror:
         """Judge an ``$OSI`` seen at link time ``t``: ``([], exp)`` or ``([(clause, msg)…], exp)``."""
         vt = self.v(t)
         slack = self.slack(wall_slack)
+        self._countdown_seen(osi, vt, wall_slack)
         exp = self.model.expectation(vt, slack)
         problems = exp.check(osi)
         prev = self.last_obs
@@ -211,6 +215,19 @@ class Mirror:
             if self.model.phase != "ascent":
                 self._plant_from(self.model, osi)
         return problems, exp
+
+    def _countdown_seen(self, osi: s.OSI, vt: float, wall_slack: float) -> None:
+        """An ``$OPK`` park shown counting: adopt "on station" at the start the display implies."""
+        m = self.model
+        if not (m.mode == "mP" and osi.mode == "mP" and m.phase == "none" and not m.timers.armed("opk")
+                and 0 < osi.park_time < m.opk_seconds):
+            return
+        start = vt - (m.opk_seconds - osi.park_time) - 0.5
+        c = m.clone()
+        c.plant(OnStation(), max(start, m.now if m.now is not None else start))
+        self.model = c
+        self.plant_slack = max(self.plant_slack, 1.0 + self.k * wall_slack)
+        self.adopted.append(f"on station (countdown shown) at v={start:.1f}")
 
     def _closure(self, osi: s.OSI, t: float, wall_slack: float, prev: Optional[float]) -> Optional[str]:
         """Adopt the plant event that explains ``osi`` (module docstring); its name or ``None``."""

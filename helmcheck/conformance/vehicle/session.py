@@ -28,7 +28,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Callable, Optional
 
-from ...grammar import SentenceError, checksum_hex, decode
+from ...grammar import Framer, Line, SentenceError, checksum_hex, decode
 from ...grammar import sentences as s
 from ...grammar.capture import escape
 from ...model.timers import tolerance
@@ -167,8 +167,14 @@ class Session:
 
     # ================================================================ exchange
     def item_of(self, raw: bytes):
-        """What a conforming vehicle reads from ``raw``: a command, an answered error, or None."""
-        d = decode(raw, self.profile)
+        """What a conforming vehicle reads from ``raw``: a command, an answered error, or None.
+
+        ``raw`` is cut into lines as a conforming vehicle does (RH-FRM-6/7); the last line counts.
+        """
+        lines = [e.raw for e in Framer(self.profile.max_line_bytes).feed(raw) if isinstance(e, Line)]
+        if not lines:
+            return None
+        d = decode(lines[-1], self.profile)
         if d.sentence is not None and isinstance(d.sentence, s.Command):
             if d.sentence.ID not in self.profile.commands and not isinstance(d.sentence, s.OXFLT):
                 return None
@@ -240,6 +246,10 @@ class Session:
     def _silent(self, ex: Exchange, clause: Optional[str], item) -> None:
         """A line with no ACK due (discard, or $OXFLT): nothing may answer it within the window."""
         window = self.profile.ack_window_s + self.link.transmit_time(len(ex.raw)) + ACK_GRACE_S
+        if isinstance(item, s.OXFLT):
+            # RH-SAF-5: no ACK. Its effect is timed (the lockout), so the tester does not sit out
+            # the ACK window here: a stray ACK is caught by the next exchange (RH-ACK-1).
+            window = 0.02
         end = ex.t_sent + window
         while True:
             rx = self.link.next(end)
@@ -253,7 +263,7 @@ class Session:
                                       f"(it must be discarded silently), got {_ack_text(sent)}")
         self.forced_wait += 0.0
         if isinstance(item, s.OXFLT):
-            self.mirror.receive(item, self.now(), 0.0)
+            self.mirror.receive(item, ex.t_sent, 0.0)
             if self.rec is not None:
                 self.rec.event(ex.t_sent, "lockout", f"$OXFLT,{item.code} sent")
         self._trace({"expect": "nothing (a silent discard)"})
@@ -340,6 +350,29 @@ class Session:
         self.mirror_dirty = True
         return alive
 
+    def burst(self, raws: list[bytes], clause: str) -> list[Exchange]:
+        """Write several commands at once, then read their ACKs in order (RH-ACK-6)."""
+        self._unsolicited(self.link.drain())
+        items = [self.item_of(r) for r in raws]
+        t_sent = self.link.send(b"".join(raws))
+        self._trace({"send": escape(b"".join(raws)), "t": round(t_sent, 6)})
+        out = []
+        for raw, item in zip(raws, items):
+            ex = Exchange(raw, item, t_sent)
+            if not isinstance(item, s.Command) or item.ACK_TYPE is None:
+                continue
+            self._collect(ex, item.ACK_TYPE, clause)
+            observed = ex.data + [ex.ack]
+            ex.expected = self.mirror.receive(item, ex.t_ack, ex.t_ack - t_sent, observed)  # type: ignore[operator]
+            if not same_replies(ex.expected, observed):
+                raise self.fail(clause, f"burst command {escape(raw.rstrip(bytes([13, 10])))}: expected "
+                                        f"{_replies_text(ex.expected)}; got {_replies_text(observed)}")
+            if ex.osi is not None:
+                self._judge_osi(ex.osi, t_sent, ex.t_ack, None)  # type: ignore[arg-type]
+            out.append(ex)
+        self.book.ok("RH-ACK-6", len(out))
+        return out
+
     # ================================================================ $OSI
     def _judge_osi(self, osi: s.OSI, t_sent: float, t_recv: float, clause: Optional[str]) -> None:
         """RH-OUT-4: the ``$OSI`` is one a conforming vehicle may report then."""
@@ -409,14 +442,28 @@ class Session:
                       f"max(0.5 s, 5 %) + {worst:.2f} s of measured slack", self.case)
 
     def until(self, what: str, pred: Callable[[s.OSI], bool], budget_v: float,
-              clause: Optional[str] = None, wall_cap: float = 60.0) -> s.OSI:
-        """Poll until ``pred(osi)``; NOT-TESTED when the vehicle does not get there in the budget."""
+              clause: Optional[str] = None, wall_cap: float = 30.0, estimate: bool = False) -> s.OSI:
+        """Poll until ``pred(osi)``; NOT-TESTED when the vehicle does not get there in the budget.
+
+        With ``estimate``, the travel time left (``$OSI`` distance ÷ speed) is compared with the
+        budget as soon as the vehicle is under way, and a hopeless wait is not started.
+        """
         t0 = self.now()
         end = t0 + min(budget_v / self.k, wall_cap)
+        n = 0
         while True:
             osi = self.poll(clause)
+            n += 1
             if pred(osi):
                 return osi
+            speed = float(osi.speed) * 1852.0 / 3600.0
+            if estimate and n >= 3 and speed > 0.05:
+                need_v = float(osi.distance) / speed
+                if need_v / self.k > end - self.now():
+                    raise CaseNotTested(f"{what} needs about {need_v:.0f} s of vehicle time "
+                                        f"({need_v / self.k:.0f} s at k={self.k:g}) for this leg alone, over the "
+                                        f"case budget of {end - t0:.0f} s; a shorter test mission or a larger "
+                                        f"time scale would reach it")
             if self.now() > end:
                 raise CaseNotTested(f"the vehicle did not reach {what} within {self.now() - t0:.1f} s "
                                     f"({budget_v:g} s of vehicle time budgeted)")

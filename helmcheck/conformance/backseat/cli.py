@@ -1,0 +1,240 @@
+"""``helmcheck certify backseat``: play the vehicle on a serial line and judge a backseat.
+
+The command opens the port (``--port pty`` prints ``port: /dev/pts/N`` as its first line on
+standard output, flushed, for the backseat to open; a device path is opened 8N1 at the
+profile's baud; ``socket://HOST:PORT`` serves one client), plays the reference vehicle, stages
+the scenarios of :mod:`.scenarios` and judges every byte the backseat sends (:mod:`.judge`).
+At the end (also after Ctrl-C, a backseat that never connected or one that went away) it writes
+``results.json``, ``wire.log`` and every report format into ``--report-dir``, prints one verdict
+line on standard output and exits 0 (pass; non-strict without ``--strict``), 1 (fail), 2
+(inconclusive) or 64 (usage). Progress goes to standard error.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import shutil
+import signal
+import sys
+import threading
+import time
+from datetime import datetime, timezone
+from pathlib import Path
+from typing import Any, Callable, Optional
+
+from ... import exitcodes
+from .scenarios import SCENARIOS
+
+__all__ = ["add_arguments", "run", "EPILOG"]
+
+EPILOG = f"""\
+scenarios (default: all, in this order, over --duration):
+  nominal      the vehicle answers as the reference model does
+  reject       every command but $OSD is refused with its "incorrect values" $ACK
+  lockout      a safety violation: 20 s (vehicle time) of err 26 for all but $OSD
+  mission-end  the running mission ends on the vehicle ($OSI reports S)
+  silence      the vehicle neither reads nor answers for a while
+
+judged (reference profile §9): RH-BS-1 framing and checksum, RH-BS-2 field ranges,
+RH-BS-3 preconditions, RH-BS-4 line budget (baud/10 bytes in any second), RH-BS-5 reaction
+to rejections and lockouts, RH-BS-6 servo refresh, RH-BS-7 upper-case hex and CR LF,
+RH-BS-8 $OSD polling every 5 s. A SHOULD missed is NON-STRICT (exit 0; 1 with --strict).
+
+examples:
+  helmcheck certify backseat                          # pty: prints 'port: /dev/pts/N'
+  helmcheck certify backseat --duration 30 --time-scale 10 --report-dir out/
+  helmcheck certify backseat --port socket://127.0.0.1:4001 --scenario lockout
+  helmcheck certify backseat --port /dev/ttyUSB0 --profile site.toml --strict
+
+exit status: 0 conformant, 1 non-conformant, 2 inconclusive, 64 usage.
+"""
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--port", default="pty", metavar="PORT",
+                   help="pty (default; prints 'port: /dev/pts/N' first), a device path, or socket://HOST:PORT")
+    p.add_argument("--profile", metavar="FILE", help="TOML profile (default: rh5)")
+    p.add_argument("--duration", type=float, default=60.0, metavar="S",
+                   help="seconds of judged run after the backseat's first byte, split across the scenarios (default 60)")
+    p.add_argument("--time-scale", type=float, metavar="K",
+                   help="the vehicle clock runs K times faster (RH-TIM-2; tell the backseat the same K; default: the profile's)")
+    p.add_argument("--scenario", action="append", choices=SCENARIOS, metavar="NAME",
+                   help=f"run only these scenarios, in order (repeatable): {', '.join(SCENARIOS)}")
+    p.add_argument("--report-dir", metavar="DIR",
+                   help="where results.json, wire.log and the reports go (default: reports/backseat-<UTC time>)")
+    p.add_argument("--strict", action="store_true", help="a SHOULD not met fails the run")
+    p.add_argument("--wire-log", metavar="FILE", help="also keep a copy of the wire log here")
+    p.add_argument("--connect-timeout", type=float, default=30.0, metavar="S",
+                   help="seconds to wait for the backseat's first byte (default 30)")
+    p.add_argument("--baud", type=int, metavar="N", help="line rate (default: the profile's)")
+
+
+def _usage(msg: str) -> int:
+    print(f"helmcheck certify backseat: {msg}", file=sys.stderr)
+    return exitcodes.USAGE
+
+
+def _positive(x: Optional[float]) -> bool:
+    return x is not None and math.isfinite(x) and x > 0
+
+
+class _Progress:
+    """Rich progress on standard error: scenario, elapsed time and offences so far."""
+
+    def __init__(self) -> None:
+        from rich.console import Console
+        from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
+
+        self.console = Console(stderr=True)
+        self.bar = Progress(TextColumn("{task.description}"), BarColumn(), TextColumn("{task.fields[extra]}"),
+                            TimeRemainingColumn(), console=self.console, transient=False,
+                            disable=not self.console.is_terminal)
+        self.task = None
+        self._last = 0.0
+
+    def start(self, total: float) -> None:
+        self.bar.start()
+        self.task = self.bar.add_task("connected", total=total, extra="")
+
+    def update(self, elapsed: float, scenario: str, counts: dict) -> None:
+        if self.task is None:
+            return
+        now = time.monotonic()
+        if now - self._last < 0.2:
+            return
+        self._last = now
+        bad = ", ".join(f"{c} ×{n}" for c, n in counts.items() if n)
+        self.bar.update(self.task, completed=elapsed, description=f"{scenario:<11}",
+                        extra=bad or "no offence so far")
+
+    def stop(self) -> None:
+        if self.task is not None:
+            self.bar.stop()
+
+
+def run(args: argparse.Namespace, *, on_port: Optional[Callable[[str], None]] = None) -> int:  # noqa: C901
+    """Carry out ``certify backseat``; returns the exit status. ``on_port(name)`` is called
+    once the port is open (after the ``port:`` line), for callers that start the backseat."""
+    from ...profile import ProfileError, load_profile
+    from ..transport import BAUD_RATES, parse_port_spec
+    from .scenarios import make_plan
+
+    try:
+        profile = load_profile(args.profile)
+    except ProfileError as e:
+        return _usage(str(e))
+    scale = args.time_scale if args.time_scale is not None else profile.time_scale
+    if not _positive(scale):
+        return _usage(f"--time-scale must be a positive number (got {args.time_scale})")
+    if not _positive(args.duration):
+        return _usage(f"--duration must be a positive number of seconds (got {args.duration})")
+    if not _positive(args.connect_timeout):
+        return _usage(f"--connect-timeout must be a positive number of seconds (got {args.connect_timeout})")
+    baud = args.baud if args.baud is not None else profile.baud
+    if baud not in BAUD_RATES:
+        return _usage(f"--baud must be one of {', '.join(map(str, BAUD_RATES))} (got {baud})")
+    try:
+        spec = parse_port_spec(args.port)
+    except ValueError as e:
+        return _usage(f"--port: {e}")
+    profile = profile.replace(time_scale=float(scale), baud=baud)
+    names = args.scenario or list(SCENARIOS)
+    plan = make_plan(names, args.duration, time_scale=scale, lockout_s=profile.lockout_s)
+    started_dt = datetime.now(timezone.utc)
+    stamp = started_dt.strftime("%Y%m%dT%H%M%SZ")
+    report_dir = Path(args.report_dir) if args.report_dir else Path("reports") / f"backseat-{stamp}"
+    try:
+        report_dir.mkdir(parents=True, exist_ok=True)
+        log_file = open(report_dir / "wire.log", "w", encoding="utf-8")
+    except OSError as e:
+        return _usage(f"cannot write to {report_dir}: {e.strerror or e}")
+    settings: dict[str, Any] = {"time_scale": float(scale), "strict": bool(args.strict),
+                                "duration_s": float(args.duration), "planned_s": round(plan.total, 3),
+                                "scenarios": list(dict.fromkeys(names)), "baud": baud,
+                                "connect_timeout_s": float(args.connect_timeout),
+                                "reaction_s": 0.5, "jitter_s": 0.2}
+    command = "helmcheck certify backseat " + " ".join(sys.argv[3:] if sys.argv[1:3] == ["certify", "backseat"]
+                                                       else [f"--port {args.port}"])
+    started = started_dt.isoformat(timespec="seconds").replace("+00:00", "Z")
+    return _certify(args, profile, spec, plan, report_dir, log_file, settings, command, started, started_dt,
+                    on_port)
+
+
+def _certify(args, profile, spec, plan, report_dir: Path, log_file, settings, command: str,
+             started: str, started_dt: datetime, on_port=None) -> int:
+    from ..transport import open_link
+    from .link import HangupPty
+
+    strict = bool(args.strict)
+    link = None
+    outcome = None
+    reason = ""
+    progress = None
+    try:
+        try:
+            link = HangupPty(profile.baud) if spec.kind == "pty" else open_link(spec, role="server", baud=profile.baud)
+        except (OSError, ValueError) as e:
+            reason = f"cannot open {args.port}: {getattr(e, 'strerror', None) or e}"
+            print(f"helmcheck certify backseat: {reason}", file=sys.stderr)
+        if link is not None:
+            try:
+                sys.stdout.write(f"port: {link.name}\n")
+                sys.stdout.flush()
+            except OSError:
+                pass
+            from ...grammar.capture import WireLogWriter  # the grammar loads after the port line
+            from ..emulator.missionfile import DirectoryCatalog, builtin_dir
+            from .runner import Runner
+            log = WireLogWriter(log_file, meta=(f"started {started_dt.strftime('%Y-%m-%dT%H:%M:%S.%fZ')}  "
+                                                f"port {link.name}  baud {profile.baud}  "
+                                                f"time_scale {profile.time_scale:g}"))
+            print(f"helmcheck certify backseat: {link.description}, profile {profile.name}, time scale "
+                  f"{profile.time_scale:g}, baud {profile.baud}, scenarios {', '.join(s.name for s in plan.slots)} "
+                  f"over {plan.total:.1f} s; waiting up to {args.connect_timeout:g} s for the backseat",
+                  file=sys.stderr)
+            if plan.note:
+                print(f"helmcheck certify backseat: {plan.note}", file=sys.stderr)
+            progress = _Progress()
+            if on_port is not None:
+                on_port(link.name)
+            runner = Runner(link, profile, plan, time_scale=profile.time_scale,
+                            missions=DirectoryCatalog([builtin_dir()]), log=log,
+                            connect_timeout=args.connect_timeout, progress=progress)
+            old = {}
+            if threading.current_thread() is threading.main_thread():
+                for sig in (signal.SIGINT, signal.SIGTERM):
+                    old[sig] = signal.signal(sig, lambda *_: runner.stop("interrupted"))
+            try:
+                outcome = runner.run()
+            finally:
+                for sig, h in old.items():
+                    signal.signal(sig, h)
+                progress.stop()
+    finally:
+        if link is not None:
+            link.close()
+        try:
+            log_file.close()
+        except OSError:
+            pass
+    from ...reports.results import ReportError, exit_code
+    from ...reports.view import VERDICT_LABEL
+    from .report import build_results, write_reports
+
+    results = build_results(outcome, profile=profile, settings=settings, command=command,
+                            port=link.name if link is not None else args.port, started=started,
+                            reason=reason)
+    try:
+        write_reports(report_dir, results)
+        if args.wire_log:
+            shutil.copyfile(report_dir / "wire.log", args.wire_log)
+    except (ReportError, OSError) as e:
+        print(f"helmcheck certify backseat: report not written: {e}", file=sys.stderr)
+        return exitcodes.INCONCLUSIVE
+    verdict = results["verdict"]
+    partial = " (PARTIAL)" if results["partial"] else ""
+    print(f"{VERDICT_LABEL[verdict]}{partial}: {results['verdict_reason']}")
+    print(f"helmcheck certify backseat: report in {report_dir}", file=sys.stderr)
+    sys.stdout.flush()
+    return exit_code(verdict, strict)

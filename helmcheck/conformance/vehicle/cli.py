@@ -1,0 +1,113 @@
+"""``helmcheck certify vehicle``: arguments, and the one-line verdict at the end.
+
+``add_arguments(parser)`` and ``run(args) -> int`` are what
+:mod:`helmcheck.commands.certify_cmd` dispatches to; :data:`EPILOG` is the ``--help`` epilog.
+Exit status: 0 pass (or non-strict without ``--strict``), 1 fail, 2 inconclusive, 64 usage.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+from pathlib import Path
+
+from ... import exitcodes
+
+__all__ = ["add_arguments", "run", "EPILOG"]
+
+EPILOG = """\
+how it works:
+  helmcheck plays the backseat. For every vehicle clause of the profile (§1-8) it runs a numbered
+  case (steps, description, expectation), each after a verified reset: $OMSTOP,0 until $OSI shows S,
+  then the profile's test mission started by name ($OMSTART,0,0,0,0,<mission>,) and N verified.
+  Every reply and every $OSI is compared with the reference model, durations within RH-TIM-1's
+  max(0.5 s, 5 %) widened by the measured slack. Then hypothesis sends random valid and invalid
+  command sequences and shrinks any failure to a replay file (helmcheck replay FILE --port URL).
+
+verdicts: pass, non-strict (a SHOULD missed), fail, inconclusive (link fault, noisy timing),
+  not-tested (the profile does not claim it). A link fault is never a fail.
+
+bench safety: unless the profile says [bench_safety] in_water = true, no $OMP motor byte above
+  max_motor_byte and no speed above max_speed_kn is ever sent, whatever a case or hypothesis asks.
+
+examples:
+  helmcheck emulate --port pty --time-scale 20 &        # prints port: /dev/pts/N
+  helmcheck certify vehicle --port /dev/pts/N --time-scale 20 --profile emu.toml
+  helmcheck certify vehicle --port /dev/ttyUSB0 --profile iver3.toml --hypothesis-profile patient
+  helmcheck certify vehicle --port socket://10.0.0.5:4001 --select 'RH-SRV-*' --select RH-ACK-2
+
+results: DIR/results.json (schema 1), DIR/wire.log, DIR/report.html, DIR/junit.xml, DIR/report.md.
+exit status: 0 pass (or non-strict without --strict), 1 fail, 2 inconclusive, 64 usage.
+"""
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--port", required=True, metavar="URL",
+                   help="what pyserial opens: /dev/ttyUSB0, /dev/pts/N, socket://HOST:PORT, rfc2217://…")
+    p.add_argument("--profile", metavar="FILE", help="TOML profile (the ICS; default: rh5)")
+    p.add_argument("--time-scale", type=float, metavar="K",
+                   help="the vehicle's clock runs K times faster than wall time (RH-TIM-2; default: the profile's)")
+    p.add_argument("--baud", type=int, metavar="N", help="line rate (default: the profile's baud)")
+    p.add_argument("--report-dir", default="reports/vehicle", metavar="DIR",
+                   help="where results.json, wire.log and the reports go (default: reports/vehicle)")
+    p.add_argument("--select", action="append", metavar="IDS",
+                   help="clause IDs or globs to certify (RH-SRV-*, RH-ACK-2); comma-separated or repeated")
+    p.add_argument("--examples", type=int, metavar="N", help="hypothesis examples (0: no exploration)")
+    p.add_argument("--seed", type=int, metavar="N", help="hypothesis seed (reproducible sequences)")
+    p.add_argument("--strict", action="store_true", help="a SHOULD not met fails the run")
+    p.add_argument("--wire-log", metavar="FILE", help="also copy the wire log to FILE")
+    p.add_argument("--hypothesis-profile", choices=("fast", "patient"), default=None,
+                   help="fast for emulators (default when K > 1), patient for hardware")
+    p.add_argument("--no-progress", action="store_true", help="no progress display")
+
+
+def _usage(msg: str) -> int:
+    print(f"helmcheck certify vehicle: {msg}", file=sys.stderr)
+    return exitcodes.USAGE
+
+
+def run(args: argparse.Namespace) -> int:
+    from ...profile import ProfileError, load_profile
+    from ..transport import BAUD_RATES, parse_port_spec
+    from .runner import Options, certify
+
+    try:
+        profile = load_profile(args.profile)
+    except ProfileError as e:
+        return _usage(str(e))
+    k = args.time_scale if args.time_scale is not None else profile.time_scale
+    if not math.isfinite(k) or k <= 0:
+        return _usage(f"--time-scale must be a positive number (got {k})")
+    if args.baud is not None:
+        if args.baud not in BAUD_RATES:
+            return _usage(f"--baud must be one of {', '.join(map(str, BAUD_RATES))}")
+        profile = profile.replace(baud=args.baud)
+    profile = profile.replace(time_scale=float(k))
+    try:
+        spec = parse_port_spec(args.port)
+    except ValueError as e:
+        return _usage(f"--port: {e}")
+    if spec.kind == "pty":
+        return _usage("--port pty creates a new pseudo-terminal; give the vehicle's port (e.g. /dev/pts/N)")
+    select = None
+    if args.select:
+        select = [x.strip() for item in args.select for x in item.split(",") if x.strip()]
+        from fnmatch import fnmatchcase
+        from ...clauses import vehicle_clauses
+        ids = [c.id for c in vehicle_clauses()]
+        bad = [p for p in select if not any(fnmatchcase(cid, p) for cid in ids)]
+        if bad:
+            return _usage(f"--select: {', '.join(bad)} match no vehicle clause (e.g. RH-SRV-*, RH-ACK-2)")
+    if args.examples is not None and args.examples < 0:
+        return _usage("--examples must be 0 or more")
+    hp = args.hypothesis_profile or ("fast" if k > 1 else "patient")
+    command = "helmcheck certify vehicle " + " ".join(sys.argv[3:] if len(sys.argv) > 3 else [])
+    opts = Options(port=args.port, profile=profile, time_scale=float(k), report_dir=Path(args.report_dir),
+                   select=select, examples=args.examples, seed=args.seed, strict=args.strict,
+                   wire_log=Path(args.wire_log) if args.wire_log else None, hypothesis_profile=hp,
+                   explore=args.examples != 0, progress=not args.no_progress, command=command.strip())
+    out = certify(opts)
+    print(f"{out.verdict.upper()}{' (partial)' if out.results.get('partial') else ''}: {out.reason} "
+          f"— report: {out.report_dir / 'report.html'}")
+    return out.exit_code

@@ -1,0 +1,237 @@
+"""Exploration: hypothesis sequences of valid and invalid commands, judged step by step.
+
+:class:`VehicleMachine` is a hypothesis ``RuleBasedStateMachine`` whose rules send a valid
+command, send an invalid line (one mutation of a valid one: out-of-range field, wrong field
+count, bad checksum, lower-case ID), let protocol time pass (vehicle seconds ÷ k, RH-TIM-2),
+poll ``$OSD,S`` and, when the profile declares it, raise a safety violation with ``$OXFLT``.
+Every reply and every ``$OSI`` is judged by the session against the mirrored model
+(:mod:`.session`, :mod:`.mirror`); a mismatch fails the example with its clause.
+
+Each example starts from a verified reset (with ``$OLOGL`` and ``$OMLOAD`` in ``S`` so that the
+mirror knows the log labels and the loaded mission), then optionally starts the test mission.
+
+Shrinking re-runs candidates against the live vehicle. The run keeps the smallest failing
+sequence it saw and saves that as a version-independent replay file (:mod:`.replay`), whatever
+hypothesis ends with — a flaky failure is reported INCONCLUSIVE with its rate rather than
+FAIL. Exploration has a wall-clock budget (``fast``: emulators, ``patient``: hardware); when it
+is spent, the remaining candidates do nothing, so hypothesis finishes quickly.
+
+Bench safety: the strategies keep speeds and the motor byte within ``[bench_safety]``, and the
+link's send function refuses anything above it anyway (:mod:`.safety`).
+"""
+
+from __future__ import annotations
+
+import time
+from typing import Optional
+
+from hypothesis import HealthCheck, Phase, settings, strategies as st
+from hypothesis.database import DirectoryBasedExampleDatabase
+from hypothesis.stateful import RuleBasedStateMachine, initialize, precondition, rule, run_state_machine_as_test
+
+from ...grammar import checksum_hex
+from .cases import _fill, _here, context
+from .judge import CaseFail, CaseInconclusive, CaseNotTested
+from .link import LinkLost
+from .replay import save_replay
+from .safety import BenchSafetyRefused
+from .session import frame
+
+__all__ = ["explore", "PROFILES", "valid_commands", "invalid_lines"]
+
+#: name -> (examples, steps per example, wall budget in seconds)
+PROFILES = {"fast": (25, 10, 45.0), "patient": (6, 8, 600.0)}
+
+_TIMEOUTS = st.sampled_from([2, 3, 5, 8, 12])
+
+
+def _num(lo: float, hi: float, places: int = 1):
+    return st.integers(int(lo * 10 ** places), int(hi * 10 ** places)).map(lambda n: f"{n / 10 ** places:g}")
+
+
+def valid_commands(nwp: int, speed: float, motor: int, oxflt: bool):
+    """Bodies (with ``{lat}``-style templates) of well-formed commands, bench-safe."""
+    spd = _num(0, speed)
+    hexb = st.integers(0x60, 0xA0).map(lambda b: f"{b:02X}")
+    mot = st.integers(0x80, max(0x80, motor)).map(lambda b: f"{b:02X}")
+    return st.one_of(
+        st.builds(lambda h, d, p, v, t: f"OMS,{h},{d},{p},{v},{t}", _num(0, 359), _num(0, 4), _num(0, 45, 0), spd,
+                  _TIMEOUTS),
+        st.builds(lambda a, b, m, t: f"OMP,{a}{a}{b}{b}{m},00,{t}", hexb, hexb, mot, _TIMEOUTS),
+        st.builds(lambda n: f"OJW,{n}", st.integers(0, nwp)),
+        st.builds(lambda m, v: f"OPK,{{lat}},{{lon}},{m},{v}", st.integers(1, 2), spd),
+        st.builds(lambda v, p: f"OMW,{{near_lat}},{{lon}},2,,15,{v},{p},", spd, st.sampled_from([0, 5])),
+        st.sampled_from(["OMW,Clr", "OMW,CLEAR", "OMW,stop", "OMSTOP,0", "OMSTART,0,0,0,0,{mission},",
+                         "OMLOAD,{mission},0", "OMSTART,0", "OLOGD,1,2", "ORWSET,Sle,R", "OLOGL,x,y",
+                         "OPOS,{lat},{lon},0.5,,", "ODVL,0.5,0,3", "OSD,G,C,S,P,,,,", "OSD,S,S", "OSD,S,Q"]),
+    )
+
+
+def invalid_lines():
+    """(kind, body) pairs: one mutation of a valid command each."""
+    return st.one_of(
+        st.tuples(st.just("frame"), st.sampled_from(["OMS,400,2,20,0,5", "OMS,90,2,20,0,0", "OMP,80808080,00,5",
+                                                      "OJW,-1", "OPK,{lat},{lon},0,0", "ODVL,9,0,3",
+                                                      "OMSTOP,2", "OMW,,1,2,3", "OSD,x", "OMS,90,2,20"])),
+        st.tuples(st.sampled_from(["badck", "lowerid", "nock"]),
+                  st.sampled_from(["OMSTOP,0", "OMS,90,2,20,0,5", "OJW,1", "OSD,S"])),
+    )
+
+
+def _raw(kind: str, body: str) -> bytes:
+    if kind == "frame":
+        return frame(body)
+    if kind == "badck":
+        ck = int(checksum_hex(body), 16) ^ 0x21
+        return b"$" + body.encode() + b"*" + f"{ck:02X}".encode() + b"\r\n"
+    if kind == "lowerid":
+        return frame(body.lower())
+    return b"$" + body.encode() + b"\r\n"
+
+
+class _State:
+    """Shared between the machine instances of one exploration."""
+
+    def __init__(self, run, budget: float):
+        self.run = run
+        self.end = time.monotonic() + budget
+        self.executions = 0
+        self.best: Optional[dict] = None  #: smallest failing trace so far
+        self.failures = 0
+        self.passes_after_fail = 0
+        self.lost: Optional[str] = None
+
+    @property
+    def spent(self) -> bool:
+        return time.monotonic() > self.end or self.lost is not None
+
+
+def _machine(state: _State, start_states, nwp, speed, motor, oxflt):
+    session = state.run.session
+
+    class VehicleMachine(RuleBasedStateMachine):
+        def __init__(self):
+            super().__init__()
+            self.active = not state.spent
+            self.ctx: dict = {}
+            self.steps = 0
+            state.executions += 1
+            if self.active:
+                session.trace = []
+
+        def _guard(self, fn):
+            if not self.active:
+                return
+            try:
+                fn()
+            except CaseFail as f:
+                self._failed(f)
+                raise AssertionError(f"{f.clause}: {f.reason}") from None
+            except (BenchSafetyRefused, CaseNotTested, CaseInconclusive):
+                return
+            except LinkLost as e:
+                state.lost = str(e)
+                self.active = False
+
+        def _failed(self, f: CaseFail) -> None:
+            state.failures += 1
+            trace = list(session.trace or [])
+            if state.best is None or len(trace) < len(state.best["steps"]):
+                state.best = {"clause": f.clause, "reason": f.reason, "steps": trace}
+
+        @initialize(start=st.sampled_from(start_states))
+        def start(self, start):
+            def go():
+                session.case, session.case_t0 = "explore", session.now()
+                session.reset(mission=False)
+                session.exchange(frame("OLOGL,a,b"))
+                session.exchange(frame(f"OMLOAD,{session.profile.mission},0"))
+                if start == "N":
+                    session.exchange(frame(f"OMSTART,0,0,0,0,{session.profile.mission},"))
+                self.ctx = context(session)
+            self._guard(go)
+
+        @rule(body=valid_commands(nwp, speed, motor, oxflt))
+        def send_valid(self, body):
+            self._guard(lambda: session.exchange(frame(_fill(body, self.ctx))))
+
+        @rule(line=invalid_lines())
+        def send_invalid(self, line):
+            kind, body = line
+            self._guard(lambda: session.exchange(_raw(kind, _fill(body, self.ctx))))
+
+        @rule(v=st.sampled_from([1.0, 2.0, 5.0, 12.0]))
+        def wait(self, v):
+            def go():
+                session.wait(v)
+                _here(session, self.ctx)
+            self._guard(go)
+
+        @rule()
+        def poll(self):
+            self._guard(lambda: (session.poll(), _here(session, self.ctx)))
+
+        @precondition(lambda self: oxflt)
+        @rule(code=st.sampled_from(["Sle", "Sop", "Sed"]))
+        def fault(self, code):
+            self._guard(lambda: session.exchange(frame(f"OXFLT,{code}")))
+
+        def teardown(self):
+            session.trace = None
+
+    return VehicleMachine
+
+
+def explore(run) -> None:
+    """Run the exploration for a :class:`~.runner.Run` and record what it found."""
+    o = run.o
+    p = run.p
+    examples, steps, budget = PROFILES.get(o.hypothesis_profile, PROFILES["fast"])
+    if o.examples is not None:
+        examples = o.examples
+    if examples <= 0:
+        return
+    state = _State(run, budget)
+    bench = p.bench_safety
+    speed = min(2.0, p.max_speed_kn, bench.max_speed_kn if not bench.in_water else 99.0)
+    motor = min(0x90, bench.max_motor_byte) if not bench.in_water else 0x90
+    factory = _machine(state, ["S", "N"], p.mission_waypoints, speed, motor, p.fault_injection == "oxflt")
+    if o.seed is not None:
+        factory._hypothesis_internal_use_seed = o.seed  # type: ignore[attr-defined]
+    db = DirectoryBasedExampleDatabase(str(run.dir / ".hypothesis"))
+    cfg = settings(max_examples=examples, stateful_step_count=steps, deadline=None, database=db,
+                   suppress_health_check=list(HealthCheck), report_multiple_bugs=False, print_blob=False,
+                   phases=(Phase.explicit, Phase.reuse, Phase.generate, Phase.shrink))
+    session = run.session
+    session.link.note(f"exploration: {examples} examples of up to {steps} steps, budget {budget:g} s")
+    t0 = time.monotonic()
+    outcome = "pass"
+    try:
+        run_state_machine_as_test(factory, settings=cfg)
+    except Exception as e:  # noqa: BLE001 - AssertionError, Flaky…, whatever ended it
+        outcome = type(e).__name__
+    finally:
+        session.trace = None
+    run.stats["explore"] = {"examples": examples, "executions": state.executions, "failures": state.failures,
+                            "wall_s": round(time.monotonic() - t0, 3), "outcome": outcome}
+    if state.lost:
+        raise LinkLost(state.lost)
+    best = state.best
+    if best is None:
+        run.book.add("RH-OUT-4", "pass", f"{state.executions} explored sequences agreed with the model",
+                     "explore")
+        return
+    cid = best["clause"]
+    flaky = "Flaky" in outcome
+    n = sum(1 for r in run.results["replays"] if r["clause"] == cid) + 1
+    rel = f"replays/{cid}-{n}.json"
+    save_replay(run.dir / rel, cid, best["reason"], best["steps"], run.k, p)
+    from ...reports import results as R
+    R.add_replay(run.results, cid, best["steps"], file=rel)
+    if flaky:
+        run.book.add(cid, "inconclusive", f"exploration: an intermittent failure ({state.failures} of "
+                     f"{state.executions} runs failed): {best['reason']}; replay {rel}", "explore")
+    else:
+        run.book.add(cid, "fail", f"exploration: {best['reason']} (shrunk to {len(best['steps'])} steps; "
+                     f"replay {rel})", "explore",
+                     [{"t": x.get("t", 0.0), "dir": ">", "line": x["send"]} for x in best["steps"] if "send" in x][-16:])

@@ -1,0 +1,160 @@
+#!/usr/bin/env python3
+"""Faulty backseats: the well-behaved one (``good_backseat.py``) with exactly one fault each.
+
+Usage: ``faulty_backseat.py PORT --fault NAME [--time-scale K] …``. Each fault is a real bug
+seen in, or easy to make in, client code (public-evidence §3), and breaks one §9 clause:
+
+==================  =========  ================================================================
+fault               clause     what it does
+==================  =========  ================================================================
+bad-checksum        RH-BS-1    every fifth state poll carries a wrong checksum
+unpadded-checksum   RH-BS-1    checksums written ``%X`` (no zero padding); an extra poll
+                               ``$OSD,,,S,,,,,`` every 3 s then ends ``*B``
+lowercase-hex       RH-BS-7    checksums in lower-case hex (``%02x``)
+bare-lf             RH-BS-7    lines end with LF alone
+short-omp           RH-BS-2    every 3 s an ``$OMP`` built with ``%x``: a byte below 0x10
+                               loses a digit (nine hex digits)
+rwset-after-start   RH-BS-3    reads a setting with ``$ORWSET`` once the mission runs
+oms-while-stopped   RH-BS-3    sends ``$OMS`` while the vehicle reports ``S``
+flood               RH-BS-4    once, 300 empty ``$OSD`` requests in one write (2700 bytes)
+lockout-ignore      RH-BS-5    keeps driving ``$OMS`` through a safety lockout
+fast-resend         RH-BS-5    resends a rejected command every 0.3 s
+late-refresh        RH-BS-6    refreshes ``$OMS`` only after 1.6 × its timeout
+no-poll             RH-BS-8    polls ``$OSD`` every 7 s
+==================  =========  ================================================================
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+
+from good_backseat import Backseat, checksum, main
+
+
+class BadChecksum(Backseat):
+    n = 0
+
+    def poll(self) -> None:
+        self.n += 1
+        if self.n % 5 == 0:
+            body = self.poll_body
+            self.ser.write(f"${body}*{checksum(body) ^ 0x01:02X}\r\n".encode())
+        else:
+            super().poll()
+
+
+class UnpaddedChecksum(Backseat):
+    last_extra = 0.0
+
+    def frame(self, body: str) -> bytes:
+        return f"${body}*{checksum(body):X}\r\n".encode("ascii")
+
+    def step(self, now: float) -> None:
+        if now - self.last_extra >= 3.0:
+            self.last_extra = now
+            self.send("OSD,,,S,,,,,")  # checksum 0x0B: written "*B"
+        super().step(now)
+
+
+class LowercaseHex(Backseat):
+    def frame(self, body: str) -> bytes:
+        return f"${body}*{checksum(body):02x}\r\n".encode("ascii")
+
+
+class BareLf(Backseat):
+    def frame(self, body: str) -> bytes:
+        return f"${body}*{checksum(body):02X}\n".encode("ascii")
+
+
+class ShortOmp(Backseat):
+    last_omp = 0.0
+
+    def step(self, now: float) -> None:
+        super().step(now)
+        if now - self.last_omp >= 3.0 and not self.in_lockout:
+            self.last_omp = now
+            fins = (0x80, 0x80, 0x08, 0x80, 0x80)
+            self.send("OMP,%x%x%x%x%x,00,5" % fins)  # 0x08 -> "8": nine digits
+
+
+class RwsetAfterStart(Backseat):
+    asked_at: float | None = None
+
+    def when_running(self, now: float) -> None:
+        super().when_running(now)
+        if self.asked_at is None:
+            self.asked_at = now
+        elif self.asked_at > 0 and now - self.asked_at > 1.0:
+            self.asked_at = -1.0
+            self.send("ORWSET,SafetyAction,R")
+
+
+class OmsWhileStopped(Backseat):
+    s_since: float | None = None
+
+    def when_running(self, now: float) -> None:
+        self.s_since = None
+        super().when_running(now)
+
+    def when_stopped(self, now: float) -> None:
+        if self.s_since is None:
+            self.s_since = now
+        if not self.setup_done or now - self.s_since >= 3.0:
+            super().when_stopped(now)  # starts the mission, but late
+        elif now - self.s_since >= 1.0 and now - self.last_oms >= 1.5:
+            self.send_oms(now)  # drives although the vehicle reports S
+
+
+class Flood(Backseat):
+    flooded = False
+
+    def when_running(self, now: float) -> None:
+        super().when_running(now)
+        if not self.flooded and now - self.t0 > 2.0:
+            self.flooded = True
+            self.ser.write(self.frame("OSD") * 300)
+
+
+class LockoutIgnore(Backseat):
+    def lockout_seen(self, now: float) -> None:
+        pass  # carries on as if nothing happened
+
+
+class FastResend(Backseat):
+    def rejected(self, type_: int, now: float) -> None:
+        if type_ == 9:  # resend the refused $OMS at once, a few times
+            body = f"OMS,{self.heading:.1f},2.0,20.0,1.0,{self.servo_timeout}"
+            for _ in range(3):
+                time.sleep(0.3)
+                self.send(body)
+        super().rejected(type_, now)
+
+
+class LateRefresh(Backseat):
+    def __init__(self, *a, **kw):
+        super().__init__(*a, **kw)
+        self.refresh_every = 1.6 * self.servo_timeout / self.k
+
+
+class NoPoll(Backseat):
+    poll_every = 7.0
+
+
+FAULTS = {
+    "bad-checksum": BadChecksum, "unpadded-checksum": UnpaddedChecksum, "lowercase-hex": LowercaseHex,
+    "bare-lf": BareLf, "short-omp": ShortOmp, "rwset-after-start": RwsetAfterStart,
+    "oms-while-stopped": OmsWhileStopped, "flood": Flood, "lockout-ignore": LockoutIgnore,
+    "fast-resend": FastResend, "late-refresh": LateRefresh, "no-poll": NoPoll,
+}
+
+if __name__ == "__main__":
+    argv = sys.argv[1:]
+    fault = None
+    if "--fault" in argv:
+        i = argv.index("--fault")
+        fault = argv[i + 1]
+        del argv[i:i + 2]
+    if fault not in FAULTS:
+        sys.exit(f"--fault must be one of {', '.join(FAULTS)}")
+    sys.exit(main(FAULTS[fault], argv))

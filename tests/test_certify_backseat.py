@@ -1,0 +1,197 @@
+"""``certify backseat`` end to end over real ptys: example backseats in ``tests/backseats/``.
+
+Every certification runs the real command (:func:`helmcheck.conformance.backseat.cli.run`, in
+a thread of this process so the grammar is built once) on its own pty, with the backseat a real
+subprocess (pyserial) that opens the printed port. All of them run at once, at time scale 5, for
+20 s of judged run each (every scenario), so the module takes about 25 s of wall time. One more
+test runs ``helmcheck certify backseat`` as a subprocess to check the ``port:`` line and Ctrl-C.
+
+The judge's slack (0.5 s reaction, 0.2 s jitter) and the example backseats' margins (polls
+every second against a 5 s limit, servo refresh at a third of its timeout) keep the verdicts
+stable on a loaded machine.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import signal
+import subprocess
+import sys
+import threading
+import time
+from concurrent.futures import ThreadPoolExecutor
+from pathlib import Path
+
+import pytest
+
+from helmcheck.conformance.backseat import cli
+from helmcheck.reports.results import load_results
+
+HERE = Path(__file__).resolve().parent / "backseats"
+GOOD = HERE / "good_backseat.py"
+FAULTY = HERE / "faulty_backseat.py"
+K = 5.0
+DURATION = 20.0
+
+#: fault -> (clause, verdict); see tests/backseats/faulty_backseat.py
+FAULTS = {
+    "bad-checksum": ("RH-BS-1", "fail"),
+    "unpadded-checksum": ("RH-BS-1", "fail"),
+    "lowercase-hex": ("RH-BS-7", "non-strict"),
+    "bare-lf": ("RH-BS-7", "non-strict"),
+    "short-omp": ("RH-BS-2", "fail"),
+    "rwset-after-start": ("RH-BS-3", "fail"),
+    "oms-while-stopped": ("RH-BS-3", "fail"),
+    "flood": ("RH-BS-4", "fail"),
+    "lockout-ignore": ("RH-BS-5", "non-strict"),
+    "fast-resend": ("RH-BS-5", "non-strict"),
+    "late-refresh": ("RH-BS-6", "non-strict"),
+    "no-poll": ("RH-BS-8", "non-strict"),
+}
+
+
+def parse(argv: list[str]) -> argparse.Namespace:
+    p = argparse.ArgumentParser()
+    cli.add_arguments(p)
+    return p.parse_args(argv)
+
+
+def certify(report_dir: Path, backseat: list[str] | None, *, extra: tuple[str, ...] = (),
+            connect_timeout: float = 20.0) -> dict:
+    """One certification on a new pty; ``backseat`` is the script's argv after the port."""
+    procs: list[subprocess.Popen] = []
+    errs = report_dir.parent / f"{report_dir.name}.backseat.err"
+
+    def on_port(name: str) -> None:
+        if backseat is not None:
+            procs.append(subprocess.Popen([sys.executable, str(backseat[0]), name, *backseat[1:]],
+                                          stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
+                                          stderr=open(errs, "wb")))
+
+    args = parse(["--duration", str(DURATION), "--time-scale", str(K), "--report-dir", str(report_dir),
+                  "--connect-timeout", str(connect_timeout), *extra])
+    try:
+        rc = cli.run(args, on_port=on_port)
+    finally:
+        for p in procs:
+            try:
+                p.wait(timeout=5)
+            except subprocess.TimeoutExpired:
+                p.kill()
+                p.wait()
+    return {"rc": rc, "results": load_results(report_dir), "dir": report_dir,
+            "backseat_rc": procs[0].returncode if procs else None,
+            "backseat_err": errs.read_text(errors="replace") if errs.exists() else ""}
+
+
+@pytest.fixture(scope="module")
+def runs(tmp_path_factory):
+    """Every certification of this module, run at once."""
+    root = tmp_path_factory.mktemp("certify-backseat")
+    jobs = {"good": [GOOD, "--time-scale", str(K)],
+            "crash": [GOOD, "--time-scale", str(K), "--crash-after", "6"]}
+    for fault in FAULTS:
+        jobs[fault] = [FAULTY, "--fault", fault, "--time-scale", str(K)]
+    with ThreadPoolExecutor(max_workers=len(jobs) + 1) as pool:
+        futures = {name: pool.submit(certify, root / name, argv) for name, argv in jobs.items()}
+        futures["never"] = pool.submit(certify, root / "never", None, connect_timeout=1.5)
+        return {name: f.result() for name, f in futures.items()}
+
+
+def clauses(run: dict) -> dict[str, dict]:
+    return {c["id"]: c for c in run["results"]["clauses"]}
+
+
+def test_well_behaved_backseat_passes_every_scenario(runs):
+    run = runs["good"]
+    r = run["results"]
+    bad = {cid: (c["verdict"], c["reason"], c["evidence"]) for cid, c in clauses(run).items()
+           if c["verdict"] != "pass"}
+    assert not bad, (bad, run["backseat_err"])
+    assert r["verdict"] == "pass" and run["rc"] == 0 and not r["partial"]
+    assert r["role"] == "backseat"
+    assert r["scenarios"] == ["nominal", "reject", "lockout", "mission-end", "silence"]
+    kinds = {e["kind"] for e in r["events"]}
+    assert {"lockout", "ack-error", "note"} <= kinds  # the lockout and a staged rejection happened
+    assert {"A", "S"} <= set(r["coverage"]["modes"])
+    for name in ("report.html", "report.md", "junit.xml", "wire.log"):
+        assert (run["dir"] / name).stat().st_size > 0
+
+
+@pytest.mark.parametrize("fault", sorted(FAULTS))
+def test_faulty_backseat_is_caught_on_its_clause(runs, fault):
+    run = runs[fault]
+    clause, verdict = FAULTS[fault]
+    cs = clauses(run)
+    c = cs[clause]
+    assert c["verdict"] == verdict, (c, run["backseat_err"])
+    assert c["offending_count"] >= 1 and c["evidence"], c
+    assert all(e["dir"] in (">", ">~") for e in c["evidence"])
+    others = {cid: (x["verdict"], x["reason"]) for cid, x in cs.items()
+              if cid != clause and x["verdict"] not in ("pass", "not-tested")}
+    assert not others, others
+    r = run["results"]
+    assert r["verdict"] == verdict
+    assert run["rc"] == (1 if verdict == "fail" else 0)
+
+
+def test_backseat_that_crashes_mid_run_is_inconclusive(runs):
+    run = runs["crash"]
+    r = run["results"]
+    assert run["backseat_rc"] == 3
+    assert r["verdict"] == "inconclusive" and r["partial"] and run["rc"] == 2
+    assert "closed the port or crashed" in r["verdict_reason"]
+    assert r["run"]["status"] == "disconnected" and 4 < r["run"]["ended_at"] < 15
+    assert (run["dir"] / "report.html").exists()
+
+
+def test_backseat_that_never_connects_is_inconclusive(runs):
+    run = runs["never"]
+    r = run["results"]
+    assert r["verdict"] == "inconclusive" and run["rc"] == 2
+    assert "never connected" in r["verdict_reason"]
+    assert all(c["verdict"] == "not-tested" for c in r["clauses"])
+    assert (run["dir"] / "report.md").exists() and (run["dir"] / "wire.log").exists()
+
+
+def test_command_prints_port_first_and_writes_a_partial_report_on_ctrl_c(tmp_path):
+    """The real command line: first stdout line ``port: …``; SIGINT mid-run → partial report."""
+    out_dir = tmp_path / "report"
+    wire = tmp_path / "copy.log"
+    proc = subprocess.Popen([sys.executable, "-m", "helmcheck", "certify", "backseat", "--time-scale", str(K),
+                             "--duration", "60", "--report-dir", str(out_dir), "--wire-log", str(wire),
+                             "--connect-timeout", "120"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, stdin=subprocess.DEVNULL)
+    backseat = None
+    try:
+        first = proc.stdout.readline().decode()
+        assert first.startswith("port: /dev/pts/"), first
+        backseat = subprocess.Popen([sys.executable, str(GOOD), first.split(": ", 1)[1].strip(),
+                                     "--time-scale", str(K)], stdin=subprocess.DEVNULL,
+                                    stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        deadline = time.monotonic() + 120
+        log = out_dir / "wire.log"
+        while time.monotonic() < deadline:  # wait until the judged run is under way
+            if log.exists() and "scenario nominal starts" in log.read_text(errors="replace"):
+                break
+            time.sleep(0.2)
+        time.sleep(2.0)
+        proc.send_signal(signal.SIGINT)
+        out, err = proc.communicate(timeout=60)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+        if backseat is not None:
+            try:
+                backseat.wait(timeout=5)
+            except subprocess.TimeoutExpired:
+                backseat.kill()
+    assert proc.returncode == 2, err.decode()
+    r = load_results(out_dir)
+    assert r["partial"] and r["verdict"] == "inconclusive"
+    assert "interrupted" in r["verdict_reason"]
+    assert out.decode().strip().startswith("INCONCLUSIVE (PARTIAL)")
+    assert wire.read_text().startswith("# helmcheck wire-log 1")
+    assert "Traceback" not in err.decode()
