@@ -24,7 +24,7 @@ import hashlib
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Callable, Optional
+from typing import Callable, Optional
 
 from ...grammar import Discard, Framer, Line, decode
 from ...grammar import sentences as s

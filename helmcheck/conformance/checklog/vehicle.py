@@ -50,7 +50,7 @@ from typing import Any, Callable, Optional
 from ...grammar import sentences as s
 from ...grammar.errors import SentenceError
 from ...model import events as mev
-from ...model.missions import InMemoryCatalog, Mission, MissionCatalog, Waypoint, mission_name_problem
+from ...model.missions import Mission, MissionCatalog, Waypoint
 from ...model.observe import Acceptable, Expectation, expectation
 from ...model.plant import (AtSurface, OnStation, PlantEvent, QueueWaypointReached, SafetyViolation,
                             Submerged, WaypointReached)
@@ -92,7 +92,6 @@ _CONTROL_OF_EVENT = {mev.ServoTimeout: "RH-SRV-4", mev.PrimitiveTimeout: "RH-PRM
                      mev.ManualParkExpired: "RH-PK-3", mev.QueueDone: "RH-OMW-4",
                      mev.QueueParkExpired: "RH-OMW-4", mev.LockoutEnded: "RH-SAF-3",
                      mev.MissionParkExpired: "RH-OUT-4", mev.MissionEnded: "RH-MSN-4"}
-_EVENT_NAME = {"OMS": s.OMS, "OMP": s.OMP}
 _CLASS_EVENT = {
     s.OMS: "OMS", s.OMP: "OMP", s.OJW: "OJW", s.OPK: "OPK", s.OMW: "OMW", s.OMSTOP: "OMSTOP",
     s.OMLOAD: "OMLOAD", s.OMSTART: "OMSTART", s.OMSTARTPaper: "OMSTART", s.OPOS: "OPOS",

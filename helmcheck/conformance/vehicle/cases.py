@@ -621,7 +621,7 @@ def run_step(session: Session, st, ctx: dict, clause: str) -> None:
         _check_expect(ex, st.expect, st.clause or clause)
     elif isinstance(st, Raw):
         raw = raw_line(st.kind, _fill(st.body, ctx), session.profile)
-        session.exchange(raw, st.clause or clause)
+        session.exchange(raw, st.clause or clause, variant=True)
     elif isinstance(st, Poll):
         _poll_checks(session, st, ctx, clause)
         _here(session, ctx)

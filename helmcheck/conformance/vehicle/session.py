@@ -183,8 +183,13 @@ class Session:
             return d.error
         return None
 
-    def exchange(self, raw: bytes, clause: Optional[str] = None, *, judge: bool = True) -> Exchange:
-        """Send ``raw`` and judge the replies (module docstring). ``clause``: whom a wrong answer fails."""
+    def exchange(self, raw: bytes, clause: Optional[str] = None, *, judge: bool = True,
+                 variant: bool = False) -> Exchange:
+        """Send ``raw`` and judge the replies (module docstring). ``clause``: whom a wrong answer fails.
+
+        ``variant``: ``raw`` is a mutated form (lower-case hex, noise, bare LF…) of a command; a
+        missing ACK then fails ``clause`` (the form was not read), not RH-ACK-1.
+        """
         item = self.item_of(raw)
         self._unsolicited(self.link.drain())
         mode_before = self.mirror.mode
@@ -201,7 +206,7 @@ class Session:
         if ack_type is None:
             self._silent(ex, clause, item)
             return ex
-        self._collect(ex, ack_type, clause)
+        self._collect(ex, ack_type, clause if variant else None)
         latency = ex.t_ack - t_sent  # type: ignore[operator]
         observed = ex.data + [ex.ack]
         ex.expected = self.mirror.receive(item, ex.t_ack, latency, observed)  # type: ignore[arg-type]
@@ -261,7 +266,7 @@ class Session:
                 what = "RH-SAF-5" if isinstance(item, s.OXFLT) else (clause or "RH-FRM-4")
                 raise self.fail(what, f"sent {escape(ex.raw.rstrip(bytes([13, 10])))}: no $ACK is due "
                                       f"(it must be discarded silently), got {_ack_text(sent)}")
-        self.forced_wait += 0.0
+        self.forced_wait += max(0.0, self.now() - ex.t_sent)
         if isinstance(item, s.OXFLT):
             self.mirror.receive(item, ex.t_sent, 0.0)
             if self.rec is not None:
@@ -303,8 +308,9 @@ class Session:
             if not self._alive():
                 raise LinkSilent(f"the vehicle answered nothing at all for {hard - ex.t_sent:.1f} s "
                                  f"(device off, wrong port or baud?)")
-            raise self.fail("RH-ACK-1", f"sent {escape(ex.raw.rstrip(bytes([13, 10])))}: no $ACK,{ack_type} "
-                                        f"within {hard - ex.t_sent:.1f} s, though the vehicle still answers")
+            raise self.fail(clause or "RH-ACK-1", f"sent {escape(ex.raw.rstrip(bytes([13, 10])))}: no "
+                                                  f"$ACK,{ack_type} within {hard - ex.t_sent:.1f} s, though the "
+                                                  f"vehicle still answers")
         allowed = window + tx + self.link.transmit_time(got_bytes) + ACK_GRACE_S
         latency = ex.t_ack - ex.t_sent
         if latency > allowed:
@@ -403,13 +409,17 @@ class Session:
         end = self.now() + vehicle_s / self.k
         self._trace({"wait": round(vehicle_s, 3)})
         t0 = self.now()
-        while self.now() < end:
-            nxt = min(end, self.now() + self.poll_gap)
-            self.link.sleep(max(0.0, nxt - self.now()))
-            if probe is not None:
-                self.exchange(probe, clause)
-            self.poll(clause)
-        self.forced_wait += self.now() - t0
+        trace, self.trace = self.trace, None  # a replay's wait step polls by itself
+        try:
+            while self.now() < end:
+                nxt = min(end, self.now() + self.poll_gap)
+                self.link.sleep(max(0.0, nxt - self.now()))
+                if probe is not None:
+                    self.exchange(probe, clause)
+                self.poll(clause)
+        finally:
+            self.trace = trace
+            self.forced_wait += self.now() - t0
 
     def settle(self, clause: str, timer: Optional[str] = None, probe: Optional[bytes] = None,
                after_v: float = 0.0) -> None:
