@@ -39,7 +39,8 @@ def build_results(outcome: Optional[Outcome], *, profile: Profile, settings: dic
             add_clause(results, cid, "not-tested", f"not judged: {why}", level=levels[cid])
     else:
         for r in outcome.judge.results(levels):
-            add_clause(results, r.id, r.verdict, r.reason, cases=r.cases, evidence=r.evidence,
+            cases = r.cases if r.offending_count else ([] if r.verdict == "not-tested" else outcome.scenarios_run)
+            add_clause(results, r.id, r.verdict, r.reason, cases=cases, evidence=r.evidence,
                        offending_count=r.offending_count, level=r.level)
         for t, kind, label in outcome.events:
             add_event(results, round(t, 6), kind, label)

@@ -1,0 +1,33 @@
+"""``helmcheck docs``: regenerate (or, with ``--check``, verify) every generated document.
+
+The grammar reference comes from ``remote_helm.lark``; the model's transition table and state
+diagram come from ``helmcheck/model/transitions.py``. Nothing in ``docs/`` is written by hand
+except ``contracts.md``.
+"""
+
+from __future__ import annotations
+
+import argparse
+
+from .. import exitcodes
+
+
+def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
+    p = sub.add_parser("docs", help="regenerate the generated documentation",
+                       description=__doc__.split("\n\n")[0].split(": ", 1)[1])
+    p.add_argument("--check", action="store_true", help="exit 1 if a checked-in copy is stale")
+    p.set_defaults(func=run)
+    return p
+
+
+def run(args: argparse.Namespace) -> int:
+    from ..grammar import docs as grammar_docs
+    from ..model import docs as model_docs
+
+    if args.check:
+        stale = (["docs/grammar.md"] if grammar_docs.stale() else []) + list(model_docs.stale())
+        for name in stale:
+            print(f"stale: {name} (run 'helmcheck docs')")
+        return exitcodes.NONCONFORMANT if stale else exitcodes.OK
+    print(f"wrote {grammar_docs.write()}")
+    return model_docs.main([])
