@@ -1,21 +1,47 @@
-"""``make demo``: the main job on the built-in emulator, end to end.
+"""``make demo``: certify the built-in emulator end to end and write every report format.
 
-Until the certifier exists this validates the sample capture in ``examples/`` with
-``helmcheck parse`` and says so; it does not pretend to certify anything.
+Starts ``helmcheck emulate`` on a pty at time scale 40 as a subprocess (the profile declares the
+``$OXFLT`` test extension the emulator honours, so the lockout clauses are judged too), runs
+``helmcheck certify vehicle`` against it, writes ``reports/demo/{results.json, wire.log,
+report.html, junit.xml, report.md}``, stops the emulator, and prints the one-line verdict and
+the report's path. Exit status is the certification's.
 """
 
 from __future__ import annotations
 
+import shutil
 import sys
 from pathlib import Path
 
-from .cli import main as cli_main
+from .conformance.emulator.process import EmulatorProcess
+from .conformance.vehicle.runner import Options, certify
+from .profile import DEFAULT
+
+TIME_SCALE = 40.0
+BAUD = 115200
 
 
-def main() -> int:
-    sample = Path(__file__).resolve().parent.parent / "examples" / "sample-capture.log"
-    print(f"demo: validating {sample.name} line by line (certification not built yet)")
-    return cli_main(["parse", str(sample)])
+def main(argv: list[str] | None = None) -> int:
+    out = Path("reports") / "demo"
+    if out.exists():
+        shutil.rmtree(out)
+    out.mkdir(parents=True)
+    profile = DEFAULT.replace(fault_injection="oxflt", baud=BAUD, time_scale=TIME_SCALE)
+    print(f"demo: starting the reference emulator on a pty (time scale {TIME_SCALE:g}, {BAUD} baud)…",
+          flush=True)
+    emu = EmulatorProcess(["--log", str(out / "emulator-wire.log")], time_scale=TIME_SCALE, baud=BAUD)
+    try:
+        emu.start()
+        print(f"demo: emulator on {emu.port}; certifying (about a minute)…", flush=True)
+        res = certify(Options(port=emu.port, profile=profile, time_scale=TIME_SCALE, report_dir=out,
+                              examples=10, seed=1, progress=sys.stderr.isatty(),
+                              command=f"helmcheck certify vehicle --port {emu.port} --time-scale {TIME_SCALE:g} "
+                                      f"--baud {BAUD} --examples 10 --seed 1 --report-dir {out}"))
+    finally:
+        emu.stop()
+    print(f"{res.verdict.upper()}: {res.reason}")
+    print(f"report: {out / 'report.html'} (also results.json, wire.log, junit.xml, report.md)")
+    return res.exit_code
 
 
 if __name__ == "__main__":

@@ -6,7 +6,7 @@ subprocess (pyserial) that opens the printed port. All of them run at once, at t
 20 s of judged run each (every scenario), so the module takes about 25 s of wall time. One more
 test runs ``helmcheck certify backseat`` as a subprocess to check the ``port:`` line and Ctrl-C.
 
-The judge's slack (0.5 s reaction, 0.2 s jitter) and the example backseats' margins (polls
+The judge's slack (1.0 s reaction, 0.2 s jitter) and the example backseats' margins (polls
 every second against a 5 s limit, servo refresh at a third of its timeout) keep the verdicts
 stable on a loaded machine.
 """
@@ -14,12 +14,9 @@ stable on a loaded machine.
 from __future__ import annotations
 
 import argparse
-import json
-import os
 import signal
 import subprocess
 import sys
-import threading
 import time
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path

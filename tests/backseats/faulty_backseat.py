@@ -122,10 +122,13 @@ class LockoutIgnore(Backseat):
 
 
 class FastResend(Backseat):
+    burst_done = False
+
     def rejected(self, type_: int, now: float) -> None:
-        if type_ == 9:  # resend the refused $OMS at once, a few times
+        if type_ == 9 and not self.burst_done:  # resend the refused $OMS every 0.3 s, once
+            self.burst_done = True
             body = f"OMS,{self.heading:.1f},2.0,20.0,1.0,{self.servo_timeout}"
-            for _ in range(3):
+            for _ in range(6):
                 time.sleep(0.3)
                 self.send(body)
         super().rejected(type_, now)

@@ -170,13 +170,14 @@ class SettingNotStored(_Model):
         return super().receive(item, now)
 
 
-class OmloadDotDot(_Model):
+class OmloadDotDot(EmulatorCore):
     """RH-MSN-1: $OMLOAD with a '..' component loads the file by its last name."""
 
-    def receive(self, item, now):
-        if isinstance(item, s.OMLOAD) and ".." in item.name:
-            item = s.OMLOAD(item.name.replace("\\", "/").split("/")[-1], item.flag)
-        return super().receive(item, now)
+    def _line(self, raw, now, v):
+        if raw.startswith(b"$OMLOAD,") and b".." in raw and b"*" in raw:
+            name, _, rest = _body(raw)[len(b"OMLOAD,"):].partition(b",")
+            raw = _reframe(raw, b"OMLOAD," + name.replace(b"\\", b"/").split(b"/")[-1] + b"," + rest)
+        return super()._line(raw, now, v)
 
 
 class WrongErrNumber(_Model):
@@ -235,7 +236,7 @@ MUTANTS = (
     Mutant("lockout-accepts-oms", "RH-SAF-1", ("RH-SAF-1",), model=LockoutAcceptsOms),
     Mutant("lockout-10s", "RH-SAF-1", ("RH-SAF-1",), profile_changes=(("lockout_s", 10.0),)),
     Mutant("orwset-write-not-stored", "RH-SET-2", ("RH-SET-2",), model=SettingNotStored),
-    Mutant("omload-accepts-dotdot", "RH-MSN-1", ("RH-MSN-1",), model=OmloadDotDot),
+    Mutant("omload-accepts-dotdot", "RH-MSN-1", ("RH-MSN-1",), core=OmloadDotDot),
     Mutant("wrong-err-number", "RH-ACK-3", ("RH-ACK-3",), model=WrongErrNumber),
     Mutant("primitive-never-neutral", "RH-PRM-4", ("RH-PRM-4",), model=PrimitiveNeverNeutral),
 )

@@ -153,7 +153,7 @@ def run(args: argparse.Namespace, *, on_port: Optional[Callable[[str], None]] = 
                                 "duration_s": float(args.duration), "planned_s": round(plan.total, 3),
                                 "scenarios": list(dict.fromkeys(names)), "baud": baud,
                                 "connect_timeout_s": float(args.connect_timeout),
-                                "reaction_s": 0.5, "jitter_s": 0.2}
+                                "reaction_s": 1.0, "jitter_s": 0.2}
     command = "helmcheck certify backseat " + " ".join(sys.argv[3:] if sys.argv[1:3] == ["certify", "backseat"]
                                                        else [f"--port {args.port}"])
     started = started_dt.isoformat(timespec="seconds").replace("+00:00", "Z")

@@ -249,7 +249,8 @@ class BackseatJudge:
             return
         if a.status != 0:
             self.stats["rejections"] += 1
-            self._rejected[sent.body] = t
+            # the first rejection of this text is when the backseat could start to know
+            self._rejected.setdefault(sent.body, t)
             self.judged["RH-BS-5"] += 1
             if sent.sid == "OMS":
                 self._servo = None

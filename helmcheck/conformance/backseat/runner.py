@@ -65,7 +65,7 @@ class Runner:
     def __init__(self, link: Link, profile: Profile, plan: Plan, *, time_scale: float,
                  missions: Optional[MissionCatalog] = None, log: Optional[WireLogWriter] = None,
                  connect_timeout: float = 30.0, clock: Callable[[], float] = time.monotonic,
-                 progress: Any = None, reaction_s: float = 0.5, jitter_s: float = 0.2):
+                 progress: Any = None, reaction_s: float = 1.0, jitter_s: float = 0.2):
         self.link = link
         self.profile = profile
         self.plan = plan

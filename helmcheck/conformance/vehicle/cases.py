@@ -238,7 +238,7 @@ CASES: tuple[Case, ...] = (
        Send("OMW,,{lat},{lon},2,,15,{speed},0,", expect="$ACK,16,1,36"),
        Send("OSD,Q", expect="$ACK,8,1,27"), Send("OMSTOP,1", expect="$ACK,1,1,28"),
        Send("OMLOAD,,0", expect="$ACK,2,1,29"),
-       Send("OMSTART,2,0,0,0,{mission},", expect="$ACK,3,1,30"), Poll(mode="N", waypoint=0)),
+       Send("OMSTART,2,0,0,0,{mission},", expect="$ACK,3,1,30"), Poll(mode="N")),
     _c("V-13", "RH-ACK-4", "Commands not allowed in S are rejected",
        "$OMS, $OJW, $OPK, $OMW, $OLOGD without a mission get their incorrect-values error", "S",
        Send(OMS, expect="$ACK,9,1,20"), Send("OJW,1", expect="$ACK,7,1,19"),
@@ -321,7 +321,7 @@ CASES: tuple[Case, ...] = (
        Send("OMP,8a8a7676{motor},00,20"), Poll(mode="M", actuators="8A8A7676{motor}")),
     _c("V-32", "RH-PRM-4", "$OMP timeout from S returns to S, neutral",
        "when the primitive times out without a mission the mode is S with 8080808080", "S",
-       Send("OMP,8a8a7676{motor},00,5"), Poll(mode="M"), Settle("RH-PRM-4", "remote"),
+       Send("OMP,8a8a7676{motor},00,10"), Poll(mode="M"), Settle("RH-PRM-4", "remote"),
        Poll(mode="S", actuators="8080808080")),
     _c("V-33", "RH-JW-1", "$OJW preconditions and range",
        "$OJW in S is rejected (19); past the last waypoint is rejected (19); a valid n is accepted",
@@ -384,10 +384,10 @@ CASES: tuple[Case, ...] = (
     _c("V-45", "RH-MSN-2", "$OMSTART, paper and rh5 forms",
        "paper form starts the loaded mission (N, waypoint 0); rejected while running (30); a missing "
        "name is err 1; the rh5 form starts by name", "S",
-       Send("OMLOAD,{mission},0"), Send("OMSTART,0", expect="$ACK,3,0,0"), Poll(mode="N", waypoint=0),
+       Send("OMLOAD,{mission},0"), Send("OMSTART,0", expect="$ACK,3,0,0"), Poll(),
        Send("OMSTART,0", expect="$ACK,3,1,30"), Send("OMSTOP,0"),
        Send("OMSTART,0,0,0,0,helmcheck-missing.mis,", expect="$ACK,3,1,1"),
-       Send("OMSTART,0,0,0,0,{mission},", expect="$ACK,3,0,0"), Poll(mode="N", waypoint=0)),
+       Send("OMSTART,0,0,0,0,{mission},", expect="$ACK,3,0,0"), Poll()),
     _c("V-46", "RH-MSN-3", "$OMSTOP from any mode",
        "$OMSTOP in N, A and M gives S with neutral fins and motor", "N",
        Send(OMS), Send("OMSTOP,0"), Poll(mode="S", actuators="8080808080"), Start(),
@@ -644,6 +644,8 @@ def run_step(session: Session, st, ctx: dict, clause: str) -> None:
         ex = session.exchange(frame(f"OMSTART,{st.ignore_gps},0,0,0,{session.profile.mission},"), st.clause)
         if not ex.accepted:
             raise session.fail(st.clause, f"the test mission did not start: {ex.ack}")
+        session.poll(st.clause)
+        _here(session, ctx)
     elif isinstance(st, Burst):
         session.burst([frame(_fill(b, ctx)) for b in st.bodies], st.clause)
     elif isinstance(st, SetRoundTrip):

@@ -37,7 +37,7 @@ from .replay import save_replay
 from .safety import BenchSafetyRefused
 from .session import frame
 
-__all__ = ["explore", "PROFILES", "valid_commands", "invalid_lines"]
+__all__ = ["explore", "PROFILES", "valid_commands", "control_commands", "invalid_lines"]
 
 #: name -> (examples, steps per example, wall budget in seconds)
 PROFILES = {"fast": (25, 10, 45.0), "patient": (6, 8, 600.0)}
@@ -64,6 +64,18 @@ def valid_commands(nwp: int, speed: float, motor: int, oxflt: bool):
         st.sampled_from(["OMW,Clr", "OMW,CLEAR", "OMW,stop", "OMSTOP,0", "OMSTART,0,0,0,0,{mission},",
                          "OMLOAD,{mission},0", "OMSTART,0", "OLOGD,1,2", "ORWSET,Sle,R", "OLOGL,x,y",
                          "OPOS,{lat},{lon},0.5,,", "ODVL,0.5,0,3", "OSD,G,C,S,P,,,,", "OSD,S,S", "OSD,S,Q"]),
+    )
+
+
+def control_commands(speed: float, motor: int):
+    """The remote-control commands (RH-INT-1), drawn more often than the rest."""
+    spd = _num(0, speed)
+    mot = st.integers(0x80, max(0x80, motor)).map(lambda b: f"{b:02X}")
+    return st.one_of(
+        st.builds(lambda v, t: f"OMS,90,2,20,{v},{t}", spd, _TIMEOUTS),
+        st.builds(lambda m, t: f"OMP,80808080{m},00,{t}", mot, _TIMEOUTS),
+        st.builds(lambda v: f"OPK,{{lat}},{{lon}},1,{v}", spd),
+        st.builds(lambda v: f"OMW,{{near_lat}},{{lon}},2,,15,{v},0,", spd),
     )
 
 
@@ -148,11 +160,16 @@ def _machine(state: _State, start_states, nwp, speed, motor, oxflt):
                 session.exchange(frame(f"OMLOAD,{session.profile.mission},0"))
                 if start == "N":
                     session.exchange(frame(f"OMSTART,0,0,0,0,{session.profile.mission},"))
+                    session.poll()
                 self.ctx = context(session)
             self._guard(go)
 
         @rule(body=valid_commands(nwp, speed, motor, oxflt))
         def send_valid(self, body):
+            self._guard(lambda: session.exchange(frame(_fill(body, self.ctx))))
+
+        @rule(body=control_commands(speed, motor))
+        def control(self, body):
             self._guard(lambda: session.exchange(frame(_fill(body, self.ctx))))
 
         @rule(line=invalid_lines())
@@ -172,14 +189,28 @@ def _machine(state: _State, start_states, nwp, speed, motor, oxflt):
             self._guard(lambda: (session.poll(), _here(session, self.ctx)))
 
         @precondition(lambda self: oxflt)
-        @rule(code=st.sampled_from(["Sle", "Sop", "Sed"]))
-        def fault(self, code):
-            self._guard(lambda: session.exchange(frame(f"OXFLT,{code}")))
+        @rule(code=st.sampled_from(["Sle", "Sop", "Sed"]), go=st.integers(0, 3))
+        def fault(self, code, go):
+            if go == 0:  # a lockout costs lockout_s of protocol time: keep them rare
+                self._guard(lambda: session.exchange(frame(f"OXFLT,{code}")))
 
         def teardown(self):
             session.trace = None
 
     return VehicleMachine
+
+
+def _confirm(run, best: dict) -> int:
+    """Re-drive the smallest failing sequence twice; how many times it failed again."""
+    from .replay import redrive
+    n = 0
+    for _ in range(2):
+        try:
+            verdict, _, _ = redrive({"steps": best["steps"]}, run.session)
+        except LinkLost:
+            raise
+        n += verdict == "fail"
+    return n
 
 
 def explore(run) -> None:
@@ -189,13 +220,15 @@ def explore(run) -> None:
     examples, steps, budget = PROFILES.get(o.hypothesis_profile, PROFILES["fast"])
     if o.examples is not None:
         examples = o.examples
+    if o.explore_budget_s is not None:
+        budget = o.explore_budget_s
     if examples <= 0:
         return
     state = _State(run, budget)
     bench = p.bench_safety
     speed = min(2.0, p.max_speed_kn, bench.max_speed_kn if not bench.in_water else 99.0)
     motor = min(0x90, bench.max_motor_byte) if not bench.in_water else 0x90
-    factory = _machine(state, ["S", "N"], p.mission_waypoints, speed, motor, p.fault_injection == "oxflt")
+    factory = _machine(state, ["N", "S"], p.mission_waypoints, speed, motor, p.fault_injection == "oxflt")
     if o.seed is not None:
         factory._hypothesis_internal_use_seed = o.seed  # type: ignore[attr-defined]
     db = DirectoryBasedExampleDatabase(str(run.dir / ".hypothesis"))
@@ -206,14 +239,18 @@ def explore(run) -> None:
     session.link.note(f"exploration: {examples} examples of up to {steps} steps, budget {budget:g} s")
     t0 = time.monotonic()
     outcome = "pass"
+    session.lazy_silence = True
     try:
         run_state_machine_as_test(factory, settings=cfg)
     except Exception as e:  # noqa: BLE001 - AssertionError, Flaky…, whatever ended it
         outcome = type(e).__name__
     finally:
         session.trace = None
+        session.lazy_silence = False
     run.stats["explore"] = {"examples": examples, "executions": state.executions, "failures": state.failures,
                             "wall_s": round(time.monotonic() - t0, 3), "outcome": outcome}
+    if state.best is not None:
+        run.stats["explore"]["found"] = f"{state.best['clause']}: {state.best['reason']}"
     if state.lost:
         raise LinkLost(state.lost)
     best = state.best
@@ -222,15 +259,17 @@ def explore(run) -> None:
                      "explore")
         return
     cid = best["clause"]
-    flaky = "Flaky" in outcome
+    confirmed = _confirm(run, best)
+    flaky = confirmed < 2
+    run.stats["explore"]["confirmed"] = f"{confirmed}/2"
     n = sum(1 for r in run.results["replays"] if r["clause"] == cid) + 1
     rel = f"replays/{cid}-{n}.json"
     save_replay(run.dir / rel, cid, best["reason"], best["steps"], run.k, p)
     from ...reports import results as R
     R.add_replay(run.results, cid, best["steps"], file=rel)
     if flaky:
-        run.book.add(cid, "inconclusive", f"exploration: an intermittent failure ({state.failures} of "
-                     f"{state.executions} runs failed): {best['reason']}; replay {rel}", "explore")
+        run.book.add(cid, "inconclusive", f"exploration: an intermittent failure (the shrunk sequence failed "
+                     f"again {confirmed} of 2 times): {best['reason']}; replay {rel}", "explore")
     else:
         run.book.add(cid, "fail", f"exploration: {best['reason']} (shrunk to {len(best['steps'])} steps; "
                      f"replay {rel})", "explore",

@@ -170,8 +170,16 @@ class Mirror:
                 if m.now is None or before >= m.now:
                     candidates.append((m.clone(), before))
                 candidates.append((m.clone(), max(vt, due + 1e-6)))
+        if m.phase != "none":  # the vehicle may have reached the surface since it was last seen
+            c = m.clone()
+            c.advance(vt)
+            if c.phase == "ascent":
+                c.update_plant(c.snapshot.with_(depth_m=0.0))
+                candidates.append((c, vt))
         results = []
         for c, at in candidates:
+            c.advance(at)
+            c.update_plant(c.snapshot)  # a vehicle that is at the surface when its ascent starts acts at once
             replies = c.receive(item, at)
             if observed is None or same_replies(replies, observed):
                 self._adopt(c, item)

@@ -54,6 +54,7 @@ class Options:
     progress: bool = True
     command: str = ""
     render: bool = True
+    explore_budget_s: Optional[float] = None  #: wall seconds for exploration (default: the hypothesis profile's)
 
 
 @dataclass
@@ -248,6 +249,12 @@ class Run:
             ses.link.note(f"case {case.id} {' '.join(case.clauses)}: {case.title}")
             entry = {"id": case.id, "clauses": list(case.clauses), "title": case.title,
                      "expectation": case.expectation, "start": case.start}
+            if all(self.book.failed(cid) for cid in case.clauses):
+                # first fail wins: a later case cannot change these clauses' verdicts
+                entry.update(verdict="not-run", reason="its clauses had already failed", wall_s=0.0)
+                self.results["cases"].append(entry)
+                self.progress.step(f"{case.id} {case.subject}", "skipped (already failed)")
+                continue
             t0 = time.monotonic()
             try:
                 verdict, reason, _ = run_case(ses, case)
