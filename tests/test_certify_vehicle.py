@@ -47,7 +47,7 @@ def _assert_bench_safe(path: Path, max_motor=0x90, max_speed=Decimal("0.5")):
         for chunk in raw.decode("latin-1").split("$")[1:]:
             fields = chunk.split("*")[0].rstrip("\r\n").split(",")
             sid = fields[0].upper()
-            if sid == "OMP" and len(fields) > 1 and len(fields[1]) >= 10:
+            if sid == "OMP" and len(fields) > 1 and re.fullmatch(r"[0-9A-Fa-f]{10}.*", fields[1]):
                 assert int(fields[1][8:10], 16) <= max_motor, raw
             idx = {"OMS": 4, "OPK": 4, "OMW": 6}.get(sid)
             if idx and len(fields) > idx and re.fullmatch(r"-?\d+(\.\d+)?", fields[idx].strip()):

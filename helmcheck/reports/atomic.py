@@ -11,16 +11,28 @@ import os
 import tempfile
 from pathlib import Path
 
-__all__ = ["write_bytes_atomic", "write_text_atomic"]
+__all__ = ["write_bytes_atomic", "write_text_atomic", "copy_file_atomic"]
 
 
 def write_bytes_atomic(path: Path | str, data: bytes, mode: int = 0o644) -> Path:
     """Replace *path* with *data* atomically; returns the path. ``OSError`` on failure."""
+    return _write_atomic(path, lambda fh: fh.write(data), mode)
+
+
+def copy_file_atomic(src: Path | str, dst: Path | str, mode: int = 0o644) -> Path:
+    """Replace *dst* with a copy of *src*, streamed (any size), atomically."""
+    import shutil
+
+    with open(src, "rb") as r:
+        return _write_atomic(dst, lambda fh: shutil.copyfileobj(r, fh, 1 << 20), mode)
+
+
+def _write_atomic(path: Path | str, fill, mode: int) -> Path:
     path = Path(path)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
     try:
         with os.fdopen(fd, "wb") as fh:
-            fh.write(data)
+            fill(fh)
             fh.flush()
             os.fsync(fh.fileno())
         os.chmod(tmp, mode)

@@ -10,13 +10,12 @@ referenced by path and SHA-256), and every report format (:func:`helmcheck.repor
 from __future__ import annotations
 
 import os
-import shutil
-import tempfile
 from pathlib import Path
 from typing import Any, Optional
 
 from ...profile import Profile
 from ...reports import results as R
+from ...reports.atomic import copy_file_atomic
 from ...reports.render import render_all
 from .checker import CheckOutcome
 
@@ -54,23 +53,6 @@ def build_results(out: CheckOutcome, profile: Profile, command: str, *, strict: 
     return res
 
 
-def _copy_atomic(src: Path, dst: Path) -> None:
-    fd, tmp = tempfile.mkstemp(prefix=f".{dst.name}.", suffix=".tmp", dir=dst.parent)
-    try:
-        with os.fdopen(fd, "wb") as w, open(src, "rb") as r:
-            shutil.copyfileobj(r, w, 1 << 20)
-            w.flush()
-            os.fsync(w.fileno())
-        os.chmod(tmp, 0o644)
-        os.replace(tmp, dst)
-    except BaseException:
-        try:
-            os.unlink(tmp)
-        except FileNotFoundError:
-            pass
-        raise
-
-
 def write_report_dir(directory: Path, out: CheckOutcome, profile: Profile, command: str, *,
                      strict: bool = False, render: bool = True) -> dict[str, Any]:
     """Write the results directory; returns the results document. ``OSError``/``ReportError``."""
@@ -85,7 +67,7 @@ def write_report_dir(directory: Path, out: CheckOutcome, profile: Profile, comma
             copied = "capture-" + out.format + ".log"
             wire_name = copied
         if out.path.resolve() != (directory / copied).resolve():
-            _copy_atomic(out.path, directory / copied)
+            copy_file_atomic(out.path, directory / copied)
     res = build_results(out, profile, command, strict=strict, wire_log=wire_name)
     res["log"]["copy"] = copied
     if copied is None:
