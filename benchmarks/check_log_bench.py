@@ -12,7 +12,6 @@ Python heap peak, at some cost in speed).
 from __future__ import annotations
 
 import argparse
-import os
 import resource
 import sys
 import tempfile

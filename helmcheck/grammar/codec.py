@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import builtins
 import re
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from decimal import Decimal
 from typing import Optional
 
@@ -27,7 +27,7 @@ from ..profile import DEFAULT, Profile
 from . import sentences as S
 from .checksum import checksum
 from .compile import build_sentence, fast_builder, lark_parser, specs
-from .errors import FRAMING, SYNTAX, Finding, SentenceError
+from .errors import SYNTAX, Finding, SentenceError
 from .ranges import check_ranges
 
 __all__ = ["decode", "parse", "format", "format_body", "Decoded", "KNOWN_IDS", "rules_for_id"]

@@ -28,7 +28,7 @@ from .scenarios import SCENARIOS
 
 __all__ = ["add_arguments", "run", "EPILOG"]
 
-EPILOG = f"""\
+EPILOG = """\
 scenarios (default: all, in this order, over --duration):
   nominal      the vehicle answers as the reference model does
   reject       every command but $OSD is refused with its "incorrect values" $ACK

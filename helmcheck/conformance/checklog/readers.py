@@ -231,7 +231,6 @@ def _read_socat(f: BinaryIO, meta: LogMeta, swap: bool, progress: Progress, hex_
     t0: list = []
     n = 0
     block: Optional[dict] = None  # direction, t, lineno, want, got(bytearray)
-    carry = b""  # text of the current line not yet consumed
 
     def new_block(m: re.Match, lineno: int) -> dict:
         d = m.group(1).decode()

@@ -9,7 +9,6 @@ referenced by path and SHA-256), and every report format (:func:`helmcheck.repor
 
 from __future__ import annotations
 
-import os
 from pathlib import Path
 from typing import Any, Optional
 
