@@ -97,7 +97,6 @@ class _FakeVehicle:
         self.th.start()
 
     def _run(self):
-        t0 = time.monotonic()
         while not self.stop:
             if not self.link.wait_readable(0.05):
                 continue

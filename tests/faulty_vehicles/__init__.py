@@ -19,7 +19,7 @@ from helmcheck.conformance.emulator.core import EmulatorCore
 from helmcheck.conformance.emulator.missionfile import DirectoryCatalog, builtin_dir
 from helmcheck.conformance.emulator.server import Server
 from helmcheck.conformance.transport import PtyLink
-from helmcheck.grammar import checksum_hex, decode
+from helmcheck.grammar import checksum_hex
 from helmcheck.grammar import sentences as s
 from helmcheck.model.vehicle import VehicleModel
 from helmcheck.profile import DEFAULT, Profile

@@ -25,7 +25,7 @@ cut by the next ``$`` and ``barelf`` a bare LF terminator (RH-FRM-7).
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from decimal import Decimal
 from fnmatch import fnmatchcase
 from typing import Optional
@@ -692,8 +692,6 @@ def _set_round_trip(session: Session, st: SetRoundTrip) -> None:
 
 def run_case(session: Session, case: Case) -> tuple[str, str, Optional[str]]:
     """Run one case: (verdict, reason, clause that failed or None). Link faults propagate."""
-    if session.profile.bench_safety.in_water is False:
-        pass
     why = unmet_need(case, session.profile)
     if why:
         raise CaseNotTested(why)

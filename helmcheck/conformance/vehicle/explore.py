@@ -40,7 +40,7 @@ from .session import frame
 __all__ = ["explore", "PROFILES", "valid_commands", "control_commands", "invalid_lines"]
 
 #: name -> (examples, steps per example, wall budget in seconds)
-PROFILES = {"fast": (25, 10, 45.0), "patient": (6, 8, 600.0)}
+PROFILES = {"fast": (20, 10, 25.0), "patient": (6, 8, 600.0)}
 
 _TIMEOUTS = st.sampled_from([2, 3, 5, 8, 12])
 

@@ -108,6 +108,7 @@ class Mirror:
         self.plant_slack = 0.0  #: vehicle seconds of uncertainty from adopted plant events
         self.last_obs: Optional[float] = None  #: wall time of the last judged $OSI
         self.adopted: list[str] = []
+        self.alts: list[VehicleModel] = []  #: other states the vehicle may be in (see receive)
 
     # ------------------------------------------------------------------ housekeeping
     def v(self, t: float) -> float:
@@ -117,6 +118,7 @@ class Mirror:
     def fresh(self) -> None:
         """Forget everything but what was learnt about the mission (after a verified reset)."""
         old = self.model
+        self.alts = []
         self.model = VehicleModel(self.profile, self.stub)
         # what a vehicle keeps across $OMSTOP: settings, log labels, the loaded mission
         self.model.settings = old.settings
@@ -177,17 +179,48 @@ class Mirror:
                 c.update_plant(c.snapshot.with_(depth_m=0.0))
                 candidates.append((c, vt))
         results = []
+        chosen = None
         for c, at in candidates:
             c.advance(at)
             c.update_plant(c.snapshot)  # a vehicle that is at the surface when its ascent starts acts at once
             replies = c.receive(item, at)
             if observed is None or same_replies(replies, observed):
-                self._adopt(c, item)
-                return replies
+                chosen = (c, replies)
+                break
             results.append((c, replies))
-        c, replies = results[0]
+        alts = self._alternatives(item, vt, observed)
+        if chosen is None:
+            if alts:  # only an unseen plant event explains the answer
+                chosen, alts = alts[0], alts[1:]
+            else:
+                chosen = results[0]
+        c, replies = chosen
         self._adopt(c, item)
+        self.alts = [a for a, _ in alts][:4]
         return replies
+
+    def _alternatives(self, item, vt: float, observed: Optional[list]) -> list:
+        """States in which a plant event the tester could not see happened just before ``item``.
+
+        They stay candidates (:attr:`alts`) until an ``$OSI`` tells them apart from the nominal.
+        """
+        out = []
+        for base in [self.model] + list(self.alts):
+            evs = []
+            if base.mode == "N" and base.mission is not None:
+                evs.append(WaypointReached())
+            if base.mode in ("mP", "W"):
+                evs.append(OnStation())
+            for e in evs:
+                c = base.clone()
+                c.advance(vt)
+                c.plant(e, vt)
+                replies = c.receive(item, vt)
+                if observed is None or same_replies(replies, observed):
+                    if isinstance(item, s.OPK) and c.mode == "mP" and c.timers.armed("opk"):
+                        c.timers.disarm("opk")
+                    out.append((c, replies))
+        return out
 
     def _adopt(self, c: VehicleModel, item) -> None:
         if isinstance(item, s.OPK) and c.mode == "mP" and c.timers.armed("opk"):
@@ -216,8 +249,16 @@ class Mirror:
         prev = self.last_obs
         if problems:
             adopted = self._closure(osi, t, wall_slack, prev)
+            if adopted is None:
+                for alt in self.alts:
+                    if not alt.expectation(vt, slack).check(osi):
+                        self.model = alt
+                        self.adopted.append("unseen plant event before the last command")
+                        adopted = "alternative"
+                        break
             if adopted is not None:
                 problems = []
+        self.alts = []
         if not problems:
             self.last_obs = t
             if self.model.phase != "ascent":

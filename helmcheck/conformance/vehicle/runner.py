@@ -20,13 +20,12 @@ from pathlib import Path
 from typing import Optional
 
 from ... import __version__
-from ...clauses import clause as clause_of, vehicle_clauses
-from ...grammar import sentences as s
+from ...clauses import vehicle_clauses
 from ...model.transitions import REMOTE_MODES
 from ...profile import Profile
 from ...reports import results as R
 from ..transport import open_link
-from .cases import CASES, Case, run_case, select_cases
+from .cases import Case, run_case, select_cases
 from .judge import Book, CaseFail, CaseInconclusive, CaseNotTested
 from .link import LinkLost, TesterLink
 from .progress import Progress
@@ -222,7 +221,7 @@ class Run:
         assert link is not None
         link.sleep(0.05)
         link.drain()
-        for _ in range(3):
+        for _ in range(2):
             link.send(frame("OSD,S"))
             end = link.now() + self.p.ack_window_s + 0.5
             while True:
@@ -248,7 +247,8 @@ class Run:
             ses.case, ses.case_t0 = case.id, ses.now()
             ses.link.note(f"case {case.id} {' '.join(case.clauses)}: {case.title}")
             entry = {"id": case.id, "clauses": list(case.clauses), "title": case.title,
-                     "expectation": case.expectation, "start": case.start}
+                     "expectation": case.expectation, "start": case.start,
+                     "steps": case.describe()["steps"]}
             if all(self.book.failed(cid) for cid in case.clauses):
                 # first fail wins: a later case cannot change these clauses' verdicts
                 entry.update(verdict="not-run", reason="its clauses had already failed", wall_s=0.0)

@@ -449,10 +449,9 @@ class Session:
         t0 = self.now()
         worst = 0.0
         while True:
-            osi = self.poll(clause) if probe is None else None
             if probe is not None:
                 self.exchange(probe, clause)
-                self.poll(clause)
+            self.poll(clause)
             slack = self.last_slack
             worst = max(worst, slack)
             if self.mirror.v(self.now()) > due + tolerance(dur, slack) + after_v:
@@ -483,6 +482,7 @@ class Session:
             osi = self.poll(clause)
             n += 1
             if pred(osi):
+                self.forced_wait += self.now() - t0
                 return osi
             speed = float(osi.speed) * 1852.0 / 3600.0
             if estimate and n >= 3 and speed > 0.05:
