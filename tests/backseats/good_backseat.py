@@ -118,6 +118,8 @@ class Backseat:
             self.start_pending = False
             if status == 0:
                 self.mode = "N"
+        if type_ == 1 and status == 0:  # our $OMSTOP took effect: whatever $OSI was in flight
+            self.mode = "S"
         if status == 0:
             return
         if err == 26:
