@@ -202,9 +202,17 @@ class Mirror:
     def _alternatives(self, item, vt: float, observed: Optional[list]) -> list:
         """States in which a plant event the tester could not see happened just before ``item``.
 
-        They stay candidates (:attr:`alts`) until an ``$OSI`` tells them apart from the nominal.
+        They stay candidates (:attr:`alts`) until an ``$OSI`` tells them apart from the nominal:
+        earlier candidates are carried through this command too (an ``$OSD`` poll between the
+        command and the ``$OSI`` that settles it must not drop them).
         """
         out = []
+        for base in self.alts:
+            c = base.clone()
+            c.advance(vt)
+            replies = c.receive(item, vt)
+            if observed is None or same_replies(replies, observed):
+                out.append((c, replies))
         for base in [self.model] + list(self.alts):
             evs = []
             if base.mode == "N" and base.mission is not None:
