@@ -65,15 +65,19 @@ def main() -> None:
     print(f"helmcheck Lark reference path (sample of {len(sample):,}): {r_lark:,.0f} lines/s")
     rmc = [x for x in lines if x.startswith(b"$GPRMC")][:200_000]
     rmc_text = [x.decode().strip() for x in rmc]
-    r_h = rate(parse, rmc)
-    print(f"$GPRMC x{len(rmc):,}: helmcheck {r_h:,.0f} lines/s", end="")
     try:
         import pynmea2
     except ImportError:
-        print("; pynmea2 not installed")
+        print(f"$GPRMC x{len(rmc):,}: helmcheck {rate(parse, rmc):,.0f} lines/s; pynmea2 not installed")
         return
-    r_p = rate(lambda x: pynmea2.parse(x, check=True), rmc_text)
-    print(f"; pynmea2 (check=True) {r_p:,.0f} lines/s; ratio {r_h / r_p:.2f}")
+    # alternate the two, three rounds each, and keep each one's best: load on the machine then
+    # hits both alike
+    r_h = r_p = 0.0
+    for _ in range(3):
+        r_h = max(r_h, rate(parse, rmc))
+        r_p = max(r_p, rate(lambda x: pynmea2.parse(x, check=True), rmc_text))
+    print(f"$GPRMC x{len(rmc):,} (best of 3 alternating rounds): helmcheck {r_h:,.0f} lines/s "
+          f"(typed, ranges checked); pynmea2 parse(check=True) {r_p:,.0f} lines/s; ratio {r_h / r_p:.2f}")
 
 
 if __name__ == "__main__":

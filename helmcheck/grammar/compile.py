@@ -384,11 +384,10 @@ def _items(f: FieldSpec, text: Optional[str]) -> tuple:
     return tuple(out)
 
 
-def _builder_expr(spec: SentenceSpec, index: dict, env: dict, tag: str) -> str:
-    """Source of an expression building ``spec.cls`` from ``t`` (the groups of a match whose
-    group numbers are ``index``); embedded sentences are built inline from the same groups."""
+def _builder_args(spec: SentenceSpec, index: dict, env: dict, tag: str) -> list[str]:
+    """Source of the field values of ``spec.cls``, in field order, from ``t`` (the groups of a
+    match whose group numbers are ``index``); embedded sentences are built from the same groups."""
     cls = spec.cls
-    env[f"cls{tag}"] = cls
     by_attr = {f.attr: f for f in spec.fields}
     required = dict(_REQUIRED.get(cls, ()))
     subs = _SUBS.get(cls, {})
@@ -399,7 +398,9 @@ def _builder_expr(spec: SentenceSpec, index: dict, env: dict, tag: str) -> str:
         if name in subs:
             sub_spec = _SPEC_BY_CLASS[subs[name]]
             first = index[sub_spec.fields[0].rule] - 1
-            args.append(f"({_builder_expr(sub_spec, index, env, k)} if t[{first}] is not None else None)")
+            env[f"cls{k}"] = sub_spec.cls
+            sub_args = ", ".join(_builder_args(sub_spec, index, env, k))
+            args.append(f"(cls{k}({sub_args}) if t[{first}] is not None else None)")
             continue
         f = by_attr.get(name)
         if f is None:
@@ -422,7 +423,7 @@ def _builder_expr(spec: SentenceSpec, index: dict, env: dict, tag: str) -> str:
         else:
             absent = ("''" if required[name] else "None") if name in required else repr(fld.default)
             args.append(f"(({conv}(v{k})) if (v{k} := {g}) is not None else {absent})")
-    return f"cls{tag}(" + ", ".join(args) + ")"
+    return args
 
 
 @lru_cache(maxsize=None)
@@ -433,8 +434,15 @@ def fast_builder(rule: str) -> Callable[[re.Match], S.Sentence]:
     fast path calls it once per line. ``tests/test_grammar_roundtrip.py`` checks both agree.
     """
     spec = specs()[rule]
-    env: dict[str, Any] = {"_items": _items}
-    expr = _builder_expr(spec, spec.regex.groupindex, env, "")
-    src = "def build(m):\n    t = m.groups()\n    return " + expr + "\n"
-    exec(compile(src, f"<builder {rule}>", "exec"), env)
+    cls = spec.cls
+    env: dict[str, Any] = {"_items": _items, "_new": object.__new__, "cls": cls}
+    args = _builder_args(spec, spec.regex.groupindex, env, "")
+    # The object is filled through its slot descriptors, as the frozen dataclass __init__ would
+    # do field by field, at half the cost (the classes have no __post_init__ to skip).
+    lines = ["def build(m):", "    t = m.groups()", "    o = _new(cls)"]
+    for i, (f, expr) in enumerate(zip(fields(cls), args)):
+        env[f"set{i}"] = getattr(cls, f.name).__set__
+        lines.append(f"    set{i}(o, {expr})")
+    lines.append("    return o")
+    exec(compile("\n".join(lines) + "\n", f"<builder {rule}>", "exec"), env)
     return env["build"]

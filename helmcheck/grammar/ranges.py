@@ -208,10 +208,13 @@ def _compass(s: S.Compass, p: Profile) -> Iterator[Problem]:
 
 
 def _gprmc(s: S.GPRMC, p: Profile) -> Iterator[Problem]:
-    if s.lat and (int(s.lat[:2]) > 90 or float(s.lat[2:]) >= 60):
-        yield "RH-OUT-3", "lat", f"latitude {s.lat} is not a valid ddmm.mmmm"
-    if s.lon and (int(s.lon[:3]) > 180 or float(s.lon[3:]) >= 60):
-        yield "RH-OUT-3", "lon", f"longitude {s.lon} is not a valid dddmm.mmmm"
+    # The grammar fixes the digit counts (ddmm.mmmm, dddmm.mmmm), so comparing the digit
+    # strings is comparing the numbers: degrees at most 90 / 180, minutes below 60.
+    lat, lon = s.lat, s.lon
+    if lat and (lat[:2] > "90" or lat[2:4] > "59"):
+        yield "RH-OUT-3", "lat", f"latitude {lat} is not a valid ddmm.mmmm"
+    if lon and (lon[:3] > "180" or lon[3:5] > "59"):
+        yield "RH-OUT-3", "lon", f"longitude {lon} is not a valid dddmm.mmmm"
 
 
 def _opi(s: S.OPI, p: Profile) -> Iterator[Problem]:
