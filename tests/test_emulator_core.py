@@ -335,3 +335,49 @@ def test_live_view_renders_without_a_terminal():
     assert fake.injected == [FAULT_KEYS["3"], "stop"]
     os.close(r)
     os.close(w)
+
+
+# ------------------------------------------------------------------------ tester hooks
+
+def test_RH_MSN_3_end_mission_stops_the_running_mission_without_a_reply():
+    core = make_core()
+    assert core.end_mission(0.0) == b"" and not core.mission_running  # nothing to end
+    assert acks(core.feed(frame("OMSTART,0,0,0,0,conformance.mis"), 0.0)) == [(3, 0, 0)]
+    assert core.mission_running
+    assert core.end_mission(0.5) == b""  # nobody on the line asked: no $ACK
+    assert not core.mission_running and core.model.mode == "S"
+    assert core.plant.target(core.model).kind == "hold"
+
+
+def test_RH_ACK_6_queued_reply_goes_out_in_order_and_paced():
+    core = make_core(baud=9600)
+    first = core.feed(frame("OSD,S"), 0.0)
+    assert first  # the first sentence goes at once, the rest waits for the line
+    rest = core.queue_reply(s.ACK(9, 1, 20), 0.0)
+    t, out = 0.0, first + rest
+    while core.pending_output:
+        t = core.next_wakeup()
+        out += core.tick(t)
+    got = replies(out)
+    assert isinstance(got[0], s.OSI) and [(r.type, r.status, r.err) for r in got[1:]] == [(8, 0, 0), (9, 1, 20)]
+    assert t >= (len(out) - len(frame("ACK,9,1,20"))) * 10 / 9600 - 1e-6
+
+
+def test_RH_SAF_1_lockout_active_follows_the_model():
+    core = make_core(k=10.0)
+    assert not core.lockout_active
+    core.inject_fault("Sop", 0.0)
+    assert core.lockout_active
+    core.tick(DEFAULT.lockout_s / 10.0 + 0.1)
+    assert not core.lockout_active
+
+
+def test_model_factory_builds_the_model():
+    from helmcheck.model.vehicle import VehicleModel
+
+    class Marked(VehicleModel):
+        pass
+
+    core = make_core(model_factory=Marked)
+    assert type(core.model) is Marked
+    assert acks(core.feed(frame("OSD,S"), 0.0)) == [(8, 0, 0)]

@@ -135,6 +135,7 @@ def _do_omw(m: VehicleModel, row: Row, c: s.OMW, now: float) -> list[s.Reply]:
     if m.mode != "W":
         m._end_remote()
     m.queue.append(c)
+    m._control_changed()
     m._transition(row, now)
     return [_ack(16)]
 
@@ -224,7 +225,7 @@ def _do_ologl(m: VehicleModel, row: Row, c: s.OLOGL, now: float) -> list[s.Reply
 
 def _do_ologd(m: VehicleModel, row: Row, c: s.OLOGD, now: float) -> list[s.Reply]:
     """RH-LOG-2: write one row to the main log."""
-    m.log_rows.append(LogRow(now, m.log_labels or (), tuple(c.values)))
+    m._write_log_row(LogRow(now, m.log_labels or (), tuple(c.values)))
     return [_ack(4)]
 
 
@@ -267,6 +268,7 @@ def _queue_next(m: VehicleModel, row: Row, now: float) -> list[s.Reply]:
     m.queue_parking = False
     if row.target == "W":
         m.queue.pop(0)
+        m._control_changed()
         m._transition(row, now)
     else:
         m._pending.append(ev.QueueDone(now))

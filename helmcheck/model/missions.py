@@ -14,6 +14,12 @@ turns both separators into ``/`` and is the key a catalogue is asked for.
 
 Decision (spec open): a mission needs at least one waypoint; :class:`Mission` refuses an empty
 list, and a catalogue should report such a file as ``BadMission("unparseable")``.
+
+Missions of unknown length: an observer that knows a mission only by name (a log checked
+without the vehicle's mission files) uses :meth:`Mission.open`. Its waypoints are
+:class:`OpenWaypoints`: :data:`OPEN_LENGTH` of them, all at (0, 0) without a park, so every
+``$OJW`` index is in range (RH-JW-1) and the mission never ends on its own (RH-MSN-4). They can
+be indexed and counted but not iterated; :attr:`Mission.is_open` tells such a mission apart.
 """
 
 from __future__ import annotations
@@ -24,8 +30,11 @@ from typing import Mapping, Optional, Protocol, Union, runtime_checkable
 
 __all__ = [
     "Waypoint", "Mission", "MissingMission", "BadMission", "LookupResult", "MissionCatalog",
-    "InMemoryCatalog", "mission_name_problem", "normalise_name",
+    "InMemoryCatalog", "mission_name_problem", "normalise_name", "OpenWaypoints", "OPEN_LENGTH",
 ]
+
+#: How many waypoints a mission of unknown length (:meth:`Mission.open`) reports.
+OPEN_LENGTH = 1_000_000
 
 
 @dataclass(frozen=True, slots=True)
@@ -39,17 +48,49 @@ class Waypoint:
     park_s: float = 0.0
 
 
+class OpenWaypoints:
+    """The waypoints of a mission of unknown length: :data:`OPEN_LENGTH` of them, each at (0, 0)
+    with no park. Indexing and ``len`` work; iterating is refused (there is no finite list)."""
+
+    __slots__ = ()
+    _WP = Waypoint(0.0, 0.0)
+
+    def __len__(self) -> int:
+        return OPEN_LENGTH
+
+    def __getitem__(self, i: int) -> Waypoint:
+        return self._WP
+
+    def __iter__(self):
+        raise TypeError("an open mission has no finite list of waypoints")
+
+
 @dataclass(frozen=True, slots=True)
 class Mission:
-    """A mission file's content: its name and its waypoints, in order (index 0 first)."""
+    """A mission file's content: its name and its waypoints, in order (index 0 first).
+
+    :meth:`open` makes a mission of unknown length (see the module docstring).
+    """
 
     name: str
-    waypoints: tuple[Waypoint, ...]
+    waypoints: Union[tuple[Waypoint, ...], OpenWaypoints]
 
     def __post_init__(self) -> None:
+        if isinstance(self.waypoints, OpenWaypoints):
+            return
         if not self.waypoints:
             raise ValueError(f"mission {self.name!r} has no waypoints")
         object.__setattr__(self, "waypoints", tuple(self.waypoints))
+
+    @classmethod
+    def open(cls, name: str) -> "Mission":
+        """A mission known only by name: :class:`OpenWaypoints` (module docstring)."""
+        return cls(name, OpenWaypoints())
+
+    @property
+    def is_open(self) -> bool:
+        """True for a mission of unknown length (:meth:`open`)."""
+        return isinstance(self.waypoints, OpenWaypoints)
 
     @property
     def last(self) -> int:

@@ -29,7 +29,13 @@ it now or as it left it; the slow shadow in it now or the fast one as it entered
 
 So that the slow shadow can still be "before" a timer the model itself already ran, the model
 keeps a checkpoint: a copy of itself taken just before the first timer fires after a
-state-changing input (``VehicleModel.checkpoints``, on by default). Shadows start from it.
+state-changing input (``VehicleModel.checkpoints``, on by default; ``VehicleModel.checkpoint``
+reads it, ``drop_checkpoint()`` forgets it). Shadows start from it.
+
+Steady state: :func:`steady_expectation` answers without shadows when no checkpoint is held
+and no timer can expire by ``now`` even at its earliest (RH-TIM-1): the one present state, with
+its park time widened by ``slack``. :func:`quick_expectation` tries it first and falls back to
+:func:`expectation` (for observers that ask for every ``$OSI`` of a long log).
 
 Limits (documented, deliberate): a command that arrives within the tolerance of a timer is
 applied to the nominal state only (the model cannot know which side of the race the vehicle
@@ -44,8 +50,9 @@ from dataclasses import dataclass
 from typing import Optional
 
 from ..grammar import sentences as s
+from .timers import tolerance
 
-__all__ = ["Acceptable", "Expectation", "expectation"]
+__all__ = ["Acceptable", "Expectation", "expectation", "steady_expectation", "quick_expectation"]
 
 
 @dataclass(frozen=True, slots=True)
@@ -154,7 +161,7 @@ def _shadow(model, sign: float, slack: float):
 
 def expectation(model, now: float, slack: float = 0.0) -> Expectation:
     """The :class:`Expectation` for an ``$OSI`` produced at ``now`` (see the module docstring)."""
-    base = model._base if model._base is not None else model
+    base = model.checkpoint if model.checkpoint is not None else model
     if base.now is not None and now < base.now:
         now = base.now
     fast, slow = _shadow(base, -1.0, slack), _shadow(base, +1.0, slack)
@@ -180,3 +187,37 @@ def _acceptable(sig: tuple, values: list[Optional[float]], slack: float) -> Acce
         lo, hi = max(0.0, lo - slack), hi + slack
     mode, wp, err, srp = sig
     return Acceptable(mode, wp, err, srp, max(0, math.floor(lo)), math.ceil(hi))
+
+
+def _timer_near(model, now: float, slack: float) -> bool:
+    """Can some armed timer expire by ``now`` at its earliest (RH-TIM-1 tolerance + slack)?"""
+    t = model.timers
+    for name in t.names():
+        d = t.deadline(name)
+        dur = t.duration(name) or 0.0
+        if d is not None and d - tolerance(dur, slack) <= now:
+            return True
+    return False
+
+
+def steady_expectation(model, now: float, slack: float = 0.0) -> Optional[Expectation]:
+    """The :class:`Expectation` at ``now`` when nothing can change before it (module
+    docstring), else ``None``."""
+    if model.checkpoint is not None or _timer_near(model, now, slack):
+        return None
+    base = model.now if model.now is not None and model.now > now else now
+    mode, wp, err, park, srp = model.state(base)
+    p = model.park_remaining(base)
+    if p is None or p <= 0:
+        lo = hi = 0
+    else:
+        lo, hi = max(0, math.floor(max(0.0, p - slack))), math.ceil(p + slack)
+        lo = min(lo, park)
+        hi = max(hi, park)
+    return Expectation(now, slack, (Acceptable(mode, wp, err, srp, lo, hi),))
+
+
+def quick_expectation(model, now: float, slack: float = 0.0) -> Expectation:
+    """:func:`steady_expectation` when it answers, else :func:`expectation`."""
+    exp = steady_expectation(model, now, slack)
+    return exp if exp is not None else expectation(model, now, slack)

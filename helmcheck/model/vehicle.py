@@ -7,6 +7,8 @@ Inputs, all with the model-clock time ``now`` in seconds (never read from a cloc
 * ``advance(now) -> list[ModelEvent]`` and ``next_deadline()`` — timeouts (``$OMS``, ``$OMP``,
   ``$ODVL``), park expiry (mission, ``$OPK``, queued ``$OMW``), lockout end (aioquic style:
   the owner arms one timer at ``next_deadline()`` and calls ``advance``).
+* ``drain_events() -> list[ModelEvent]`` — the events an input produced (``receive`` keeps
+  them; ``advance``, ``plant`` and ``update_plant`` return them), without running any timer.
 * ``plant(event, now)`` and ``update_plant(snapshot)`` — what the physical vehicle did
   (:mod:`helmcheck.model.plant`).
 
@@ -24,7 +26,18 @@ Time (RH-TIM-2, RH-RD-15): ``now`` is *vehicle* time. An emulator running k time
 real time passes ``k × wall seconds``; the model's durations are never scaled. Time never goes
 backwards: a ``now`` earlier than the last one is taken as the last one. Every input first runs
 the timers due at or before ``now`` (a command arriving exactly at a deadline meets the expired
-state); the events they produce wait for the next ``advance``.
+state); the events they produce wait for the next ``advance`` (or ``drain_events``).
+
+Bounded history: ``log_rows`` (RH-LOG-2) and ``opos_records`` (RH-POS-1/2) keep the last
+:attr:`VehicleModel.HISTORY` entries; ``log_row_count`` counts every row ever written, and
+``log_rows_since(count)`` gives the rows an owner has not yet seen (its main log).
+
+Observation helpers (for emulators and observers; none changes the state): ``event_of`` and
+``row_for`` (the table row a command would meet now), ``navigation_target()`` (what ``$OSI``
+field 7 measures, RH-RD-5), ``control_generation`` (changes whenever the remote-control goal
+may have changed, so a replacing ``$OPK``/``$OMW`` is a new goal), ``opk_counting``,
+``timer(name)`` and the expectation ``checkpoint`` (:mod:`~helmcheck.model.observe`). Two calls
+let an observer adopt what it saw: ``drop_checkpoint()`` and ``await_on_station()`` (RH-PK-2).
 
 Decisions (spec open), besides those in :mod:`~helmcheck.model.transitions`:
 
@@ -43,6 +56,7 @@ Decisions (spec open), besides those in :mod:`~helmcheck.model.transitions`:
 from __future__ import annotations
 
 import copy
+from collections import deque
 from typing import Optional, Union
 
 from ..grammar import sentences as s
@@ -76,6 +90,9 @@ _SAFETY = frozenset(SAFETY_CODES)
 class VehicleModel:
     """The reference vehicle state machine. See the module docstring."""
 
+    #: How many ``log_rows`` and ``opos_records`` the model keeps (the oldest are dropped).
+    HISTORY = 256
+
     def __init__(self, profile: Profile = DEFAULT, missions: Optional[MissionCatalog] = None,
                  snapshot: Optional[PlantSnapshot] = None) -> None:
         self.profile = profile
@@ -107,8 +124,11 @@ class VehicleModel:
         # safety, logs, settings
         self.error_state = "N"
         self.log_labels: Optional[tuple[str, ...]] = None
-        self.log_rows: list[LogRow] = []
-        self.opos_records: list[OposRecord] = []
+        self.log_rows: deque[LogRow] = deque(maxlen=self.HISTORY)
+        self.log_row_count = 0  #: rows ever written to the main log (monotonic, RH-LOG-2)
+        self.opos_records: deque[OposRecord] = deque(maxlen=self.HISTORY)
+        #: changes whenever the remote-control goal may have changed (see the module docstring)
+        self.control_generation = 0
         self.settings = SettingsStore(profile)
         self.last_row: Optional[Row] = None
         self.timers = Timers()
@@ -184,11 +204,47 @@ class VehicleModel:
         """The model time of the next timer expiry, or ``None`` when no timer runs."""
         return self.timers.due
 
+    def timer(self, name: Optional[str] = None) -> Optional[tuple[float, float, str]]:
+        """``(deadline, duration, name)`` of the named timer, or of the next one to expire;
+        ``None`` when it is not armed (RH-TIM-1 tolerances are taken on the duration)."""
+        t = self.timers
+        if name is None:
+            e = t.earliest()
+            if e is None:
+                return None
+            name = e[1]
+        d = t.deadline(name)
+        if d is None:
+            return None
+        return d, t.duration(name) or 0.0, name
+
     def advance(self, now: float) -> list[ev.ModelEvent]:
         """Run every timer due at or before ``now``; return the events since the last call."""
         self._run_due(now)
+        return self.drain_events()
+
+    def drain_events(self) -> list[ev.ModelEvent]:
+        """The events produced since the last call (by ``receive`` or a timer it ran first),
+        in order; runs no timer. ``advance``, ``plant`` and ``update_plant`` drain too."""
         out, self._pending = self._pending, []
         return out
+
+    @staticmethod
+    def event_of(item: Item) -> Optional[str]:
+        """The table event (:data:`~helmcheck.model.transitions.TABLE`) of a parsed command;
+        ``None`` for a sentence error, ``$OXFLT`` or a class the table does not know."""
+        cls = type(item)
+        event = _EVENT_OF_CLASS.get(cls)
+        if event is None and cls is s.OMWClear:
+            event = "OMW_CLEAR" if item.waypoint is None else "OMW_CLEAR_WP"  # type: ignore[union-attr]
+        return event
+
+    def row_for(self, item: Item) -> Optional[Row]:
+        """The transition row ``receive(item)`` would meet in the present state (RH-ACK-4,
+        RH-SAF-1), before field checks; ``None`` when the table has no event for ``item``.
+        Changes nothing: call ``advance`` first to bring the timers up to the command's time."""
+        event = self.event_of(item)
+        return None if event is None else select(self.mode, self.phase, event, self)
 
     def receive(self, item: Item, now: float) -> list[s.Reply]:
         """The replies a conforming vehicle sends for ``item``, in order (RH-ACK-1..6)."""
@@ -203,13 +259,12 @@ class VehicleModel:
         cls = type(item)
         event = _EVENT_OF_CLASS.get(cls)
         if event is None:
-            if cls is s.OMWClear:
-                event = "OMW_CLEAR" if item.waypoint is None else "OMW_CLEAR_WP"  # type: ignore[union-attr]
-            elif cls is s.OXFLT:
+            if cls is s.OXFLT:
                 if self._oxflt:
                     self._violation(item.code, now)  # type: ignore[union-attr]
                 return []
-            else:
+            event = self.event_of(item)
+            if event is None:
                 return []
         if cls.ID not in self._commands:
             return []
@@ -272,6 +327,55 @@ class VehicleModel:
 
     # ------------------------------------------------------------------ observable state
 
+    @property
+    def opk_counting(self) -> bool:
+        """RH-PK-2: the ``$OPK`` park countdown runs (the vehicle is on station)."""
+        return self.timers.armed("opk")
+
+    @property
+    def lockout_active(self) -> bool:
+        """RH-SAF-1: the lockout after a safety violation runs (commands but ``$OSD`` get 26)."""
+        return self.phase == "lockout"
+
+    def navigation_target(self) -> Optional[tuple[float, float]]:
+        """RH-RD-5: the position ``$OSI`` field 7 measures the distance to, or ``None`` (field 7
+        is 0): the ``$OPK`` position in ``mP``, the first queued ``$OMW`` waypoint in ``W``, the
+        mission's next waypoint in ``N`` and in ``P`` (not while a frozen park has no time set)."""
+        if self.mode == "mP" and self.opk is not None:
+            return float(self.opk.lat), float(self.opk.lon)
+        if self.mode == "W" and self.queue:
+            return float(self.queue[0].lat), float(self.queue[0].lon)
+        if self.mode in ("N", "P") and self.mission is not None and not (
+                self.mode == "P" and self.park_left is None and not self.timers.armed("park")):
+            w = self.mission.waypoints[self.mission_wp]
+            return w.lat, w.lon
+        return None
+
+    def log_rows_since(self, count: int) -> list[LogRow]:
+        """The main-log rows written after the first ``count`` (RH-LOG-2), oldest first; rows
+        already dropped from the bounded history (:attr:`HISTORY`) are not returned."""
+        new = min(self.log_row_count - count, len(self.log_rows))
+        if new <= 0:
+            return []
+        return list(self.log_rows)[-new:]
+
+    @property
+    def checkpoint(self) -> Optional["VehicleModel"]:
+        """The copy taken before the first timer fired since the last input, or ``None``
+        (the start of the expectation shadows, :mod:`~helmcheck.model.observe`)."""
+        return self._base
+
+    def drop_checkpoint(self) -> None:
+        """Forget the checkpoint: the present state is the start of what may be expected
+        (an observer that adopted a state the checkpoint predates)."""
+        self._base = None
+
+    def await_on_station(self) -> None:
+        """RH-PK-2: undo a started ``$OPK`` countdown; it starts at the next
+        :class:`~helmcheck.model.plant.OnStation` (an observer that cannot see the position
+        adopts the countdown only when the vehicle shows it)."""
+        self.timers.disarm("opk")
+
     def park_remaining(self, now: Optional[float] = None) -> Optional[float]:
         """Seconds of park left as ``$OSI`` field 10 would show them (before rounding up)."""
         now = self.now if now is None else now
@@ -323,8 +427,8 @@ class VehicleModel:
         """An independent copy (for shadows and what-if questions)."""
         new = copy.copy(self)
         new.queue = list(self.queue)
-        new.log_rows = list(self.log_rows)
-        new.opos_records = list(self.opos_records)
+        new.log_rows = deque(self.log_rows, maxlen=self.HISTORY)
+        new.opos_records = deque(self.opos_records, maxlen=self.HISTORY)
         new.settings = self.settings.copy()
         new.timers = self.timers.copy()
         new._pending = []
@@ -374,19 +478,21 @@ class VehicleModel:
             self._data = DataCache(self.profile, snap)
 
     def _distance(self) -> float:
-        p = self._snap
-        target = None
-        if self.mode == "mP" and self.opk is not None:
-            target = (float(self.opk.lat), float(self.opk.lon))
-        elif self.mode == "W" and self.queue:
-            target = (float(self.queue[0].lat), float(self.queue[0].lon))
-        elif self.mode in ("N", "P") and self.mission is not None and not (
-                self.mode == "P" and self.park_left is None and not self.timers.armed("park")):
-            w = self.mission.waypoints[self.mission_wp]
-            target = (w.lat, w.lon)
+        """``$OSI`` field 7 (RH-RD-5): metres to :meth:`navigation_target`, else 0."""
+        target = self.navigation_target()
         if target is None:
             return 0.0
+        p = self._snap
         return distance_m(p.lat, p.lon, target[0], target[1])
+
+    def _write_log_row(self, row: LogRow) -> None:
+        """RH-LOG-2: keep ``row`` in the bounded history and count it."""
+        self.log_rows.append(row)
+        self.log_row_count += 1
+
+    def _control_changed(self) -> None:
+        """The remote-control goal (set-points, ``$OPK`` position, queue head) may have changed."""
+        self.control_generation += 1
 
     def _receive_error(self, err: SentenceError) -> list[s.Reply]:
         t = err.ack_type
@@ -439,6 +545,7 @@ class VehicleModel:
 
     def _end_remote(self) -> None:
         """RH-INT-1: end whatever remote control is active (there is no stack)."""
+        self._control_changed()
         self.servo = None
         self.primitive = None
         self.opk = None

@@ -246,11 +246,8 @@ def make_core(m: Mutant | None, time_scale: float, start: float) -> EmulatorCore
     profile: Profile = EMU_PROFILE.replace(time_scale=time_scale, **dict(m.profile_changes if m else ()))
     catalog = DirectoryCatalog([builtin_dir()])
     cls = m.core if m else EmulatorCore
-    core = cls(profile, catalog, start=start, time_scale=time_scale, baud=115200)
-    if m is not None and m.model is not None:
-        core.model = m.model(profile, catalog)
-        core._push_snapshot()
-    return core
+    model = m.model if m is not None and m.model is not None else VehicleModel
+    return cls(profile, catalog, start=start, time_scale=time_scale, baud=115200, model_factory=model)
 
 
 @contextmanager

@@ -6,8 +6,8 @@ model's), the judging is :class:`~.judge.BackseatJudge`'s and the staging is
 :mod:`.scenarios`'. Every byte from the backseat goes first to the judge, which hands back
 complete lines; each line then goes to the vehicle unless a scenario says otherwise (a
 ``silence`` drops it, a ``reject`` window answers it with an error ``$ACK`` in the vehicle's
-place, in order and paced like the vehicle's own output). Every byte the vehicle writes is
-shown to the judge when it goes out (what the backseat could know).
+place, queued by the core behind its own output, in order and paced like it). Every byte the
+vehicle writes is shown to the judge when it goes out (what the backseat could know).
 
 Link life (decisions): the run starts at the backseat's first byte; none within
 ``connect_timeout`` is "never connected". On a pty the loop lets go of its own copy of the
@@ -26,9 +26,8 @@ from collections import deque
 from dataclasses import dataclass, field
 from typing import Any, Callable, Optional
 
-from ...grammar import format as format_sentence
 from ...grammar import sentences as s
-from ...grammar.capture import FROM_VEHICLE, TO_VEHICLE, WireLogWriter
+from ...grammar.capture import TO_VEHICLE, WireLogWriter
 from ...model.missions import MissionCatalog
 from ...profile import Profile
 from ..emulator.core import EmulatorCore
@@ -82,7 +81,6 @@ class Runner:
         self._stop: Optional[str] = None
         self._out = bytearray()
         self._held: deque[Piece] = deque()
-        self._staged: deque[bytes] = deque()
         self._actions = deque(plan.actions)
         self._silent = False
         self._rejecting = False
@@ -192,8 +190,8 @@ class Runner:
         self._flush_input_to_vehicle(now)
 
     def _flush_input_to_vehicle(self, now: float) -> None:
-        """Hand complete lines to the vehicle in order; a staged ``$ACK`` holds the queue."""
-        while self._held and not self._staged:
+        """Hand complete lines to the vehicle in order."""
+        while self._held:
             piece = self._held.popleft()
             self._deliver(piece, now)
             self._after_vehicle(now)
@@ -210,11 +208,9 @@ class Runner:
         if (self._rejecting and cmd is not None and cmd.ACK_TYPE is not None and not isinstance(cmd, s.OSD)
                 and cmd.ID in self.profile.commands):
             self._log_bytes(t, TO_VEHICLE, piece.raw)
-            ack = format_sentence(s.ACK(cmd.ACK_TYPE, 1, cmd.ERR))
-            self._staged.append(ack)
             if len(self.outcome.events) < 500:
                 self.outcome.events.append((t, "ack-error", f"staged rejection of ${cmd.ID}: err {cmd.ERR}"))
-            self._flush_staged(now)
+            self._emit(self.core.queue_reply(s.ACK(cmd.ACK_TYPE, 1, cmd.ERR), now))
             return
         self._emit(self.core.feed(piece.raw, now))
 
@@ -226,18 +222,9 @@ class Runner:
                 self._note(now, f"silence: {len(out)} bytes of replies not sent")
         else:
             self._emit(out)
-        self._flush_staged(now)
         self._flush_input_to_vehicle(now)
         self._after_vehicle(now)
         self._write(now)
-
-    def _flush_staged(self, now: float) -> None:
-        core = self.core
-        while self._staged and core.pending_output == 0 and core.pacer.free_at <= now + 1e-9:
-            raw = self._staged.popleft()
-            core.pacer.reserve(len(raw), now)
-            self._log_bytes(self.rel(now), FROM_VEHICLE, raw)
-            self._emit(raw)
 
     def _emit(self, data: bytes) -> None:
         if not data:
@@ -264,8 +251,9 @@ class Runner:
         self._dropped_out = 0
 
     def _after_vehicle(self, now: float) -> None:
-        m = self.core.model
-        lock = m.phase == "lockout"
+        core = self.core
+        m = core.model
+        lock = core.lockout_active
         if lock != self._lockout:
             self._lockout = lock
             self.judge.lockout(lock, self.rel(now))
@@ -311,13 +299,10 @@ class Runner:
         """The running mission ends on the vehicle, off the wire (scenario ``mission-end``)."""
         core = self.core
         self._emit(core.tick(now))
-        m = core.model
-        if not m.running:
+        if not core.mission_running:
             self._note(now, "mission-end: no mission was running; nothing to end")
             return
-        m.receive(s.OMSTOP(0), core.v)  # the reply is not sent: nobody on the line asked
-        m.advance(core.v)
-        core.plant.sync(m)
+        self._emit(core.end_mission(now))
         self._note(now, "mission-end: the mission ended on the vehicle")
         self.outcome.events.append((self.rel(now), "note", "mission ended on the vehicle"))
         self._after_vehicle(now)

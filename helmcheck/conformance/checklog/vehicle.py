@@ -41,7 +41,6 @@ the ``$OJW`` range, a mission park or end) are INCONCLUSIVE, and the vehicle's a
 from __future__ import annotations
 
 import ast
-import math
 import re
 from collections import deque
 from dataclasses import dataclass, field
@@ -50,12 +49,10 @@ from typing import Any, Callable, Optional
 from ...grammar import sentences as s
 from ...grammar.errors import SentenceError
 from ...model import events as mev
-from ...model.missions import Mission, MissionCatalog, Waypoint
-from ...model.observe import Acceptable, Expectation, expectation
+from ...model.missions import Mission, MissionCatalog
+from ...model.observe import quick_expectation
 from ...model.plant import (AtSurface, OnStation, PlantEvent, QueueWaypointReached, SafetyViolation,
                             Submerged, WaypointReached)
-from ...model.timers import tolerance
-from ...model.transitions import select
 from ...model.vehicle import VehicleModel
 from ...profile import SAFETY_CODES, Profile
 from .accounting import ClauseBook, Evidence
@@ -92,41 +89,20 @@ _CONTROL_OF_EVENT = {mev.ServoTimeout: "RH-SRV-4", mev.PrimitiveTimeout: "RH-PRM
                      mev.ManualParkExpired: "RH-PK-3", mev.QueueDone: "RH-OMW-4",
                      mev.QueueParkExpired: "RH-OMW-4", mev.LockoutEnded: "RH-SAF-3",
                      mev.MissionParkExpired: "RH-OUT-4", mev.MissionEnded: "RH-MSN-4"}
-_CLASS_EVENT = {
-    s.OMS: "OMS", s.OMP: "OMP", s.OJW: "OJW", s.OPK: "OPK", s.OMW: "OMW", s.OMSTOP: "OMSTOP",
-    s.OMLOAD: "OMLOAD", s.OMSTART: "OMSTART", s.OMSTARTPaper: "OMSTART", s.OPOS: "OPOS",
-    s.OSD: "OSD", s.OLOGL: "OLOGL", s.OLOGD: "OLOGD", s.ORWSET: "ORWSET", s.ODVL: "ODVL",
-}
 _LETTER_CLASS = {"G": s.GPRMC, "C": s.Compass, "S": s.OSI, "P": s.OPI, "D": s.DVL, "Y": s.OYSI,
                  "T": s.OCTD, "I": s.OINS}
 _ID_CLASS = {cls.ID: cls for cls in (s.GPRMC, s.Compass, s.OSI, s.OPI, s.DVL, s.OYSI, s.OCTD, s.OINS)}
 
 
-class _OpenWaypoints:
-    """Waypoints of a mission the checker has not seen: as many as asked for, none parks."""
-
-    _WP = Waypoint(0.0, 0.0)
-
-    def __len__(self) -> int:
-        return 1_000_000
-
-    def __getitem__(self, i: int) -> Waypoint:
-        return self._WP
-
-    def __iter__(self):
-        raise TypeError("an open mission has no finite list of waypoints")
-
-
 class OpenCatalog:
-    """The catalogue used without ``--missions``: every safe name is a mission of unknown length.
+    """The catalogue used without ``--missions``: every safe name is a mission of unknown length
+    (:meth:`~helmcheck.model.missions.Mission.open`).
 
     Answers that depend on it are judged INCONCLUSIVE by :class:`VehicleJudge`.
     """
 
     def lookup(self, name: str):
-        m = Mission(name, (Waypoint(0.0, 0.0),))
-        object.__setattr__(m, "waypoints", _OpenWaypoints())
-        return m
+        return Mission.open(name)
 
 
 _NOTE_RE = re.compile(r"^plant: (\w+)\((.*?)\)(?: \[[^\]]*\])? at v=([-0-9.eE]+)\s*$")
@@ -235,7 +211,8 @@ class VehicleJudge:
         """Run the model's timers up to ``t``; remember what a timer released (for blame)."""
         self.last_t = max(self.last_t, t)
         m = self.model
-        if m.timers.due is None or m.timers.due > self.v(t):
+        due = m.next_deadline()
+        if due is None or due > self.v(t):
             return
         before = m.mode
         evs = m.advance(self.v(t))
@@ -289,15 +266,11 @@ class VehicleJudge:
         clauses: tuple = ()
         is_err = isinstance(item, SentenceError)
         if not is_err:
-            ev = _CLASS_EVENT.get(type(item))
-            if type(item) is s.OMWClear:
-                ev = "OMW_CLEAR" if item.waypoint is None else "OMW_CLEAR_WP"
-            if ev is not None:
-                row = select(m.mode, m.phase, ev, m)
-                if row is not None:
-                    clauses = tuple(c for c in row.clauses if not c.startswith("RH-RD"))
-                    if row.error is None:
-                        clauses = (clauses[0],) if clauses else ()
+            row = m.row_for(item)
+            if row is not None:
+                clauses = tuple(c for c in row.clauses if not c.startswith("RH-RD"))
+                if row.error is None:
+                    clauses = (clauses[0],) if clauses else ()
         else:
             rows_phase = m.phase
             clauses = ("RH-SAF-1",) if rows_phase == "lockout" else ("RH-ACK-3",)
@@ -467,11 +440,11 @@ class VehicleJudge:
         t0 = p.t
         now_v = self.v((t0 + t) / 2)
         slack_v = self.v((t - t0) / 2 + self.r)
-        exp = _expect(m, now_v, slack_v)
+        exp = quick_expectation(m, now_v, slack_v)
         findings = exp.check(osi)
         if findings and live and not self.recorder_plant:
             findings = self._infer(osi, now_v, slack_v, findings)
-            exp = _expect(self.model, now_v, slack_v)
+            exp = quick_expectation(self.model, now_v, slack_v)
         cev = Evidence(p.t, ">", p.lineno, p.text)
         if not findings:
             rr = self.recent_release
@@ -543,7 +516,7 @@ class VehicleJudge:
         trial = m.clone()
         for step in range(64):
             trial.plant(cands[0], trial.now if trial.now is not None else now_v)
-            got = _expect(trial, now_v, slack_v).check(osi)
+            got = quick_expectation(trial, now_v, slack_v).check(osi)
             if not got:
                 for _ in range(step + 1):
                     self.model.plant(cands[0], self.model.now if self.model.now is not None else now_v)
@@ -619,27 +592,3 @@ class VehicleJudge:
                                   "are not judged.")
             self.book.untested("RH-MSN-4", "Mission end depends on the mission file (use --missions).")
 
-
-def _expect(m: VehicleModel, now: float, slack: float) -> Expectation:
-    """``expectation(m, now, slack)``, with a fast path when no timer can matter by ``now``."""
-    if m._base is None:
-        t = m.timers
-        near = False
-        for name in t.names():
-            d = t.deadline(name)
-            dur = t.duration(name) or 0.0
-            if d is not None and d - tolerance(dur, slack) <= now:
-                near = True
-                break
-        if not near:
-            base = m.now if m.now is not None and m.now > now else now
-            mode, wp, err, park, srp = m.state(base)
-            p = m.park_remaining(base)
-            if p is None or p <= 0:
-                lo = hi = 0
-            else:
-                lo, hi = max(0, math.floor(max(0.0, p - slack))), math.ceil(p + slack)
-                lo = min(lo, park)
-                hi = max(hi, park)
-            return Expectation(now, slack, (Acceptable(mode, wp, err, srp, lo, hi),))
-    return expectation(m, now, slack)

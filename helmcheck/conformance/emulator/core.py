@@ -10,6 +10,14 @@ seconds, any monotonic origin) into every call and writes what comes back.
   now (the rest waits for :meth:`tick`).
 * ``tick(now) -> bytes`` — time passed: runs model timers and plant events due by ``now``.
 * ``next_wakeup() -> float | None`` — the wall time at which ``tick`` has something to do.
+* ``inject_fault(code, now)`` and ``end_mission(now)`` — what happens on the vehicle off the
+  wire: a safety violation (RH-SAF-1, RH-SAF-5), the running mission stopped (RH-MSN-3).
+* ``queue_reply(reply, now)`` — a sentence in the vehicle's place (a tester's staged answer),
+  sent in order behind the replies already waiting and paced like them.
+* ``mission_running``, ``lockout_active`` — what a tester driving the core needs to know.
+
+The model is built by ``model_factory(profile, missions)`` (default
+:class:`~helmcheck.model.vehicle.VehicleModel`; a test may pass a deliberately faulty one).
 
 Input handling: the framer cuts lines (RH-FRM-6/7); each line is decoded against the profile.
 A valid command goes to the model; a well-framed known command with bad fields goes to the
@@ -24,7 +32,10 @@ everything at once.
 Logs: the wire log (``helmcheck.grammar.capture`` format) records every input line or
 discarded run (``>``/``>~``), every sentence sent (``<``) and notes (``!``) for plant and model
 events, injected faults and link changes; times are wall seconds since ``start``. Accepted
-``$OLOGD`` rows (RH-LOG-2) go to the main log, a CSV file.
+``$OLOGD`` rows (RH-LOG-2) go to the main log, a CSV file. Memory stays bounded: the model
+keeps only its last rows and ``$OPOS`` records (:attr:`VehicleModel.HISTORY`), the core asks it
+for the rows written since it last looked (``log_rows_since``), and the output queue is capped
+(:data:`MAX_OUTBOX_BYTES`).
 """
 
 from __future__ import annotations
@@ -51,8 +62,6 @@ __all__ = ["EmulatorCore", "HistoryEntry", "MainLog", "MAX_OUTBOX_BYTES", "DEFAU
 
 #: Replies waiting for the line are capped; beyond this a flood's replies are dropped (noted).
 MAX_OUTBOX_BYTES = 64 * 1024
-#: Model lists that grow per command are trimmed to this many entries (bounded memory).
-_KEEP_RECORDS = 256
 DEFAULT_UTC0 = 1_767_225_600.0  # 2026-01-01T00:00:00Z
 
 
@@ -103,7 +112,8 @@ class EmulatorCore:
                  log: Optional[WireLogWriter] = None, main_log: Optional[MainLog] = None,
                  settings_path: Optional[Path] = None, utc0: float = DEFAULT_UTC0,
                  params: Optional[PlantParams] = None, history: int = 400,
-                 on_error: Optional[Callable[[str], None]] = None):
+                 on_error: Optional[Callable[[str], None]] = None,
+                 model_factory: Callable[[Profile, Optional[MissionCatalog]], VehicleModel] = VehicleModel):
         self.profile = profile
         self.time_scale = float(time_scale if time_scale is not None else profile.time_scale)
         if self.time_scale <= 0:
@@ -111,7 +121,7 @@ class EmulatorCore:
         self.start = start
         self.utc0 = utc0
         self.plant = Plant(profile, params or PlantParams())
-        self.model = VehicleModel(profile, missions)
+        self.model = model_factory(profile, missions)
         self.framer = Framer(profile.max_line_bytes)
         self.pacer = LinePacer(profile.baud if baud is None else baud)
         self.log = log
@@ -127,7 +137,7 @@ class EmulatorCore:
                       "model_errors": 0, "faults": 0}
         self.last_command: Optional[s.Command] = None
         self.last_command_v: float = 0.0
-        self._log_written = 0  #: model log rows already in the main log
+        self._log_written = 0  #: the model's ``log_row_count`` already in the main log
         if settings_path is not None:
             self._load_settings(settings_path)
         self._push_snapshot()
@@ -183,6 +193,33 @@ class EmulatorCore:
             self._note(now, f"model: {_event_text(e)}")
         self._after_model(now)
         return self._release(now)
+
+    def end_mission(self, now: float) -> bytes:
+        """The running mission stops on the vehicle, off the wire (RH-MSN-3: as an operator's
+        stop; the model takes it as an ``$OMSTOP`` nobody on the line asked for, so its reply is
+        not sent). Nothing happens when no mission runs; returns bytes to send now."""
+        v = self._catch_up(now)
+        if self.model.running:
+            self._model_call(lambda: self.model.receive(s.OMSTOP(0), v), now)
+            self._after_model(now)
+        return self._release(now)
+
+    def queue_reply(self, reply: s.Reply, now: float) -> bytes:
+        """Send ``reply`` in the vehicle's place, behind the replies already waiting and paced
+        like them (RH-ACK-2's transmit time, RH-ACK-6's order); returns bytes to send now."""
+        self._catch_up(now)
+        self._send(format_sentence(reply), now)
+        return self._release(now)
+
+    @property
+    def mission_running(self) -> bool:
+        """A mission runs on the vehicle (modes other than ``S``, RH-MSN-2)."""
+        return self.model.running
+
+    @property
+    def lockout_active(self) -> bool:
+        """The lockout after a safety violation runs (RH-SAF-1)."""
+        return self.model.lockout_active
 
     def connect(self, now: float, info: str = "") -> None:
         """A peer connected (TCP); the model's state carries on."""
@@ -286,25 +323,20 @@ class EmulatorCore:
 
     def _after_model(self, now: float) -> None:
         """Flush the model's pending events to the log and let the plant see the new goal."""
-        evs = self._model_call(lambda: self.model.advance(self.v), now) or ()
+        evs = self._model_call(self.model.drain_events, now) or ()
         for e in evs:
             self._note(now, f"model: {_event_text(e)}")
         self.plant.sync(self.model)
-        m = self.model
-        if len(m.log_rows) > 2 * _KEEP_RECORDS:
-            del m.log_rows[:-_KEEP_RECORDS]
-            self._log_written = len(m.log_rows)
-        if len(m.opos_records) > 2 * _KEEP_RECORDS:
-            del m.opos_records[:-_KEEP_RECORDS]
 
     def _write_main_log(self) -> None:
-        rows = self.model.log_rows
+        """RH-LOG-2: the rows the model wrote since the last call go to the main log."""
+        m = self.model
         if self.main_log is not None:
             p = self.plant
-            for row in rows[self._log_written:]:
+            for row in m.log_rows_since(self._log_written):
                 self.main_log.write(row.at, self.utc0 + row.at, p.lat, p.lon, p.depth,
                                     row.labels, row.values)
-        self._log_written = len(rows)
+        self._log_written = m.log_row_count
 
     # ================================================================ time
     def _catch_up(self, now: float) -> float:

@@ -8,6 +8,11 @@ station at the ``$OPK`` position (RH-PK-2), a queued ``$OMW`` waypoint reached (
 the surface / submerged (RH-RD-10, RH-SAF-4). :meth:`Plant.snapshot` gives the measured values
 the data sentences report (RH-OUT-1..3).
 
+Where to go is the model's answer, never recomputed here: a goal position is the model's
+``navigation_target()`` (what ``$OSI`` field 7 measures, RH-RD-5), and a new remote-control goal
+(a replacing ``$OPK``, a change of the ``$OMW`` queue) is told by the model's
+``control_generation``, so an arrival there is reported again.
+
 Kinematics (a simple, deterministic vehicle; all times are *vehicle* seconds):
 
 * Heading (magnetic, RH-RD-14) slews toward its target at ``turn_rate_dps``; the vehicle
@@ -138,18 +143,19 @@ class Plant:
         if mode == "N" and m.mission is not None:
             i = m.mission_wp
             w = m.mission.waypoints[i]
-            return Target("goto", depth=w.depth, speed_kn=w.speed, lat=w.lat, lon=w.lon,
+            lat, lon = m.navigation_target()
+            return Target("goto", depth=w.depth, speed_kn=w.speed, lat=lat, lon=lon,
                           max_pitch=self.params.default_max_pitch_deg, arrive="wp",
                           key=("wp", m.mission, i))
         if mode == "P":
             return Target("hold", depth=0.0 if m.error_state != "N" else None)
         if mode == "mP" and m.opk is not None:
-            if m.timers.armed("opk"):
+            if m.opk_counting:
                 return Target("hold")
-            c = m.opk
-            return Target("goto", speed_kn=float(c.speed), lat=float(c.lat), lon=float(c.lon),
+            lat, lon = m.navigation_target()
+            return Target("goto", speed_kn=float(m.opk.speed), lat=lat, lon=lon,
                           max_pitch=self.params.default_max_pitch_deg, arrive="station",
-                          key=("opk", id(c), c))
+                          key=("opk", m.control_generation))
         if mode == "A" and m.servo is not None:
             c = m.servo
             return Target("course", depth=self._depth_m(float(c.depth)), speed_kn=float(c.speed),
@@ -162,9 +168,10 @@ class Plant:
             c = m.queue[0]
             d = self._depth_m(float(c.depth1))
             depth = d if d >= 0 else max(0.0, self.params.water_depth_m + d)
-            return Target("goto", depth=depth, speed_kn=float(c.speed), lat=float(c.lat),
-                          lon=float(c.lon), max_pitch=float(c.max_pitch), arrive="queue",
-                          key=("queue", id(c), c, len(m.queue)))
+            lat, lon = m.navigation_target()
+            return Target("goto", depth=depth, speed_kn=float(c.speed), lat=lat, lon=lon,
+                          max_pitch=float(c.max_pitch), arrive="queue",
+                          key=("queue", m.control_generation))
         return Target("hold")
 
     def _primitive(self, c: Any, hold_depth: bool) -> Target:

@@ -25,7 +25,7 @@ from __future__ import annotations
 import time
 from typing import Optional
 
-from hypothesis import HealthCheck, Phase, settings, strategies as st
+from hypothesis import HealthCheck, Phase, seed, settings, strategies as st
 from hypothesis.database import DirectoryBasedExampleDatabase
 from hypothesis.stateful import RuleBasedStateMachine, initialize, precondition, rule, run_state_machine_as_test
 
@@ -230,7 +230,7 @@ def explore(run) -> None:
     motor = min(0x90, bench.max_motor_byte) if not bench.in_water else 0x90
     factory = _machine(state, ["N", "S"], p.mission_waypoints, speed, motor, p.fault_injection == "oxflt")
     if o.seed is not None:
-        factory._hypothesis_internal_use_seed = o.seed  # type: ignore[attr-defined]
+        factory = seed(o.seed)(factory)
     db = DirectoryBasedExampleDatabase(str(run.dir / ".hypothesis"))
     cfg = settings(max_examples=examples, stateful_step_count=steps, deadline=None, database=db,
                    suppress_health_check=list(HealthCheck), report_multiple_bugs=False, print_blob=False,

@@ -141,16 +141,7 @@ class Mirror:
 
     def deadline(self, name: Optional[str] = None) -> Optional[tuple[float, float, str]]:
         """(vehicle deadline, duration, timer name) of the named (or the next) model timer."""
-        t = self.model.timers
-        if name is None:
-            e = t.earliest()
-            if e is None:
-                return None
-            name = e[1]
-        d = t.deadline(name)
-        if d is None:
-            return None
-        return d, t.duration(name) or 0.0, name
+        return self.model.timer(name)
 
     # ------------------------------------------------------------------ commands
     def receive(self, item, t_ack: float, latency: float, observed: Optional[list] = None) -> list:
@@ -225,14 +216,14 @@ class Mirror:
                 c.plant(e, vt)
                 replies = c.receive(item, vt)
                 if observed is None or same_replies(replies, observed):
-                    if isinstance(item, s.OPK) and c.mode == "mP" and c.timers.armed("opk"):
-                        c.timers.disarm("opk")
+                    if isinstance(item, s.OPK) and c.mode == "mP" and c.opk_counting:
+                        c.await_on_station()
                     out.append((c, replies))
         return out
 
     def _adopt(self, c: VehicleModel, item) -> None:
-        if isinstance(item, s.OPK) and c.mode == "mP" and c.timers.armed("opk"):
-            c.timers.disarm("opk")  # countdown adopted when the vehicle shows it (module doc)
+        if isinstance(item, s.OPK) and c.mode == "mP" and c.opk_counting:
+            c.await_on_station()  # countdown adopted when the vehicle shows it (module doc)
         self.model = c
 
     # ------------------------------------------------------------------ observations
@@ -276,7 +267,7 @@ class Mirror:
     def _countdown_seen(self, osi: s.OSI, vt: float, wall_slack: float) -> None:
         """An ``$OPK`` park shown counting: adopt "on station" at the start the display implies."""
         m = self.model
-        if not (m.mode == "mP" and osi.mode == "mP" and m.phase == "none" and not m.timers.armed("opk")
+        if not (m.mode == "mP" and osi.mode == "mP" and m.phase == "none" and not m.opk_counting
                 and 0 < osi.park_time < m.opk_seconds):
             return
         start = vt - (m.opk_seconds - osi.park_time) - 0.5
@@ -310,7 +301,7 @@ class Mirror:
             c = m.clone()
             c.advance(vt)
             self._plant_from(c, osi)
-            c._base = None
+            c.drop_checkpoint()
             return c
 
         def events(*evs):
