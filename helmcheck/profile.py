@@ -11,7 +11,12 @@ Keys beyond §10 (each a ``[D]`` of the profile, documented in the README):
 - ``waypoint_base`` (RH-JW-1), ``omw_clear_keywords`` (RH-OMW-3, RH-RD-4),
 - ``safety_action`` (RH-SAF-4 default ``SafetyAction``), ``on_station_m`` (RH-RD-5),
 - ``gps_fix_depth_m`` (RH-RD-10), ``opk_max_distance_m`` (RH-PK-1, RH-RD-9),
-- ``vehicle_name``: the name the emulator reports in ``$OSI`` field 18.
+- ``vehicle_name``: the name the emulator reports in ``$OSI`` field 18,
+- ``end_mission`` (RH-MSN-4): a short mission present on the vehicle whose end a run can wait
+  for (default ``short.mis``, shipped by the emulator); ``""`` = none, RH-MSN-4 NOT-TESTED,
+- ``srp_mission`` (RH-SAF-4, RH-RD-6): an SRP mission present on the vehicle, given at start so
+  that ``SafetyAction = srp`` can be exercised (default ``srp.mis``, shipped by the emulator);
+  ``""`` = none, the ``srp`` branch NOT-TESTED.
 """
 
 from __future__ import annotations
@@ -77,6 +82,8 @@ class Profile:
     gps_fix_depth_m: float = 0.25
     opk_max_distance_m: float = 16093.0
     vehicle_name: str = "IVER3-EMU"
+    end_mission: str = "short.mis"
+    srp_mission: str = "srp.mis"
     name: str = "rh5"  #: where the profile came from (file name or "rh5"); not a TOML key
 
     @property

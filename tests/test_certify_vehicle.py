@@ -57,7 +57,8 @@ def _assert_bench_safe(path: Path, max_motor=0x90, max_speed=Decimal("0.5")):
 # ---------------------------------------------------------------------------- the emulator
 
 def test_builtin_emulator_certifies(tmp_path):
-    """Every vehicle clause PASS or NOT-TESTED with a reason; all report formats written."""
+    """Every vehicle clause PASS (RH-MSN-4 on the profile's end_mission, RH-SAF-4 in both SafetyAction
+    branches); all report formats written."""
     prof = tmp_path / "emu.toml"
     prof.write_text('fault_injection = "oxflt"\nbaud = 115200\n')
     out = tmp_path / "rep"
@@ -73,7 +74,11 @@ def test_builtin_emulator_certifies(tmp_path):
     for c in r["clauses"]:
         assert c["reason"], c
     nt = {c["id"] for c in r["clauses"] if c["verdict"] == "not-tested"}
-    assert nt <= {"RH-MSN-4"}, nt
+    assert not nt, nt
+    verdicts = {c["id"]: c["verdict"] for c in r["clauses"]}
+    assert verdicts["RH-MSN-4"] == "pass" and verdicts["RH-SAF-4"] == "pass"
+    cases = {c["id"]: c["verdict"] for c in r["cases"]}
+    assert cases["V-47"] == "pass" and cases["V-61"] == "pass" and cases["V-63"] == "pass", cases
     for name in ("results.json", "wire.log", "report.html", "junit.xml", "report.md"):
         assert (out / name).stat().st_size > 0, name
     assert r["settings"]["bench_safety"]["enforced"] is True
@@ -228,3 +233,14 @@ def test_unopenable_port_is_inconclusive_with_report(tmp_path):
     r = load_results(tmp_path / "r")
     assert r["verdict"] == "inconclusive"
     assert any("cannot open" in c["reason"] for c in r["clauses"])
+
+
+# ---------------------------------------------------------------------------- RH-MSN-4 bounds
+
+def test_RH_MSN_4_an_end_mission_too_long_for_the_cap_is_inconclusive(tmp_path):
+    """The vehicle reports hours left (the long test mission named as end_mission): not a FAIL."""
+    with serve(lambda start: make_core(None, K, start)) as port:
+        out = certify(_opts(port, tmp_path, select=["RH-MSN-4"],
+                            profile=EMU_PROFILE.replace(time_scale=K, end_mission=EMU_PROFILE.mission)))
+    c = next(c for c in out.results["clauses"] if c["id"] == "RH-MSN-4")
+    assert c["verdict"] == "inconclusive" and "past the cap" in c["reason"], c

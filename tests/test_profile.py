@@ -53,3 +53,24 @@ def test_rh4_defaults_to_feet_and_shorter_osi(tmp_path):
     p = load_profile(_write(tmp_path, "protocol = 'rh4'"))
     assert p.depth_unit == "ft" and p.osi_fields == 17
     assert abs(p.max_depth - 328.08) < 0.01
+
+
+def test_end_and_srp_missions_are_string_keys(tmp_path):
+    """RH-MSN-4 ``end_mission`` and RH-SAF-4 ``srp_mission``: the emulator's missions by default,
+    any name or empty (none) in a file, and refused when not a string."""
+    assert (DEFAULT.end_mission, DEFAULT.srp_mission) == ("short.mis", "srp.mis")
+    p = load_profile(_write(tmp_path, "end_mission = 'sub/end.mis'\nsrp_mission = ''"))
+    assert (p.end_mission, p.srp_mission) == ("sub/end.mis", "")
+    for key in ("end_mission", "srp_mission"):
+        with pytest.raises(ProfileError, match=f"key '{key}': must be a string"):
+            load_profile(_write(tmp_path, f"{key} = 3"))
+
+
+def test_empty_end_or_srp_mission_makes_its_case_not_tested():
+    from helmcheck.conformance.vehicle.cases import CASES, unmet_need
+    end = next(c for c in CASES if c.subject == "RH-MSN-4")
+    srp = next(c for c in CASES if c.subject == "RH-SAF-4" and "srp_mission" in c.needs)
+    emu = DEFAULT.replace(fault_injection="oxflt")
+    assert unmet_need(end, emu) is None and unmet_need(srp, emu) is None
+    assert "end_mission" in unmet_need(end, emu.replace(end_mission=""))
+    assert "srp_mission" in unmet_need(srp, emu.replace(srp_mission=""))

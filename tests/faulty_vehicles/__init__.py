@@ -210,6 +210,24 @@ class PrimitiveNeverNeutral(_Model):
         return o
 
 
+class SafetyActionSrpIgnored(_Model):
+    """RH-SAF-4: with SafetyAction srp and an SRP given at start, it parks at the surface anyway."""
+
+    @property
+    def srp_ready(self) -> bool:
+        return False
+
+
+class MissionNeverEnds(_Model):
+    """RH-MSN-4: the last waypoint reached (and parked), the mission goes on in N; it never ends."""
+
+    def _fire(self, event, now):
+        if event in ("wp_reached", "park_expired") and self.mission is not None and not self.more_wps:
+            if event == "park_expired" or not self.wp_parks:
+                return None
+        return super()._fire(event, now)
+
+
 # ============================================================================ registry
 
 @dataclass(frozen=True)
@@ -220,6 +238,7 @@ class Mutant:
     core: type = EmulatorCore
     model: type | None = None
     profile_changes: tuple = ()  #: (key, value) pairs for the *vehicle's* profile
+    time_scale: float = 25.0  #: k for the emulator and the tester (higher for long missions)
 
 
 MUTANTS = (
@@ -239,6 +258,8 @@ MUTANTS = (
     Mutant("omload-accepts-dotdot", "RH-MSN-1", ("RH-MSN-1",), core=OmloadDotDot),
     Mutant("wrong-err-number", "RH-ACK-3", ("RH-ACK-3",), model=WrongErrNumber),
     Mutant("primitive-never-neutral", "RH-PRM-4", ("RH-PRM-4",), model=PrimitiveNeverNeutral),
+    Mutant("safety-action-srp-ignored", "RH-SAF-4", ("RH-SAF-4",), model=SafetyActionSrpIgnored),
+    Mutant("mission-never-ends", "RH-MSN-4", ("RH-MSN-4",), model=MissionNeverEnds, time_scale=60.0),
 )
 
 

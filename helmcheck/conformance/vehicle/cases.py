@@ -9,6 +9,14 @@ for every reply and every ``$OSI`` is the mirrored reference model (:mod:`.mirro
 ``expect`` text a step carries is for people and replay files, and the interpreter checks that
 it agrees with the model (a disagreement is a tester fault: INCONCLUSIVE, never FAIL).
 
+Two cases start a mission other than the plain test mission. RH-MSN-4 (V-47) starts the
+profile's ``end_mission`` by name and waits for its end (:class:`MissionEnd`). The ``srp``
+branch of RH-SAF-4 (V-63; V-61 is the ``park`` branch) writes ``SafetyAction = srp`` in ``S``
+(:class:`WithSetting`, written back afterwards), starts the test mission with the profile's
+``srp_mission`` as its SRP (RH-RD-6), raises a violation and checks the vehicle runs the SRP
+at the surface (RH-RD-12, RH-RD-13). An empty ``end_mission`` or ``srp_mission`` makes its case
+NOT-TESTED with that reason.
+
 Templates in step text: ``{mission}`` the profile's mission, ``{speed}`` a speed within the
 bench-safety limit, ``{motor}`` a motor byte within it, ``{lat}``/``{lon}`` the vehicle's last
 reported position, ``{near_lat}`` a point ~110 m north of it, ``{far_lat}`` one ~111 km north,
@@ -37,8 +45,9 @@ from .judge import CaseFail, CaseInconclusive, CaseNotTested
 from .safety import BenchSafetyRefused
 from .session import Session, frame
 
-__all__ = ["Case", "Send", "Raw", "Poll", "Wait", "Settle", "Until", "Fault", "Start", "Burst",
-           "SetRoundTrip", "Octd", "CASES", "select_cases", "run_case", "raw_line", "context"]
+__all__ = ["Case", "Send", "Raw", "Poll", "Wait", "Settle", "Until", "Fault", "Start", "MissionEnd",
+           "WithSetting", "Burst", "SetRoundTrip", "Octd", "CASES", "select_cases", "run_case", "raw_line",
+           "context"]
 
 
 # ============================================================================ step vocabulary
@@ -74,6 +83,7 @@ class Poll:
     park_below: Optional[int] = None
     park: Optional[int] = None
     lat_near: Optional[str] = None
+    srp_active: Optional[bool] = None
 
 
 @dataclass(frozen=True)
@@ -105,6 +115,7 @@ class Until:
     clause: Optional[str] = None
     estimate: bool = False
     surface: bool = False
+    srp_active: Optional[bool] = None
 
 
 @dataclass(frozen=True)
@@ -116,10 +127,36 @@ class Fault:
 
 @dataclass(frozen=True)
 class Start:
-    """Start the profile's mission by name (rh5 form); ``ignore_gps`` sets the first flag."""
+    """Start a mission by name (rh5 form): the profile key ``which`` names it (``mission``, the
+    test mission, or ``end_mission``); ``srp`` gives the profile's ``srp_mission`` as the SRP
+    name (``$OMSTART,…,<name>,<srp>``, RH-RD-6); ``ignore_gps`` sets the first flag."""
 
     ignore_gps: int = 0
     clause: str = "RH-MSN-2"
+    which: str = "mission"
+    srp: bool = False
+
+
+@dataclass(frozen=True)
+class MissionEnd:
+    """Wait for the running mission to end (``S``, RH-MSN-4): :meth:`~.session.Session.mission_end`
+    with a fixed cap of ``cap_v`` vehicle seconds and a case budget of ``wall_s`` wall seconds."""
+
+    clause: str = "RH-MSN-4"
+    cap_v: float = 1800.0
+    wall_s: float = 600.0
+
+
+@dataclass(frozen=True)
+class WithSetting:
+    """Read ``setting`` (in ``S``), write state 1 and ``value``, run ``steps``; then stop the
+    mission (the verified reset, waiting out a lockout) and write back what was read, so later
+    cases meet the vehicle as it was (RH-SET-1/2)."""
+
+    setting: str
+    value: str
+    steps: tuple
+    clause: str = "RH-SET-1"
 
 
 @dataclass(frozen=True)
@@ -393,9 +430,10 @@ CASES: tuple[Case, ...] = (
        Send(OMS), Send("OMSTOP,0"), Poll(mode="S", actuators="8080808080"), Start(),
        Send("OMP,8a8a7676{motor},00,30"), Send("OMSTOP,0"), Poll(mode="S", actuators="8080808080")),
     _c("V-47", "RH-MSN-4", "The mission ends at its last waypoint",
-       "after the last waypoint (and its park) the mode is S", "N",
-       Send("OJW,{wp_last}"), Until("the end of the test mission", mode="S", budget_v=3600.0,
-                                    clause="RH-MSN-4", estimate=True)),
+       "the profile's end_mission, started by name, ends in S after its last waypoint (and its park), "
+       "within twice the time left the vehicle reports (remaining time, distance and speed) + 60 s, "
+       "or a cap of 1800 s of vehicle time", "S",
+       Start(which="end_mission", clause="RH-MSN-4"), MissionEnd("RH-MSN-4"), needs=("end_mission",)),
     # --- §6 read/write -----------------------------------------------------------------------
     _c("V-48", "RH-POS-1", "$OPOS forms",
        "accepted with empty or given conductivity/temperature and a sixth empty field, in S and N; "
@@ -461,6 +499,15 @@ CASES: tuple[Case, ...] = (
        Fault("Sfp"), Settle("RH-SAF-4", "lockout"),
        Until("the surface after the lockout", mode="P", budget_v=600.0, clause="RH-SAF-4"),
        Poll(mode="P", park=0, error_state="Sfp"), needs=("oxflt", "safety_action:park")),
+    _c("V-63", "RH-SAF-4", "At the surface SafetyAction srp runs the SRP",
+       "with SafetyAction written srp in S and the test mission started with the profile's srp_mission, "
+       "a violation ends at the surface in the SRP: mode N, next waypoint 0, $OSI field 17 True, the "
+       "code kept (RH-RD-12, RH-RD-13); SafetyAction is written back afterwards", "S",
+       WithSetting("SafetyAction", "srp", (
+           Start(srp=True, clause="RH-SAF-4"), Fault("Sfp"), Settle("RH-SAF-4", "lockout"),
+           Until("the SRP after the surface", mode="N", srp_active=True, budget_v=600.0, clause="RH-SAF-4"),
+           Poll("RH-SAF-4", mode="N", error_state="Sfp", srp_active=True))),
+       needs=("oxflt", "srp_mission", "srp_field", "cmd:ORWSET")),
     # --- §8 time ---------------------------------------------------------------------------------
     _c("V-62", "RH-TIM-1 RH-TIM-2", "Durations hold at the declared time scale",
        "a 20 s servo timeout and a 10 s primitive timeout end within max(0.5 s, 5 %) plus the "
@@ -493,6 +540,16 @@ def unmet_need(case: Case, profile: Profile) -> Optional[str]:
             return f"the profile's osd_letters lack {arg}"
         if kind == "safety_action" and profile.safety_action != arg:
             return f"the profile's safety_action is {profile.safety_action}, this case needs {arg}"
+        if kind == "end_mission" and not profile.end_mission:
+            return ("the profile names no end_mission (a short mission whose end a run can wait for): "
+                    "the test mission is too long to reach its end (RH-MSN-4)")
+        if kind == "srp_mission" and not profile.srp_mission:
+            return ("the profile names no srp_mission: the srp branch of SafetyAction cannot be "
+                    "exercised (RH-SAF-4)")
+        if kind == "srp_field" and profile.protocol != "rh5" and profile.osi_fields < 16:
+            return f"the profile's $OSI has {profile.osi_fields} fields: none shows whether the SRP runs"
+        if kind == "cmd" and arg not in profile.commands:
+            return f"the profile does not claim {arg}"
     cmds = {b.body.split(",")[0] for b in case.steps if isinstance(b, Send)}
     missing = [c for c in cmds if c in s.__dict__ and c not in profile.commands and c != "OSD"]
     if missing:
@@ -605,6 +662,15 @@ def _poll_checks(session: Session, st: Poll, ctx: dict, clause: str) -> None:
         want = float(_fill(st.lat_near, ctx))
         if abs(float(o.lat) - want) > 0.0004:
             raise bad(f"latitude is {o.lat}, expected about {want:.6f}")
+    if st.srp_active is not None:
+        flag = srp_flag(o, session.profile)
+        if flag is not None and flag != ("True" if st.srp_active else "False"):
+            raise bad(f"SRP active (field 17) is {flag}, expected {st.srp_active}")
+
+
+def srp_flag(o, profile: Profile) -> Optional[str]:
+    """The SRP-active field of an ``$OSI``: rh5 field 17, older profiles field 16; ``None`` if absent."""
+    return o.srp_active if profile.protocol == "rh5" else o.battery
 
 
 def _here(session: Session, ctx: dict) -> None:
@@ -631,21 +697,24 @@ def run_step(session: Session, st, ctx: dict, clause: str) -> None:
         session.settle(st.clause, st.timer, frame(_fill(st.probe, ctx)) if st.probe else None)
     elif isinstance(st, Until):
         fix = session.profile.gps_fix_depth_m
+        srp = None if st.srp_active is None else ("True" if st.srp_active else "False")
 
         def pred(o, st=st):
             return ((st.mode is None or o.mode == st.mode)
                     and (st.park_below is None or o.park_time < st.park_below)
-                    and (not st.surface or (o.depth is not None and float(o.depth) <= fix)))
+                    and (not st.surface or (o.depth is not None and float(o.depth) <= fix))
+                    and (srp is None or srp_flag(o, session.profile) == srp))
         session.until(st.what, pred, st.budget_v, st.clause or clause, estimate=st.estimate)
         _here(session, ctx)
     elif isinstance(st, Fault):
         session.exchange(frame(f"OXFLT,{st.code}"), "RH-SAF-5")
     elif isinstance(st, Start):
-        ex = session.exchange(frame(f"OMSTART,{st.ignore_gps},0,0,0,{session.profile.mission},"), st.clause)
-        if not ex.accepted:
-            raise session.fail(st.clause, f"the test mission did not start: {ex.ack}")
-        session.poll(st.clause)
+        _start(session, st, ctx)
+    elif isinstance(st, MissionEnd):
+        session.mission_end(f"the end of {session.profile.end_mission}", st.clause, st.cap_v, st.wall_s)
         _here(session, ctx)
+    elif isinstance(st, WithSetting):
+        _with_setting(session, st, ctx, clause)
     elif isinstance(st, Burst):
         session.burst([frame(_fill(b, ctx)) for b in st.bodies], st.clause)
     elif isinstance(st, SetRoundTrip):
@@ -662,6 +731,64 @@ def run_step(session: Session, st, ctx: dict, clause: str) -> None:
                                           f"$OPOS gave {st.conductivity}, {st.temperature} (always applied)")
     else:  # pragma: no cover
         raise TypeError(st)
+
+
+def _start(session: Session, st: Start, ctx: dict) -> None:
+    """``$OMSTART`` by name (rh5 form, RH-MSN-2, RH-RD-6). The test mission must start (else
+    FAIL); a mission named by ``end_mission`` or an SRP named by ``srp_mission`` the vehicle does
+    not have is the profile's mistake (INCONCLUSIVE, with the vehicle's answer)."""
+    p = session.profile
+    name = getattr(p, st.which)
+    srp = p.srp_mission if st.srp else ""
+    plain = st.which == "mission" and not srp
+    ex = session.exchange(frame(f"OMSTART,{st.ignore_gps},0,0,0,{name},{srp}"), st.clause, judge=plain)
+    if not ex.accepted:
+        if plain:
+            raise session.fail(st.clause, f"the test mission did not start: {ex.ack}")
+        named = f"{st.which} {name!r}" + (f" with srp_mission {srp!r}" if srp else "")
+        raise CaseInconclusive(f"the profile's {named} did not start: {_ack(ex.ack)} (is it on the "
+                               f"vehicle?)", st.clause)
+    session.poll(st.clause)
+    _here(session, ctx)
+
+
+def _with_setting(session: Session, st: WithSetting, ctx: dict, clause: str) -> None:
+    """:class:`WithSetting`: RH-SET-1 read and write in ``S``; what was read is always written back."""
+    ex = session.exchange(frame(f"ORWSET,{st.setting},R"), st.clause)
+    if not ex.accepted:
+        raise session.fail(st.clause, f"reading {st.setting} in S was refused: {ex.ack}")
+    orig = list(ex.ack.extra[2:])  # type: ignore[union-attr]
+    if not orig and st.setting == "SafetyAction":
+        orig = ["1", session.profile.safety_action]
+    w = session.exchange(frame(f"ORWSET,{st.setting},W,1,{st.value}"), st.clause)
+    if not w.accepted:
+        raise session.fail(st.clause, f"writing {st.setting} = {st.value} in S was refused: {w.ack}")
+    try:
+        for sub in st.steps:
+            run_step(session, sub, ctx, clause)
+    except (CaseFail, CaseInconclusive, CaseNotTested):
+        _restore_setting(session, st, orig, quiet=True)
+        raise
+    _restore_setting(session, st, orig, quiet=False)
+
+
+def _ack(a) -> str:
+    return "no $ACK" if a is None else "$ACK," + ",".join(map(str, (a.type, a.status, a.err, *a.extra)))
+
+
+def _restore_setting(session: Session, st: WithSetting, orig: list, quiet: bool) -> None:
+    """Stop the mission (verified reset) and write ``orig`` back; ``quiet``: a case already ended."""
+    if not orig:
+        return
+    try:
+        session.reset(mission=False)
+        ex = session.exchange(frame(f"ORWSET,{st.setting},W,{','.join(orig)}"), st.clause, judge=False)
+        if not ex.accepted:
+            raise CaseInconclusive(f"could not write {st.setting} back to {','.join(orig)}: {_ack(ex.ack)}",
+                                   st.clause)
+    except (CaseFail, CaseInconclusive):
+        if not quiet:
+            raise
 
 
 def _set_round_trip(session: Session, st: SetRoundTrip) -> None:

@@ -15,9 +15,13 @@ the declared time scale k, RH-TIM-2). It answers two questions:
 What the tester cannot see is the plant (motion). The model needs plant events (a mission
 waypoint reached, on station at an ``$OPK`` position, a queued waypoint reached, the surface);
 the mirror *adopts* one when, and only when, the vehicle's ``$OSI`` is explained by it and not
-without it, at the earliest moment it can have happened (the previous poll). It also learns the
-test mission's park times from the first mission park it sees: the tester knows the mission
-only by name and waypoint count (profile ``mission``, ``mission_waypoints``).
+without it, at the earliest moment it can have happened (the previous poll). It also learns a
+mission's park times from the first mission park it sees: the tester knows the test mission
+only by name and waypoint count (profile ``mission``, ``mission_waypoints``), and the short
+mission and the SRP mission (profile ``end_mission``, ``srp_mission``) only by name
+(:class:`StubCatalog`). Those two are open-length missions until the vehicle shows their end:
+an ``S`` that only "the last waypoint was the present one" explains is adopted as the end
+(RH-MSN-4), judged with the same RH-OUT-4 tolerance (a mission park still running is not an end).
 
 Decision (spec open): an ``$OPK`` countdown starts when the vehicle shows it counting (the
 tester cannot see "on station"); the uncertainty this adds is part of the slack.
@@ -29,13 +33,13 @@ from dataclasses import dataclass, field
 from typing import Optional
 
 from ...grammar import sentences as s
-from ...model.missions import Mission, MissingMission, Waypoint, normalise_name
+from ...model.missions import Mission, MissingMission, OpenWaypoints, Waypoint, normalise_name
 from ...model.plant import OnStation, QueueWaypointReached, WaypointReached
 from ...model.timers import tolerance
 from ...model.vehicle import VehicleModel
 from ...profile import Profile
 
-__all__ = ["Mirror", "StubCatalog", "same_replies", "JITTER_S"]
+__all__ = ["Mirror", "StubCatalog", "StubMission", "same_replies", "JITTER_S"]
 
 #: Wall seconds of scheduling jitter the observer allows on top of what it measures.
 JITTER_S = 0.03
@@ -43,28 +47,43 @@ _FT = 0.3048
 
 
 @dataclass
-class StubCatalog:
-    """The vehicle's missions as the tester knows them: the profile's test mission, by name.
+class StubMission:
+    """One mission as the tester knows it: by name, with its waypoint count when known.
 
     Waypoint positions are unknown (the model does not need them to judge); park times are
-    learnt from observation (``None`` = not seen yet, taken as 0 until then).
+    learnt from observation (``None`` = not seen yet, taken as 0 until then). A mission of
+    unknown length (``waypoints`` None) is an open-length mission
+    (:meth:`~helmcheck.model.missions.Mission.open`) until its end is seen (RH-MSN-4):
+    :meth:`ended_at` then gives it its length.
     """
 
     name: str
-    waypoints: int
+    waypoints: Optional[int] = None
     parks: dict = field(default_factory=dict)
     _cache: Optional[Mission] = None
 
-    @classmethod
-    def for_profile(cls, profile: Profile) -> "StubCatalog":
-        return cls(normalise_name(profile.mission), max(1, profile.mission_waypoints))
-
     def mission(self) -> Mission:
         if self._cache is None:
-            wps = tuple(Waypoint(41.52 + 0.002 * (i + 1), -71.32, 2.0, 2.0, float(self.parks.get(i) or 0.0))
-                        for i in range(self.waypoints))
-            self._cache = Mission(self.name, wps)
+            if self.waypoints is None:
+                self._cache = Mission(self.name, _LearntOpenWaypoints(self.parks))
+            else:
+                self._cache = self._finite(self.waypoints)
         return self._cache
+
+    def _finite(self, n: int) -> Mission:
+        wps = tuple(Waypoint(41.52 + 0.002 * (i + 1), -71.32, 2.0, 2.0, float(self.parks.get(i) or 0.0))
+                    for i in range(n))
+        return Mission(self.name, wps)
+
+    def ended_at(self, last: int) -> Mission:
+        """The mission with ``last`` as its last waypoint (nothing is learnt yet)."""
+        return self._finite(last + 1)
+
+    def learn_end(self, last: int) -> None:
+        """RH-MSN-4: the vehicle showed the end after waypoint ``last``."""
+        if self.waypoints is None:
+            self.waypoints = last + 1
+            self._cache = None
 
     def learn_park(self, index: int, seconds: float) -> None:
         if self.parks.get(index) is None:
@@ -79,10 +98,71 @@ class StubCatalog:
                 return i
         return None
 
+
+class _LearntOpenWaypoints(OpenWaypoints):
+    """Open-length waypoints (:class:`~helmcheck.model.missions.OpenWaypoints`) with the park
+    times learnt so far."""
+
+    __slots__ = ("parks",)
+
+    def __init__(self, parks: dict):
+        self.parks = dict(parks)
+
+    def __getitem__(self, i: int) -> Waypoint:
+        park = self.parks.get(i)
+        return Waypoint(0.0, 0.0, park_s=float(park)) if park else self._WP
+
+
+class StubCatalog:
+    """The vehicle's missions as the tester knows them, by name (profile ``mission``,
+    ``end_mission``, ``srp_mission``).
+
+    The test mission has the profile's ``mission_waypoints``; the others are of unknown length
+    (:class:`StubMission`). ``name``, ``waypoints``, ``parks``, :meth:`mission`,
+    :meth:`learn_park` and :attr:`park_waypoint` speak of the test mission.
+    """
+
+    def __init__(self, name: str, waypoints: int, others: tuple = ()):
+        self.main = StubMission(name, max(1, waypoints))
+        self.entries = {name: self.main}
+        for other in others:
+            if other and other not in self.entries:
+                self.entries[other] = StubMission(other)
+
+    @classmethod
+    def for_profile(cls, profile: Profile) -> "StubCatalog":
+        others = tuple(normalise_name(n) for n in (profile.end_mission, profile.srp_mission) if n)
+        return cls(normalise_name(profile.mission), profile.mission_waypoints, others)
+
+    @property
+    def name(self) -> str:
+        return self.main.name
+
+    @property
+    def waypoints(self) -> int:
+        return self.main.waypoints  # type: ignore[return-value]
+
+    @property
+    def parks(self) -> dict:
+        return self.main.parks
+
+    @property
+    def park_waypoint(self) -> Optional[int]:
+        return self.main.park_waypoint
+
+    def mission(self) -> Mission:
+        return self.main.mission()
+
+    def learn_park(self, index: int, seconds: float) -> None:
+        self.main.learn_park(index, seconds)
+
+    def entry(self, name: str) -> Optional[StubMission]:
+        """The stub of the mission called ``name``, or ``None``."""
+        return self.entries.get(normalise_name(name))
+
     def lookup(self, name: str):
-        if normalise_name(name) == self.name:
-            return self.mission()
-        return MissingMission(name)
+        e = self.entry(name)
+        return e.mission() if e is not None else MissingMission(name)
 
 
 def _key(r: s.Reply) -> tuple:
@@ -285,7 +365,10 @@ class Mirror:
         tp = max(m.now if m.now is not None else 0.0, self.v(tp_wall))
         gap = max(0.0, vt - tp)
 
+        learnt: list = []  #: what a build would teach the stubs, applied only if it explains osi
+
         def trial(name: str, build) -> Optional[str]:
+            learnt.clear()
             c = build()
             if c is None:
                 return None
@@ -294,6 +377,8 @@ class Mirror:
                 self.model = c
                 self.plant_slack = max(self.plant_slack, gap)
                 self.adopted.append(f"{name} at v={tp:.1f}")
+                for learn in learnt:
+                    learn()
                 return name
             return None
 
@@ -312,25 +397,62 @@ class Mirror:
                 return c
             return build
 
+        def swap(c: VehicleModel, old: Mission, mission: Mission) -> VehicleModel:
+            """``c`` with the stub mission ``old`` replaced by what was learnt about it."""
+            if c.mission is old:
+                c.mission = mission
+            if c.loaded is old:
+                c.loaded = mission
+            if c.srp_mission is old:
+                c.srp_mission = mission
+            return c
+
         def learn_park():
             wp = m.mission_wp
-            if m.mission is None or m.mode != "N" or self.stub.parks.get(wp) is not None:
+            entry = self.stub.entry(m.mission.name) if m.mission is not None else None
+            if entry is None or m.mode != "N" or entry.parks.get(wp) is not None:
                 return None
             if osi.mode == "P" and osi.next_waypoint == wp:
-                self.stub.learn_park(wp, osi.park_time + gap)
+                entry.learn_park(wp, osi.park_time + gap)
             elif osi.mode == "N" and osi.next_waypoint == wp + 1:
-                self.stub.learn_park(wp, 0.0)
+                entry.learn_park(wp, 0.0)
             else:
                 return None
-            mission = self.stub.mission()
-            c = m.clone()
-            c.mission = mission
-            c.loaded = mission
+            c = swap(m.clone(), m.mission, entry.mission())  # type: ignore[arg-type]
             c.plant(WaypointReached(wp), tp)
             return c
 
+        def mission_end():
+            """RH-MSN-4 for a mission of unknown length: ``S`` where its end explains it.
+
+            The last waypoint is the one the model is at: reached now (``N``), or parked on and
+            its park run out (``P``, or ``N`` just after that park ran out: the checkpoint).
+            """
+            run = m.mission
+            if osi.mode != "S" or m.phase != "none" or run is None or not run.is_open:
+                return None
+            entry = self.stub.entry(run.name)
+            if entry is None:
+                return None
+            base = m.checkpoint
+            if base is not None and base.mode == "P" and base.mission is run and m.mode == "N":
+                last = base.mission_wp
+                c = swap(base.clone(), run, entry.ended_at(last))
+            elif m.mode == "P":
+                last = m.mission_wp
+                c = swap(m.clone(), run, entry.ended_at(last))
+            elif m.mode == "N":
+                last = m.mission_wp
+                c = swap(m.clone(), run, entry.ended_at(last))
+                c.plant(WaypointReached(last), tp)
+            else:
+                return None
+            learnt.append(lambda: entry.learn_end(last))
+            return c
+
         for name, build in (("surface/depth", surfaced), ("waypoint reached", events(WaypointReached())),
-                            ("learnt mission park", learn_park), ("on station", events(OnStation())),
+                            ("learnt mission park", learn_park), ("mission end", mission_end),
+                            ("on station", events(OnStation())),
                             ("queue waypoint reached", events(QueueWaypointReached())),
                             ("two waypoints reached", events(WaypointReached(), WaypointReached()))):
             got = trial(name, build)

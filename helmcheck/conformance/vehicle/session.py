@@ -14,6 +14,8 @@ what cases (:mod:`.cases`) and exploration (:mod:`.explore`) are made of:
   RH-TIM-2), polled and judged all along; ``settle`` waits past a model timer's deadline plus
   the RH-TIM-1 tolerance widened by the measured slack, and reports INCONCLUSIVE when that
   slack is too large for the duration to be judged.
+* :meth:`Session.mission_end` — poll until the running mission ends (RH-MSN-4), within a bound
+  derived from the time left, distance and speed the vehicle reports, or a fixed cap.
 * :meth:`Session.reset` — the verified reset between cases: ``$OMSTOP,0`` (waiting out a
   lockout), ``$OSI`` shows ``S``; then the profile's mission started by name with the rh5 form
   ``$OMSTART,0,0,0,0,<mission>,`` and ``N`` verified.
@@ -38,10 +40,13 @@ from .judge import Book, CaseFail, CaseInconclusive, CaseNotTested
 from .link import LinkLost, Rx, TesterLink
 from .mirror import Mirror, same_replies
 
-__all__ = ["Session", "Exchange", "LinkSilent", "frame", "ACK_GRACE_S"]
+__all__ = ["Session", "Exchange", "LinkSilent", "frame", "ACK_GRACE_S", "END_MARGIN_V"]
 
 #: Wall seconds of host jitter allowed on top of the ACK window and transmit time (RH-ACK-2).
 ACK_GRACE_S = 0.25
+#: Vehicle seconds added to twice the time a vehicle says its mission has left (RH-MSN-4).
+END_MARGIN_V = 60.0
+_KN = 1852.0 / 3600.0
 _INTERRUPTS = ("OMS", "OMP", "OPK", "OMW", "OJW")
 _UNSOLICITED_ACKS = (13, 14)
 
@@ -496,6 +501,79 @@ class Session:
                 raise CaseNotTested(f"the vehicle did not reach {what} within {self.now() - t0:.1f} s "
                                     f"({budget_v:g} s of vehicle time budgeted)")
             self.link.sleep(max(self.poll_gap, 0.05))
+
+    def mission_end(self, what: str, clause: str, cap_v: float, wall_budget: float) -> s.OSI:
+        """RH-MSN-4: poll until the running mission ends (``S``); FAIL when it does not in time.
+
+        The bound is derived from what the vehicle reports: twice the time it says is left, plus
+        :data:`END_MARGIN_V` (turns, dives, slowing near a waypoint); each poll may tighten it,
+        and progress (a new mode or next waypoint) derives it afresh. The time left is the larger
+        of ``$OSI`` field 13 (rh5: remaining mission time in hours) and the leg (field 7
+        distance ÷ field 6 speed) plus a park shown; with neither usable (not under way, field 13
+        absent or 0) the bound is the fixed cap, ``cap_v`` vehicle seconds from the start, which
+        no bound passes. A vehicle that says more is left than the cap allows, a bound that does
+        not fit ``wall_budget`` wall seconds at time scale k, or a wait without an estimate that
+        outlasts that budget, is INCONCLUSIVE (a shorter mission or a larger k would fit). The ``$OSI`` showing ``S`` is judged by the mirror like
+        every other (RH-OUT-4 tolerance).
+        """
+        t0 = self.now()
+        v0 = self.mirror.v(t0)
+        cap_end = v0 + cap_v
+        deadline = cap_end
+        basis = f"the cap of {cap_v:g} s of vehicle time (no usable estimate reported)"
+        seen: Optional[tuple] = None
+        estimated = False
+        while True:
+            osi = self.poll(clause)
+            if osi.mode == "S":
+                self.forced_wait += self.now() - t0
+                return osi
+            vt = self.mirror.v(self.now())
+            key = (osi.mode, osi.next_waypoint)
+            progress, seen = key != seen, key
+            if progress:
+                deadline, estimated = cap_end, False
+                basis = f"the cap of {cap_v:g} s of vehicle time (no usable estimate reported)"
+            left = self._time_left(osi)
+            if left is not None:
+                if vt + left > cap_end:
+                    raise CaseInconclusive(
+                        f"{what}: the vehicle reports about {left:.0f} s of vehicle time left "
+                        f"{vt - v0:.0f} s after the start, past the cap of {cap_v:g} s; a shorter mission "
+                        f"would be judged", clause)
+                bound = min(cap_end, vt + 2.0 * left + END_MARGIN_V)
+                if not estimated or bound < deadline:
+                    deadline, estimated = bound, True
+                    basis = (f"it reported about {left:.0f} s left in mode {osi.mode} toward waypoint "
+                             f"{osi.next_waypoint} at {vt - v0:.0f} s")
+            if estimated and (deadline - v0) / self.k > wall_budget:
+                raise CaseInconclusive(
+                    f"{what} may take up to {deadline - v0:.0f} s of vehicle time "
+                    f"({(deadline - v0) / self.k:.0f} s at k={self.k:g}), over the case budget of "
+                    f"{wall_budget:g} s; a shorter mission or a larger time scale would fit", clause)
+            if not estimated and self.now() - t0 > wall_budget and vt <= deadline:
+                raise CaseInconclusive(
+                    f"{what}: no time left, distance or speed reported to bound the wait, and the case "
+                    f"budget of {wall_budget:g} s ran out before the cap of {cap_v:g} s of vehicle time", clause)
+            if vt > deadline:
+                raise self.fail(clause, f"{what}: {vt - v0:.0f} s of vehicle time after the start $OSI still "
+                                        f"shows mode {osi.mode}, next waypoint {osi.next_waypoint}, not S; "
+                                        f"{basis}, so it should have ended by {deadline - v0:.0f} s")
+            self.link.sleep(max(self.poll_gap, 0.05))
+
+    def _time_left(self, osi: s.OSI) -> Optional[float]:
+        """Vehicle seconds of the mission left by the vehicle's own report, or ``None``."""
+        found = []
+        if (self.profile.protocol == "rh5" and osi.remaining_time is not None
+                and osi.remaining_time > 0):
+            found.append(float(osi.remaining_time) * 3600.0)
+        park = float(osi.park_time) if osi.mode == "P" else 0.0
+        speed = float(osi.speed) * _KN
+        if speed > 0.05:
+            found.append(float(osi.distance) / speed + park)
+        elif park > 0:
+            found.append(park)
+        return max(found) if found else None
 
     # ================================================================ reset
     def reset(self, mission: bool = True, park: bool = False) -> None:
