@@ -61,8 +61,7 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
 
 
 def _usage(msg: str) -> int:
-    print(f"helmcheck check-log: {msg}", file=sys.stderr)
-    return exitcodes.USAGE
+    return exitcodes.usage_error("helmcheck check-log", msg)
 
 
 def run(args: argparse.Namespace) -> int:

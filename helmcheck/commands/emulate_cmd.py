@@ -57,8 +57,7 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
 
 
 def _usage(msg: str) -> int:
-    print(f"helmcheck emulate: {msg}", file=sys.stderr)
-    return exitcodes.USAGE
+    return exitcodes.usage_error("helmcheck emulate", msg)
 
 
 def run(args: argparse.Namespace) -> int:  # noqa: C901 - argument checks, then one call

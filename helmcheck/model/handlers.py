@@ -157,17 +157,7 @@ def _do_omw_clear_wp(m: VehicleModel, row: Row, c: s.OMWClear, now: float) -> li
 
 def _do_omstop(m: VehicleModel, row: Row, c: s.OMSTOP, now: float) -> list[s.Reply]:
     """RH-MSN-3, RH-RD-13: stop; remote control and queue cleared; error state back to N."""
-    m._end_remote()
-    m.mission = None
-    m.mission_mode = "N"
-    m.mission_wp = 0
-    m.park_left = None
-    m.srp_active = False
-    m.srp_mission = None
-    m.ignore_gps = False
-    m.error_state = "N"
-    m.timers.disarm("lockout")
-    m.timers.disarm("park")
+    m._reset_mission(None)
     m._transition(row, now)
     return [_ack(1)]
 

@@ -582,8 +582,15 @@ class VehicleModel:
 
     def _start(self, mission: Mission, row: Row, now: float, *, ignore_gps: bool,
                srp: Optional[Mission], as_srp: bool) -> None:
-        self._end_remote()
         self.loaded = mission
+        self._reset_mission(mission, ignore_gps=ignore_gps, srp=srp, as_srp=as_srp)
+        self._transition(row, now)
+
+    def _reset_mission(self, mission: Optional[Mission], *, ignore_gps: bool = False,
+                       srp: Optional[Mission] = None, as_srp: bool = False) -> None:
+        """Mission state as ``$OMSTART`` leaves it (``mission`` given) or ``$OMSTOP`` (None):
+        remote control and the queue ended, the safety episode over (RH-MSN-2/3, RH-RD-13)."""
+        self._end_remote()
         self.mission = mission
         self.mission_mode = "N"
         self.mission_wp = 0
@@ -594,7 +601,6 @@ class VehicleModel:
         self.error_state = "N"
         self.timers.disarm("lockout")
         self.timers.disarm("park")
-        self._transition(row, now)
 
     def _lookup(self, name: str) -> Union[Mission, MissingMission, BadMission]:
         return self.missions.lookup(normalise_name(name))

@@ -71,8 +71,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def _usage(msg: str) -> int:
-    print(f"helmcheck certify backseat: {msg}", file=sys.stderr)
-    return exitcodes.USAGE
+    return exitcodes.usage_error("helmcheck certify backseat", msg)
 
 
 def _positive(x: Optional[float]) -> bool:

@@ -80,13 +80,7 @@ class ClauseBook:
         e.fails += 1
         if not e.fail_reason:
             e.fail_reason = reason
-        evidence = list(evidence)
-        if evidence and len(e.lines) < MAX_LINES:
-            e.lines.append(evidence[0].lineno)
-        for ev in evidence:
-            if len(e.evidence) >= MAX_EVIDENCE:
-                break
-            e.evidence.append(ev)
+        _keep(evidence, e.lines, e.evidence)
 
     def inconclusive(self, cid: str, reason: str, evidence: Iterable[Evidence] = ()) -> None:
         e = self._e.get(cid)
@@ -95,13 +89,7 @@ class ClauseBook:
         e.inconclusive += 1
         if not e.inconc_reason:
             e.inconc_reason = reason
-        evidence = list(evidence)
-        if evidence and len(e.inconc_lines) < MAX_LINES:
-            e.inconc_lines.append(evidence[0].lineno)
-        for ev in evidence:
-            if len(e.inconc_evidence) >= MAX_EVIDENCE:
-                break
-            e.inconc_evidence.append(ev)
+        _keep(evidence, e.inconc_lines, e.inconc_evidence)
 
     def untested(self, cid: str, reason: str) -> None:
         """Why a clause cannot be judged from this log (used only if nothing was judged)."""
@@ -163,3 +151,14 @@ def _where(lines: list[int], n: int) -> str:
     shown = ", ".join(map(str, lines[:10]))
     more = f" and {n - min(len(lines), 10)} more" if n > min(len(lines), 10) else ""
     return f" (log line {shown}{more})"
+
+
+def _keep(evidence: Iterable[Evidence], lines: list, kept: list) -> None:
+    """Bounded evidence: the first line number of each finding, the first few lines quoted."""
+    evidence = list(evidence)
+    if evidence and len(lines) < MAX_LINES:
+        lines.append(evidence[0].lineno)
+    for ev in evidence:
+        if len(kept) >= MAX_EVIDENCE:
+            break
+        kept.append(ev)

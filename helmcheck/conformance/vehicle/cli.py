@@ -63,8 +63,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def _usage(msg: str) -> int:
-    print(f"helmcheck certify vehicle: {msg}", file=sys.stderr)
-    return exitcodes.USAGE
+    return exitcodes.usage_error("helmcheck certify vehicle", msg)
 
 
 def run(args: argparse.Namespace) -> int:
