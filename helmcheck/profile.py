@@ -16,12 +16,25 @@ Keys beyond §10 (each a ``[D]`` of the profile, documented in the README):
   for (default ``short.mis``, shipped by the emulator); ``""`` = none, RH-MSN-4 NOT-TESTED,
 - ``srp_mission`` (RH-SAF-4, RH-RD-6): an SRP mission present on the vehicle, given at start so
   that ``SafetyAction = srp`` can be exercised (default ``srp.mis``, shipped by the emulator);
-  ``""`` = none, the ``srp`` branch NOT-TESTED.
+  ``""`` = none, the ``srp`` branch NOT-TESTED,
+- ``vehicle_serial``, ``uvc_version``: what the implementation under test is (identity in the
+  report; never judged).
+
+§10 keys with rules of their own:
+
+- ``violation_trigger`` (RH-SAF-5): how the tester gets a safety violation to judge §7. Left
+  out, it is ``oxflt`` when ``fault_injection = "oxflt"`` and ``none`` otherwise
+  (:attr:`Profile.trigger`); ``oxflt`` needs ``fault_injection = "oxflt"`` and
+  ``mission-rule`` needs ``violation_mission`` and a positive ``violation_after_s``.
+- ``reaction_s`` (RH-BS-3/5): the time a backseat gets to act on a state report.
+
+Every number must be finite; durations that divide or bound a wait must be positive.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import math
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -69,6 +82,10 @@ class Profile:
     mission: str = "conformance.mis"
     mission_waypoints: int = 4
     fault_injection: str = "none"
+    violation_trigger: str = ""  #: "" = derived from fault_injection (see :attr:`trigger`)
+    violation_mission: str = ""
+    violation_after_s: float = 0.0
+    reaction_s: float = 0.25
     time_scale: float = 1.0
     baud: int = 19200
     bench_safety: BenchSafety = field(default_factory=BenchSafety)
@@ -84,12 +101,23 @@ class Profile:
     vehicle_name: str = "IVER3-EMU"
     end_mission: str = "short.mis"
     srp_mission: str = "srp.mis"
+    vehicle_serial: str = ""
+    uvc_version: str = ""
     name: str = "rh5"  #: where the profile came from (file name or "rh5"); not a TOML key
 
     @property
     def max_depth(self) -> float:
         """The depth ceiling in the profile's depth unit (RH-SRV-2; feet for rh4 and older)."""
         return self.max_depth_m if self.depth_unit == "m" else self.max_depth_m / 0.3048
+
+    @property
+    def trigger(self) -> str:
+        """RH-SAF-5: how a violation is raised for §7 — ``oxflt``, ``mission-rule``,
+        ``operator`` or ``none``. Left out of the file, ``oxflt`` when the vehicle declares
+        ``fault_injection = "oxflt"``, else ``none``."""
+        if self.violation_trigger:
+            return self.violation_trigger
+        return "oxflt" if self.fault_injection == "oxflt" else "none"
 
     def replace(self, **changes: Any) -> "Profile":
         return dataclasses.replace(self, **changes)
@@ -109,7 +137,15 @@ _CHOICES = {
     "depth_unit": ("m", "ft"),
     "fault_injection": ("none", "oxflt"),
     "safety_action": ("park", "srp"),
+    "violation_trigger": ("none", "oxflt", "mission-rule", "operator"),
 }
+#: Keys whose value must be > 0 (they divide a duration or bound a wait).
+_POSITIVE = ("time_scale", "lockout_s", "ack_window_s", "on_station_m", "max_depth_m")
+#: Upper bounds beyond which a value has no meaning on the wire.
+_AT_MOST = {"ack_window_s": 60.0, "lockout_s": 3600.0, "time_scale": 1000.0, "max_depth_m": 11000.0,
+            "max_speed_kn": 50.0, "reaction_s": 10.0, "gps_fix_depth_m": 100.0, "on_station_m": 10000.0,
+            "opk_max_distance_m": 100000.0, "violation_after_s": 86400.0, "max_line_bytes": 65536,
+            "mission_waypoints": 100000, "osi_fields": 64}
 _BAUDS = (9600, 19200, 38400, 57600, 115200)
 
 
@@ -136,12 +172,22 @@ def _check(where: str, key: str, value: Any, default: Any) -> Any:
             raise bad("must be at least 16")
         if key == "waypoint_base" and value not in (0, 1):
             raise bad("must be 0 or 1")
+        if key == "mission_waypoints" and value < 1:
+            raise bad("must be at least 1")
+        limit = _AT_MOST.get(key)
+        if limit is not None and value > limit:
+            raise bad(f"must be at most {limit:g}")
         return value
     if isinstance(default, float):
         if isinstance(value, bool) or not isinstance(value, (int, float)):
             raise bad("must be a number")
-        if value < 0 or (key in ("time_scale", "lockout_s", "ack_window_s") and value <= 0):
+        if not math.isfinite(value):
+            raise bad("must be a finite number")
+        if value < 0 or (key.rpartition(".")[2] in _POSITIVE and value <= 0):
             raise bad("must be positive")
+        limit = _AT_MOST.get(key)
+        if limit is not None and value > limit:
+            raise bad(f"must be at most {limit:g}")
         return float(value)
     if isinstance(default, str):
         if not isinstance(value, str):
@@ -201,7 +247,23 @@ def profile_from_dict(data: dict[str, Any], where: str = "<profile>") -> Profile
         kwargs["osi_fields"] = hi
     if "depth_unit" not in kwargs and protocol != "rh5":
         kwargs["depth_unit"] = "ft"
+    _check_trigger(where, kwargs)
     return Profile(name=where, **kwargs)
+
+
+def _check_trigger(where: str, kw: dict[str, Any]) -> None:
+    """RH-SAF-5: the violation trigger must be usable with the rest of the profile."""
+    trig = kw.get("violation_trigger", "")
+    if trig == "oxflt" and kw.get("fault_injection", "none") != "oxflt":
+        raise ProfileError(f"{where}: key 'violation_trigger': 'oxflt' needs fault_injection = \"oxflt\" "
+                           f"(the vehicle must accept the $OXFLT test extension)")
+    if trig == "mission-rule":
+        if not kw.get("violation_mission"):
+            raise ProfileError(f"{where}: key 'violation_trigger': 'mission-rule' needs violation_mission, "
+                               f"a mission on the vehicle whose own safety rule trips")
+        if not kw.get("violation_after_s", 0.0) > 0:
+            raise ProfileError(f"{where}: key 'violation_trigger': 'mission-rule' needs violation_after_s > 0, "
+                               f"the vehicle seconds after its start at which the rule trips")
 
 
 def load_profile(path: str | Path | None) -> Profile:

@@ -1,0 +1,20 @@
+"""The judges: one sans-IO observer per role, one verdict ledger, one timing formula.
+
+Live certification and offline log checking feed the same observer the same
+:class:`~helmcheck.judge.wire.WireEvent` s, so the same bytes get the same verdict, whoever
+reads them. Modules:
+
+* :mod:`~helmcheck.judge.ledger` — the one verdict ledger and its one combining rule;
+* :mod:`~helmcheck.judge.timing` — RH-TIM-1 tolerances, observer slack, the ACK window;
+* :mod:`~helmcheck.judge.facts` — protocol facts derived from the transition table;
+* :mod:`~helmcheck.judge.wire` — wire events and the recorder notes a judge understands;
+* :mod:`~helmcheck.judge.vehicle` — the vehicle observer (§1–8);
+* :mod:`~helmcheck.judge.backseat` — the backseat observer (§9).
+
+Nothing here imports ``serial``, ``time``, ``threading`` or ``asyncio``.
+"""
+
+from .ledger import ClauseVerdict, Evidence, Ledger
+from .wire import FROM_VEHICLE, NOTE, TO_VEHICLE, WireEvent
+
+__all__ = ["Ledger", "Evidence", "ClauseVerdict", "WireEvent", "TO_VEHICLE", "FROM_VEHICLE", "NOTE"]

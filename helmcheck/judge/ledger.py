@@ -1,0 +1,225 @@
+"""The verdict ledger: every finding of a run, one verdict per clause, one rule to combine them.
+
+Every judge (the vehicle observer, the backseat observer) and every driver fact (a case that
+could not run, a step bench safety refused) writes here, and nowhere else. A finding is one
+observation of one clause:
+
+* ``passed`` — the clause was exercised and the implementation met it (counted; the first
+  deciding exchange is kept as evidence);
+* ``failed`` — a MUST violated gives ``fail``, a SHOULD violated gives ``non-strict``
+  (reference profile, preamble);
+* ``inconclusive`` — the clause was exercised but could not be judged (timing the observer
+  cannot bound, a mission file it does not have, a link fault);
+* ``not_tested`` — why the clause could not be exercised at all.
+
+The one combining rule (TTCN-3, "first fail wins"): ``fail``/``non-strict`` > ``inconclusive`` >
+``pass`` > ``not-tested``. The reason shown is the first one at the winning level, with the
+counts; evidence is bounded (:data:`MAX_EVIDENCE` excerpts, :data:`MAX_LINES` offending log line
+numbers per clause), so a ledger stays small whatever the length of the run.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Iterable, Optional
+
+from ..clauses import catalogue
+
+__all__ = ["Ledger", "Evidence", "ClauseVerdict", "MAX_EVIDENCE", "MAX_LINES", "RANK", "combine"]
+
+MAX_EVIDENCE = 8
+MAX_LINES = 50
+#: The combining rule: a higher rank wins.
+RANK = {"not-tested": 0, "pass": 1, "inconclusive": 2, "non-strict": 3, "fail": 3}
+
+
+@dataclass(frozen=True, slots=True)
+class Evidence:
+    """One line of wire evidence: time, wire-log direction, text as logged, log line number."""
+
+    t: float
+    dir: str  #: ">" / "<" (a CR LF line), ">~" / "<~" (any other run), "!" (a note)
+    text: str
+    lineno: int = 0  #: the record's line in the wire log (0 when not known)
+
+    def as_dict(self) -> dict:
+        line = f"line {self.lineno}: {self.text}" if self.lineno else self.text
+        return {"t": max(0.0, round(self.t, 6)), "dir": self.dir, "line": line[:400]}
+
+
+@dataclass(frozen=True)
+class ClauseVerdict:
+    """The verdict of one clause, ready for ``results.json``."""
+
+    id: str
+    verdict: str
+    reason: str
+    level: str
+    cases: tuple[str, ...] = ()
+    evidence: tuple[Evidence, ...] = ()
+    lines: tuple[int, ...] = ()
+    offending_count: int = 0
+    observations: int = 0
+
+    def as_entry(self) -> dict:
+        return {"id": self.id, "verdict": self.verdict, "reason": self.reason, "level": self.level,
+                "cases": list(self.cases), "evidence": [e.as_dict() for e in self.evidence],
+                "lines": list(self.lines), "offending_count": self.offending_count}
+
+
+@dataclass
+class _Level:
+    count: int = 0
+    reason: str = ""
+    evidence: list = field(default_factory=list)
+    lines: list = field(default_factory=list)
+
+
+@dataclass
+class _Entry:
+    levels: dict = field(default_factory=lambda: {k: _Level() for k in ("pass", "fail", "inconclusive",
+                                                                          "not-tested")})
+    cases: dict = field(default_factory=dict)
+    remarks: list = field(default_factory=list)
+
+
+class Ledger:
+    """Findings per clause, combined by the one rule (module docstring)."""
+
+    def __init__(self, clause_ids: Iterable[str]):
+        known = catalogue()
+        self.order = [c for c in clause_ids if c in known]
+        self._level = {c: known[c].level for c in self.order}
+        self._e: dict[str, _Entry] = {c: _Entry() for c in self.order}
+        #: every failure in order: (serial, clause, reason) — drivers read :meth:`failures_since`
+        self._fail_log: list[tuple[int, str, str]] = []
+        self._serial = 0
+
+    def __contains__(self, cid: str) -> bool:
+        return cid in self._e
+
+    # ------------------------------------------------------------------ findings
+    def _add(self, cid: str, kind: str, reason: str, evidence: Iterable[Evidence], case: str) -> None:
+        e = self._e.get(cid)
+        if e is None:
+            return  # a clause outside this ledger (not selected, or the other role)
+        lv = e.levels[kind]
+        lv.count += 1
+        if not lv.reason and reason:
+            lv.reason = reason
+        ev = list(evidence)
+        if ev and len(lv.lines) < MAX_LINES and ev[0].lineno:
+            lv.lines.append(ev[0].lineno)
+        if not lv.evidence and ev:
+            lv.evidence = ev[:MAX_EVIDENCE]
+        if case:
+            e.cases[case] = None
+
+    def passed(self, cid: str, reason: str = "", evidence: Iterable[Evidence] = (), case: str = "") -> None:
+        """The clause was exercised and met (the first call's reason and evidence are kept)."""
+        self._add(cid, "pass", reason, evidence, case)
+
+    def failed(self, cid: str, reason: str, evidence: Iterable[Evidence] = (), case: str = "") -> None:
+        """The clause was violated: ``fail`` for a MUST, ``non-strict`` for a SHOULD."""
+        if cid not in self._e:
+            return
+        self._add(cid, "fail", reason, evidence, case)
+        self._serial += 1
+        self._fail_log.append((self._serial, cid, reason))
+
+    def inconclusive(self, cid: str, reason: str, evidence: Iterable[Evidence] = (), case: str = "") -> None:
+        """The clause was exercised but could not be judged (the reason says why)."""
+        self._add(cid, "inconclusive", reason, evidence, case)
+
+    def not_tested(self, cid: str, reason: str, case: str = "") -> None:
+        """Why the clause could not be exercised (shown only if nothing else was found)."""
+        self._add(cid, "not-tested", reason, (), case)
+
+    def remark(self, cid: str, text: str) -> None:
+        """A remark appended to the clause's reason (an inference its verdict rests on)."""
+        e = self._e.get(cid)
+        if e is not None and text not in e.remarks and len(e.remarks) < 3:
+            e.remarks.append(text)
+
+    # ------------------------------------------------------------------ queries
+    def has_failed(self, cid: str) -> bool:
+        e = self._e.get(cid)
+        return e is not None and e.levels["fail"].count > 0
+
+    def has_finding(self, cid: str) -> bool:
+        """Anything at all was recorded for the clause (a pass, fail, inconclusive or reason)."""
+        e = self._e.get(cid)
+        return e is not None and any(lv.count for lv in e.levels.values())
+
+    def judged(self, cid: str) -> bool:
+        e = self._e.get(cid)
+        return e is not None and any(e.levels[k].count for k in ("pass", "fail", "inconclusive"))
+
+    def mark(self) -> int:
+        """A position in the failure log (see :meth:`failures_since`)."""
+        return self._serial
+
+    def failures_since(self, mark: int) -> list[tuple[str, str]]:
+        """(clause, reason) of every failure recorded after :meth:`mark` returned ``mark``."""
+        return [(c, r) for n, c, r in self._fail_log if n > mark]
+
+    def counts(self, cid: str) -> dict[str, int]:
+        e = self._e[cid]
+        return {k: lv.count for k, lv in e.levels.items()}
+
+    def verdict(self, cid: str) -> ClauseVerdict:
+        """The combined verdict of one clause (the module's one rule)."""
+        e = self._e[cid]
+        level = self._level[cid]
+        lv = e.levels
+        judged = lv["pass"].count + lv["fail"].count + lv["inconclusive"].count
+        cases = tuple(e.cases)
+        if lv["fail"].count:
+            f = lv["fail"]
+            verdict = "fail" if level == "MUST" else "non-strict"
+            reason = (f"{f.count} violation(s) in {judged} observation(s){_where(f.lines, f.count)}; "
+                      f"first: {f.reason}")
+            out = ClauseVerdict(cid, verdict, reason, level, cases, tuple(f.evidence), tuple(f.lines),
+                                f.count, judged)
+        elif lv["inconclusive"].count:
+            i = lv["inconclusive"]
+            reason = (f"{i.count} of {judged} observation(s) could not be judged"
+                      f"{_where(i.lines, i.count)}: {i.reason}")
+            out = ClauseVerdict(cid, "inconclusive", reason, level, cases, tuple(i.evidence),
+                                tuple(i.lines), 0, judged)
+        elif lv["pass"].count:
+            p = lv["pass"]
+            reason = f"{p.count} observation(s) met the clause" + (f"; first: {p.reason}" if p.reason else ".")
+            out = ClauseVerdict(cid, "pass", reason, level, cases, tuple(p.evidence), (), 0, judged)
+        else:
+            n = lv["not-tested"]
+            reason = n.reason or "no occasion to exercise this clause"
+            out = ClauseVerdict(cid, "not-tested", reason, level, cases, (), (), 0, 0)
+        if e.remarks and out.verdict != "not-tested":
+            out = ClauseVerdict(out.id, out.verdict, out.reason + " Note: " + " ".join(e.remarks), out.level,
+                                out.cases, out.evidence, out.lines, out.offending_count, out.observations)
+        return out
+
+    def verdicts(self) -> list[ClauseVerdict]:
+        return [self.verdict(c) for c in self.order]
+
+    def entries(self) -> list[dict]:
+        """The clause entries of ``results.json`` (schema 1), in catalogue order."""
+        return [v.as_entry() for v in self.verdicts()]
+
+
+def _where(lines: list[int], n: int) -> str:
+    if not lines:
+        return ""
+    shown = ", ".join(map(str, lines[:10]))
+    more = f" and {n - min(len(lines), 10)} more" if n > min(len(lines), 10) else ""
+    return f" (wire-log line {shown}{more})"
+
+
+def combine(verdicts: Iterable[str]) -> Optional[str]:
+    """The winning verdict word of several findings by the one rule (``None`` for none)."""
+    best: Optional[str] = None
+    for v in verdicts:
+        if best is None or RANK[v] > RANK[best]:
+            best = v
+    return best

@@ -1,0 +1,154 @@
+"""What a judge is fed: timestamped wire events, and the recorder notes it understands.
+
+A judge never reads a port, a file or a clock. Whoever drives it — a live certification, an
+offline log check — hands it the same :class:`WireEvent` s, in order:
+
+* bytes the backseat sent the vehicle (``dir = ">"``) or the vehicle sent the backseat
+  (``"<"``), split anywhere, with the time they were seen (wall seconds since the record began);
+* notes (``"!"``): what the recorder knew besides the bytes.
+
+A live run writes every event to its wire log *and* feeds it to the judge with the time and
+line number it was written with (:class:`helmcheck.conformance.recorder.Recorder`); an offline
+check reads the same records back. So one log gives one verdict, whoever reads it.
+
+Notes a judge acts on (anything else is kept as evidence only); the words are part of the
+wire-log format (``docs/contracts.md``):
+
+==========================================  ===================================================
+``case V-22 RH-INT-2: <title>``             a clause case starts; findings inside it are booked
+                                            on its clauses where they touch them
+``case V-22 end``                           the case is over
+``not tested RH-X,RH-Y: <reason>``          the tester could not exercise these clauses
+``inconclusive RH-X,RH-Y: <reason>``        the tester exercised them but cannot judge them
+``link: <baud> baud 8N1 <port>``            the line's settings as the tester opened it (RH-FRM-9)
+``plant: <Event>(<args>) at v=<seconds>``   an emulator's physics event (exact, when present)
+``fault injected (<source>): <code>``       a safety violation raised off the wire (RH-SAF-5)
+``lockout starts (<code>)`` / ``… ends``    the vehicle's lockout, as the vehicle knows it
+``scenario <name> starts``                  a certify-backseat scenario
+``silence starts`` / ``silence ends``       the vehicle stops / resumes answering
+``reject: …`` / ``reject: window ends``     staged refusals start / end
+``operator: <instruction>``                 an operator was asked to act (RH-SAF-5)
+==========================================  ===================================================
+"""
+
+from __future__ import annotations
+
+import ast
+import re
+from dataclasses import dataclass
+from typing import Any, Optional
+
+from ..profile import SAFETY_CODES
+
+__all__ = ["WireEvent", "TO_VEHICLE", "FROM_VEHICLE", "NOTE", "Note", "parse_note", "case_note",
+           "case_end_note", "tester_note", "parse_plant"]
+
+TO_VEHICLE = ">"
+FROM_VEHICLE = "<"
+NOTE = "!"
+
+
+@dataclass(frozen=True, slots=True)
+class WireEvent:
+    """One record: bytes one way, or a note, at ``t`` wall seconds since the record began."""
+
+    t: float
+    dir: str  #: ">", "<" or "!"
+    data: bytes = b""
+    note: str = ""
+    lineno: int = 0  #: the record's line in the wire log (0 when not known)
+
+
+@dataclass(frozen=True, slots=True)
+class Note:
+    """A note a judge acts on: ``kind`` and its parts (see the module docstring)."""
+
+    kind: str  #: case | case-end | not-tested | inconclusive | link | plant | fault | lockout |
+    #: lockout-end | scenario | silence | silence-end | reject | reject-end | operator
+    case: str = ""
+    clauses: tuple[str, ...] = ()
+    text: str = ""
+    code: str = ""
+    value: Any = None  #: plant: (event class name, kwargs, v); link: baud
+
+
+_CASE = re.compile(r"^case (\S+) ((?:RH-[A-Z]+-\d+ ?)+): (.*)$")
+_CASE_END = re.compile(r"^case (\S+) end$")
+_TESTER = re.compile(r"^(not tested|inconclusive) ((?:RH-[A-Z]+-\d+,?)+): (.*)$")
+_LINK = re.compile(r"^link: (\d+) baud 8N1\b")
+_PLANT = re.compile(r"^plant: (\w+)\((.*?)\)(?: \[[^\]]*\])? at v=([-0-9.eE]+)\s*$")
+_FAULT = re.compile(r"^fault injected \(([^)]*)\): (\w+)\s*$")
+_LOCKOUT = re.compile(r"^lockout (starts|ends)\b(?: \((\w+)\))?")
+_SCENARIO = re.compile(r"^scenario (\S+) starts")
+
+
+def parse_plant(args: str) -> Optional[dict]:
+    kwargs: dict[str, Any] = {}
+    for part in filter(None, (p.strip() for p in args.split(","))):
+        k, _, v = part.partition("=")
+        try:
+            kwargs[k.strip()] = ast.literal_eval(v.strip())
+        except (ValueError, SyntaxError):
+            return None
+    return kwargs
+
+
+def parse_note(text: str) -> Optional[Note]:
+    """The :class:`Note` a judge acts on, or ``None`` for a note that is evidence only."""
+    m = _CASE.match(text)
+    if m:
+        return Note("case", case=m.group(1), clauses=tuple(m.group(2).split()), text=m.group(3))
+    m = _CASE_END.match(text)
+    if m:
+        return Note("case-end", case=m.group(1))
+    m = _TESTER.match(text)
+    if m:
+        kind = "not-tested" if m.group(1) == "not tested" else "inconclusive"
+        return Note(kind, clauses=tuple(c for c in m.group(2).split(",") if c), text=m.group(3))
+    m = _LINK.match(text)
+    if m:
+        return Note("link", value=int(m.group(1)), text=text)
+    m = _PLANT.match(text)
+    if m:
+        kwargs = parse_plant(m.group(2))
+        if kwargs is None:
+            return None
+        try:
+            v = float(m.group(3))
+        except ValueError:
+            return None
+        return Note("plant", value=(m.group(1), kwargs, v), text=text)
+    m = _FAULT.match(text)
+    if m and m.group(2) in SAFETY_CODES:
+        return Note("fault", code=m.group(2), text=m.group(1))
+    m = _LOCKOUT.match(text)
+    if m:
+        return Note("lockout" if m.group(1) == "starts" else "lockout-end", code=m.group(2) or "")
+    m = _SCENARIO.match(text)
+    if m:
+        return Note("scenario", text=m.group(1))
+    if text.startswith("silence starts"):
+        return Note("silence")
+    if text.startswith("silence ends"):
+        return Note("silence-end")
+    if text.startswith("reject: window ends"):
+        return Note("reject-end")
+    if text.startswith("reject: "):
+        return Note("reject", text=text[8:])
+    if text.startswith("operator: "):
+        return Note("operator", text=text[10:])
+    return None
+
+
+def case_note(case_id: str, clauses: tuple[str, ...] | list[str], title: str) -> str:
+    return f"case {case_id} {' '.join(clauses)}: {title}"
+
+
+def case_end_note(case_id: str) -> str:
+    return f"case {case_id} end"
+
+
+def tester_note(kind: str, clauses, reason: str) -> str:
+    """``not tested RH-X,RH-Y: reason`` or ``inconclusive RH-X: reason`` (one line)."""
+    word = {"not-tested": "not tested", "inconclusive": "inconclusive"}[kind]
+    return f"{word} {','.join(clauses)}: {reason}".replace("\n", " ")
