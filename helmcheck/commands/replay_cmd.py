@@ -38,11 +38,15 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
 
 
 def run(args: argparse.Namespace) -> int:
+    from ..clauses import vehicle_clauses
+    from ..conformance.recorder import Recorder
     from ..conformance.transport import open_link, parse_port_spec
-    from ..conformance.vehicle.judge import Book
-    from ..conformance.vehicle.link import LinkLost, TesterLink
+    from ..conformance.vehicle.flow import LinkLost
+    from ..conformance.vehicle.link import TesterLink
     from ..conformance.vehicle.replay import ReplayError, load_replay, redrive
     from ..conformance.vehicle.session import Session
+    from ..judge import Ledger
+    from ..judge.vehicle import VehicleObserver
     from ..profile import ProfileError, load_profile, profile_from_dict
 
     try:
@@ -76,8 +80,11 @@ def run(args: argparse.Namespace) -> int:
         except (OSError, ValueError) as e:
             print(f"INCONCLUSIVE: cannot open {args.port}: {e}", file=sys.stderr)
             return exitcodes.INCONCLUSIVE
-        link = TesterLink(raw, profile, log=log, meta=f"replay {args.file} port {args.port} time_scale {k:g}")
-        session = Session(link, profile, k, Book())
+        ledger = Ledger([c.id for c in vehicle_clauses()])
+        observer = VehicleObserver(profile, ledger, time_scale=k, baud=profile.baud)
+        recorder = Recorder(log, [f"replay {args.file} port {args.port} time_scale {k:g}"], [observer])
+        link = TesterLink(raw, profile, recorder)
+        session = Session(link, profile, k, observer)
         try:
             verdict, reason, clause = redrive(doc, session)
         except LinkLost as e:
@@ -85,7 +92,7 @@ def run(args: argparse.Namespace) -> int:
     finally:
         if link is not None:
             link.close()
-        elif log is not None:
+        if log is not None:
             log.close()
     was = doc.get("clause", "?")
     if verdict == "fail":

@@ -64,7 +64,7 @@ class ClauseVerdict:
     def as_entry(self) -> dict:
         return {"id": self.id, "verdict": self.verdict, "reason": self.reason, "level": self.level,
                 "cases": list(self.cases), "evidence": [e.as_dict() for e in self.evidence],
-                "lines": list(self.lines), "offending_count": self.offending_count}
+                "lines": list(self.lines), "offending_count": self.offending_count, "replay": None}
 
 
 @dataclass

@@ -28,6 +28,8 @@ wire-log format (``docs/contracts.md``):
 ``silence starts`` / ``silence ends``       the vehicle stops / resumes answering
 ``reject: …`` / ``reject: window ends``     staged refusals start / end
 ``operator: <instruction>``                 an operator was asked to act (RH-SAF-5)
+``run aborted: <reason>``                   the run ended early: what was not judged is
+                                            INCONCLUSIVE with this reason
 ==========================================  ===================================================
 """
 
@@ -64,7 +66,7 @@ class Note:
     """A note a judge acts on: ``kind`` and its parts (see the module docstring)."""
 
     kind: str  #: case | case-end | not-tested | inconclusive | link | plant | fault | lockout |
-    #: lockout-end | scenario | silence | silence-end | reject | reject-end | operator
+    #: lockout-end | scenario | silence | silence-end | reject | reject-end | operator | aborted
     case: str = ""
     clauses: tuple[str, ...] = ()
     text: str = ""
@@ -137,6 +139,8 @@ def parse_note(text: str) -> Optional[Note]:
         return Note("reject", text=text[8:])
     if text.startswith("operator: "):
         return Note("operator", text=text[10:])
+    if text.startswith("run aborted: "):
+        return Note("aborted", text=text[13:])
     return None
 
 

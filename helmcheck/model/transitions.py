@@ -171,7 +171,10 @@ def _build() -> tuple[Row, ...]:
     row(("M",), "OMS", "A", ("RH-SRV-1", "RH-INT-1", "RH-RD-1"), guard=("running",))
     row(("S", "M"), "OMS", STAY, ("RH-SRV-1", "RH-ACK-4"), error=20)
     # -- primitive (RH-PRM-*)
-    row(("S", "N", "P", "mP", "A", "W"), "OMP", "M", ("RH-PRM-1", "RH-PRM-3", "RH-INT-1"))
+    row(("S", "N", "P", "mP", "A", "W"), "OMP", "M", ("RH-PRM-1", "RH-PRM-3", "RH-INT-1"),
+        phases=("none",))
+    row(("S", "N", "P", "mP", "A", "W"), "OMP", "M", ("RH-SAF-3", "RH-PRM-3", "RH-RD-12"),
+        phases=("ascent",))
     row(("M",), "OMP", "M", ("RH-PRM-3", "RH-RD-3"))
     # -- jump (RH-JW-*)
     row(("N", "P", "mP", "A", "W"), "OJW", "N", ("RH-JW-1", "RH-JW-2"))
@@ -230,7 +233,7 @@ def _build() -> tuple[Row, ...]:
     row(("N",), "wp_reached", "S", ("RH-MSN-4",), phases=("none",))
     row(("P",), "park_expired", "N", ("RH-RD-5",), guard=("more_wps",), phases=("none",))
     row(("P",), "park_expired", "S", ("RH-MSN-4",), phases=("none",))
-    row(everywhere, "lockout_end", STAY, ("RH-SAF-3", "RH-RD-12"), phases=("lockout",),
+    row(everywhere, "lockout_end", STAY, ("RH-SAF-1", "RH-SAF-3", "RH-RD-12"), phases=("lockout",),
         phase_to="ascent")
     row(("S",), "surfaced", "S", ("RH-SAF-4", "RH-RD-12"), phases=("ascent",), phase_to="none")
     row(("N", "P"), "surfaced", "N", ("RH-SAF-4",), guard=("srp_ready",), phases=("ascent",),

@@ -57,7 +57,7 @@ from __future__ import annotations
 
 import copy
 from collections import deque
-from typing import Optional, Union
+from typing import NamedTuple, Optional, Union
 
 from ..grammar import sentences as s
 from ..grammar.errors import SentenceError
@@ -75,7 +75,7 @@ from .timers import Timers
 from .transitions import ERRORS, EVENT_OF_ACK_TYPE, REMOTE_MODES, STAY, Row, rows_for, select
 from .validate import field_error
 
-__all__ = ["VehicleModel", "LogRow", "OposRecord", "Item"]
+__all__ = ["VehicleModel", "LogRow", "OposRecord", "Item", "Step"]
 
 Item = Union[s.Command, SentenceError]
 
@@ -85,6 +85,16 @@ _EVENT_OF_CLASS: dict[type, str] = {
     s.OSD: "OSD", s.OLOGL: "OLOGL", s.OLOGD: "OLOGD", s.ORWSET: "ORWSET", s.ODVL: "ODVL",
 }
 _SAFETY = frozenset(SAFETY_CODES)
+
+
+class Step(NamedTuple):
+    """One table row the model applied (``VehicleModel.trace``): the row, the model time, and —
+    for a row a timer fired — the timer's name and duration (RH-TIM-1 judges that duration)."""
+
+    row: Row
+    at: float
+    timer: str = ""
+    duration: float = 0.0
 
 
 class VehicleModel:
@@ -136,6 +146,9 @@ class VehicleModel:
         self._base: Optional["VehicleModel"] = None
         #: keep a copy of the state before the first timer fires after an input (for observers)
         self.checkpoints = True
+        #: when a list, every table row applied is appended as a :class:`Step` (for observers)
+        self.trace: Optional[list] = None
+        self._firing: Optional[tuple[str, float]] = None
         self._snap = snapshot if snapshot is not None else PlantSnapshot()
         self._data = DataCache(profile, self._snap)
 
@@ -283,6 +296,8 @@ class VehicleModel:
         if err is not None:
             return [_ack(t, err)]
         self.last_row = row
+        if self.trace is not None:
+            self.trace.append(Step(row, now))
         replies = _APPLY[event](self, row, item, now)
         if event != "OSD":
             self._base = None
@@ -433,6 +448,7 @@ class VehicleModel:
         new.timers = self.timers.copy()
         new._pending = []
         new._base = None
+        new.trace = [] if self.trace is not None else None
         return new
 
     def expectation(self, now: float, slack: float = 0.0):
@@ -514,8 +530,12 @@ class VehicleModel:
             deadline, name = timers.earliest()  # type: ignore[misc]
             if self.now is None or deadline > self.now:
                 self.now = deadline
+            self._firing = (name, timers.duration(name) or 0.0)
             timers.disarm(name)
-            _EXPIRE[name](self, deadline)
+            try:
+                _EXPIRE[name](self, deadline)
+            finally:
+                self._firing = None
         if self.now is None or now > self.now:
             self.now = now
 
@@ -525,6 +545,9 @@ class VehicleModel:
         if row is None:
             return None
         self.last_row = row
+        if self.trace is not None:
+            timer, duration = self._firing if self._firing is not None else ("", 0.0)
+            self.trace.append(Step(row, now, timer, duration))
         _APPLY[event](self, row, None, now)
         return row
 
@@ -570,6 +593,8 @@ class VehicleModel:
         assert row is not None
         self._base = None
         self.last_row = row
+        if self.trace is not None:
+            self.trace.append(Step(row, now))
         self._end_remote()
         self.error_state = code
         self.timers.arm("lockout", now, self.profile.lockout_s)

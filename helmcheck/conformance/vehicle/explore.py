@@ -4,17 +4,18 @@
 command, send an invalid line (one mutation of a valid one: out-of-range field, wrong field
 count, bad checksum, lower-case ID), let protocol time pass (vehicle seconds ÷ k, RH-TIM-2),
 poll ``$OSD,S`` and, when the profile declares it, raise a safety violation with ``$OXFLT``.
-Every reply and every ``$OSI`` is judged by the session against the mirrored model
-(:mod:`.session`, :mod:`.mirror`); a mismatch fails the example with its clause.
+Every reply and every ``$OSI`` is judged by the vehicle observer, as everywhere else; an example
+fails when the observer booked a failure during it (the example stops there).
 
 Each example starts from a verified reset (with ``$OLOGL`` and ``$OMLOAD`` in ``S`` so that the
-mirror knows the log labels and the loaded mission), then optionally starts the test mission.
+observer knows the log labels and the loaded mission), then optionally starts the test mission.
 
 Shrinking re-runs candidates against the live vehicle. The run keeps the smallest failing
 sequence it saw and saves that as a version-independent replay file (:mod:`.replay`), whatever
-hypothesis ends with — a flaky failure is reported INCONCLUSIVE with its rate rather than
-FAIL. Exploration has a wall-clock budget (``fast``: emulators, ``patient``: hardware); when it
-is spent, the remaining candidates do nothing, so hypothesis finishes quickly.
+hypothesis ends with, and re-drives it twice to say whether it fails again. Exploration has a
+wall-clock budget (``fast``: emulators, ``patient``: hardware); when it is spent, the remaining
+candidates do nothing, so hypothesis finishes quickly — and the report says so: only the
+sequences that really ran are counted.
 
 Bench safety: the strategies keep speeds and the motor byte within ``[bench_safety]``, and the
 link's send function refuses anything above it anyway (:mod:`.safety`).
@@ -30,9 +31,8 @@ from hypothesis.database import DirectoryBasedExampleDatabase
 from hypothesis.stateful import RuleBasedStateMachine, initialize, precondition, rule, run_state_machine_as_test
 
 from ...grammar import checksum_hex
-from .cases import _fill, _here, context
-from .judge import CaseFail, CaseInconclusive, CaseNotTested
-from .link import LinkLost
+from .flow import CaseStop, LinkLost
+from .interpreter import _here, context, fill
 from .replay import save_replay
 from .safety import BenchSafetyRefused
 from .session import frame
@@ -106,9 +106,13 @@ class _State:
 
     def __init__(self, run, budget: float):
         self.run = run
+        self.budget = budget
         self.end = time.monotonic() + budget
-        self.executions = 0
+        self.executions = 0  #: sequences that ran at least their reset
+        self.skipped = 0  #: sequences hypothesis asked for after the budget was spent
         self.best: Optional[dict] = None  #: smallest failing trace so far
+        self.examples = 0
+        self.progress = None
         self.failures = 0
         self.passes_after_fail = 0
         self.lost: Optional[str] = None
@@ -127,34 +131,42 @@ def _machine(state: _State, start_states, nwp, speed, motor, oxflt):
             self.active = not state.spent
             self.ctx: dict = {}
             self.steps = 0
-            state.executions += 1
             if self.active:
+                state.executions += 1
                 session.trace = []
+                if state.progress is not None:
+                    state.progress.explore(state.executions, state.examples,
+                                           max(0.0, state.end - time.monotonic()))
+            else:
+                state.skipped += 1
 
         def _guard(self, fn):
             if not self.active:
                 return
             try:
                 fn()
-            except CaseFail as f:
-                self._failed(f)
-                raise AssertionError(f"{f.clause}: {f.reason}") from None
-            except (BenchSafetyRefused, CaseNotTested, CaseInconclusive):
+                session.check()
+            except CaseStop as f:
+                if f.outcome == "fail":
+                    self._failed(f)
+                    raise AssertionError(f.reason) from None
+                return
+            except BenchSafetyRefused:
                 return
             except LinkLost as e:
                 state.lost = str(e)
                 self.active = False
 
-        def _failed(self, f: CaseFail) -> None:
+        def _failed(self, f: CaseStop) -> None:
             state.failures += 1
             trace = list(session.trace or [])
             if state.best is None or len(trace) < len(state.best["steps"]):
-                state.best = {"clause": f.clause, "reason": f.reason, "steps": trace}
+                state.best = {"clause": f.clause or "", "reason": f.reason, "steps": trace}
 
         @initialize(start=st.sampled_from(start_states))
         def start(self, start):
             def go():
-                session.case, session.case_t0 = "explore", session.now()
+                session.mark = session.ledger.mark()
                 session.reset(mission=False)
                 session.exchange(frame("OLOGL,a,b"))
                 session.exchange(frame(f"OMLOAD,{session.profile.mission},0"))
@@ -166,19 +178,19 @@ def _machine(state: _State, start_states, nwp, speed, motor, oxflt):
 
         @rule(body=valid_commands(nwp, speed, motor, oxflt))
         def send_valid(self, body):
-            self._guard(lambda: session.exchange(frame(_fill(body, self.ctx))))
+            self._guard(lambda: session.exchange(frame(fill(body, self.ctx))))
 
         @rule(body=control_commands(speed, motor))
         def control(self, body):
-            self._guard(lambda: session.exchange(frame(_fill(body, self.ctx))))
+            self._guard(lambda: session.exchange(frame(fill(body, self.ctx))))
 
         @rule(line=invalid_lines())
         def send_invalid(self, line):
             kind, body = line
-            self._guard(lambda: session.exchange(_raw(kind, _fill(body, self.ctx))))
+            self._guard(lambda: session.exchange(_raw(kind, fill(body, self.ctx))))
 
         @rule(v=st.sampled_from([1.0, 2.0, 5.0, 12.0]))
-        def wait(self, v):
+        def wait_a_while(self, v):
             def go():
                 session.wait(v)
                 _here(session, self.ctx)
@@ -225,6 +237,8 @@ def explore(run) -> None:
     if examples <= 0:
         return
     state = _State(run, budget)
+    state.examples = examples
+    state.progress = run.progress
     bench = p.bench_safety
     speed = min(2.0, p.max_speed_kn, bench.max_speed_kn if not bench.in_water else 99.0)
     motor = min(0x90, bench.max_motor_byte) if not bench.in_water else 0x90
@@ -236,7 +250,8 @@ def explore(run) -> None:
                    suppress_health_check=list(HealthCheck), report_multiple_bugs=False, print_blob=False,
                    phases=(Phase.explicit, Phase.reuse, Phase.generate, Phase.shrink))
     session = run.session
-    session.link.note(f"exploration: {examples} examples of up to {steps} steps, budget {budget:g} s")
+    session.note(f"exploration: {examples} examples of up to {steps} steps, budget {budget:g} s")
+    session.begin_case("explore", ("RH-OUT-4",), "hypothesis exploration of command sequences")
     t0 = time.monotonic()
     outcome = "pass"
     session.lazy_silence = True
@@ -247,16 +262,19 @@ def explore(run) -> None:
     finally:
         session.trace = None
         session.lazy_silence = False
-    run.stats["explore"] = {"examples": examples, "executions": state.executions, "failures": state.failures,
+        session.end_case()
+    spent = state.skipped > 0 or time.monotonic() > state.end
+    run.stats["explore"] = {"examples": examples, "ran": state.executions, "failures": state.failures,
+                            "budget_s": budget, "budget_spent": spent,
                             "wall_s": round(time.monotonic() - t0, 3), "outcome": outcome}
+    session.note(f"exploration: {state.executions} sequence(s) ran" +
+                 (f"; the {budget:g} s budget was spent before {examples} examples" if spent else ""))
     if state.best is not None:
-        run.stats["explore"]["found"] = f"{state.best['clause']}: {state.best['reason']}"
+        run.stats["explore"]["found"] = state.best["reason"]
     if state.lost:
         raise LinkLost(state.lost)
     best = state.best
     if best is None:
-        run.book.add("RH-OUT-4", "pass", f"{state.executions} explored sequences agreed with the model",
-                     "explore")
         return
     cid = best["clause"]
     confirmed = _confirm(run, best)

@@ -1,18 +1,19 @@
-"""The tester's side of the serial line (RH-FRM-9): send, collect timestamped replies, log.
+"""The tester's side of the serial line (RH-FRM-9): send, receive, record — and nothing else.
 
 :class:`TesterLink` wraps a client :class:`~helmcheck.conformance.transport.Link`. It owns:
 
 * the one send function, :meth:`TesterLink.send`, where the bench-safety interlock
   (:mod:`.safety`) sees every byte before it leaves;
-* the receive side: bytes are cut into lines by the grammar's framer (with a generous limit, so
-  an overlong vehicle line is still seen and judged), every line is decoded against the
-  profile, and each arrives as an :class:`Rx` with its wall time;
-* the wire log (``helmcheck wire-log 1``) of both directions plus notes, and an in-memory
-  transcript from which the judge cuts evidence excerpts;
-* link-fault detection: :class:`LinkLost` when the device vanishes (EIO, closed socket);
-  counters of valid and garbage input so the runner can tell "silent" and "garbage" apart.
+* the receive side: bytes are cut into runs by a framer with a generous limit (so a wire-log
+  record is one line, and an overlong vehicle line still arrives whole for the judge) and each
+  arrives as an :class:`Rx` with its wall time;
+* recording: every byte each way, and every note, goes through the run's
+  :class:`~helmcheck.conformance.recorder.Recorder` — which writes the wire log and feeds the
+  judges — stamped *before* a write and *after* a read, so the times bracket what the vehicle
+  did;
+* link-fault detection: :class:`~.flow.LinkLost` when the device vanishes (EIO, closed socket).
 
-Times are wall seconds since the link was opened (``t``); nothing here knows a time scale.
+Times are wall seconds since the link was opened; nothing here knows a time scale or a clause.
 """
 
 from __future__ import annotations
@@ -20,72 +21,44 @@ from __future__ import annotations
 import time
 from collections import deque
 from dataclasses import dataclass
-from typing import IO, Optional
+from typing import Optional
 
-from ...grammar import Decoded, Discard, Framer, decode
-from ...grammar.capture import FROM_VEHICLE, NOTE, TO_VEHICLE, WireLogWriter, escape, format_record
+from ...grammar import Discard, Framer
+from ...grammar.capture import FROM_VEHICLE, TO_VEHICLE, escape
 from ...profile import Profile
+from ..recorder import Recorder
 from ..transport import Link, LinkClosed
+from .flow import LinkLost
 from .safety import BenchGuard, BenchSafetyRefused
 
-__all__ = ["TesterLink", "Rx", "LinkLost", "Entry"]
-
-#: Transcript entries kept in memory for evidence (the wire log on disk keeps everything).
-_TRANSCRIPT_MAX = 200_000
-
-
-class LinkLost(Exception):
-    """The device or connection is gone (a link fault: INCONCLUSIVE, never FAIL)."""
+__all__ = ["TesterLink", "Rx", "LinkLost"]
 
 
 @dataclass(frozen=True, slots=True)
 class Rx:
-    """One run of bytes from the vehicle: a line (``decoded`` set) or a discarded run."""
+    """One run of bytes from the vehicle: a line, or bytes the framer set aside."""
 
     t: float
     raw: bytes
-    decoded: Optional[Decoded]  #: None for bytes the framer threw away (noise, torn, overlong)
-    reason: str = ""
-
-    @property
-    def sentence(self):
-        return self.decoded.sentence if self.decoded is not None else None
-
-    @property
-    def valid(self) -> bool:
-        return self.decoded is not None and self.decoded.sentence is not None
-
-
-@dataclass(frozen=True, slots=True)
-class Entry:
-    """A transcript line: wall time, wire-log direction, text (escaped as in the wire log)."""
-
-    t: float
-    dir: str
-    line: str
-
-    def as_evidence(self) -> dict:
-        return {"t": round(self.t, 6), "dir": self.dir, "line": self.line}
+    line: bool  #: a run from ``$`` to LF within the limit
 
 
 class TesterLink:
-    """A synchronous backseat link with a wire log. See the module docstring."""
+    """A synchronous backseat link that records everything. See the module docstring."""
 
-    def __init__(self, link: Link, profile: Profile, *, log: Optional[IO[str]] = None,
-                 meta: str = "", guard: Optional[BenchGuard] = None, clock=time.monotonic):
+    def __init__(self, link: Link, profile: Profile, recorder: Recorder, *,
+                 guard: Optional[BenchGuard] = None, clock=time.monotonic):
         self.link = link
         self.profile = profile
+        self.rec = recorder
         self.clock = clock
         self.t0 = clock()
         self.guard = guard if guard is not None else BenchGuard(profile)
         self.framer = Framer(max(4096, 4 * profile.max_line_bytes))
         self.inbox: deque[Rx] = deque()
-        self.transcript: deque[Entry] = deque(maxlen=_TRANSCRIPT_MAX)
-        self.wire = WireLogWriter(log, meta) if log is not None else None
         self.bytes_in = 0
         self.bytes_out = 0
-        self.valid_in = 0
-        self.garbage_in = 0
+        self.lines_in = 0
         self.lost: Optional[str] = None
         self.per_byte = 10.0 / profile.baud if profile.baud else 0.0
 
@@ -97,32 +70,12 @@ class TesterLink:
         """Seconds the line needs for ``n`` bytes at the profile's baud (8N1)."""
         return n * self.per_byte
 
-    # ------------------------------------------------------------------ log
-    def _record(self, t: float, direction: str, raw: bytes = b"", note: str = "") -> None:
-        text = format_record(t, direction, raw, note)
-        _, d, line = (text.split(" ", 2) + [""])[:3]
-        self.transcript.append(Entry(t, d, line))
-        if self.wire is not None:
-            if direction == NOTE:
-                self.wire.note(t, note)
-            else:
-                self.wire.bytes(t, direction, raw)
-
     def note(self, text: str) -> float:
-        t = self.now()
-        self._record(t, NOTE, note=text)
-        return t
-
-    def excerpt(self, t0: float, t1: float, limit: int = 16) -> list[dict]:
-        """Evidence: the transcript lines between ``t0`` and ``t1`` (the last ``limit`` of them)."""
-        out = [e for e in self.transcript if t0 - 1e-6 <= e.t <= t1 + 1e-6]
-        if len(out) > limit:
-            out = out[:4] + out[-(limit - 4):]
-        return [e.as_evidence() for e in out]
+        return self.rec.note(self.now(), text)
 
     # ------------------------------------------------------------------ send
     def send(self, raw: bytes) -> float:
-        """Write ``raw`` (bench safety first); returns the wall time the last byte was handed over.
+        """Write ``raw`` (bench safety first); returns the time it was recorded with.
 
         Raises :class:`~.safety.BenchSafetyRefused` (nothing is sent) or :class:`LinkLost`.
         """
@@ -133,27 +86,26 @@ class TesterLink:
             self.guard.refused += 1
             self.note(f"bench safety: not sent: {why}: {escape(raw)}")
             raise BenchSafetyRefused(why)
-        self.pump(0)  # bytes that arrived before this send are timestamped before it
-        t = self.now()
-        self._record(t, TO_VEHICLE, raw)
+        self.pump(0)  # what arrived before this send is recorded before it
+        t = self.rec.bytes(self.now(), TO_VEHICLE, raw)
         try:
             self.link.write_all(raw, timeout=max(2.0, 3 * self.transmit_time(len(raw))))
         except (LinkClosed, OSError) as e:
             self._lose(f"write failed: {e}")
         self.bytes_out += len(raw)
-        return self.now()
+        return t
 
     def _lose(self, why: str) -> None:
         if not self.lost:
             self.lost = why
-            self.note(f"link lost: {why}")
             for ev in self.framer.close():
-                self._add(Rx(self.now(), ev.raw, None, ev.reason))
+                self._add(self.now(), ev.raw, False)
+            self.note(f"link lost: {why}")
         raise LinkLost(self.lost)
 
     # ------------------------------------------------------------------ receive
     def pump(self, timeout: float) -> bool:
-        """Wait up to ``timeout`` seconds for bytes; frame them into :attr:`inbox`."""
+        """Wait up to ``timeout`` seconds for bytes; record them and queue them in :attr:`inbox`."""
         if self.lost:
             raise LinkLost(self.lost)
         try:
@@ -174,22 +126,17 @@ class TesterLink:
             self.bytes_in += len(ev.data)
             for fe in self.framer.feed(ev.data):
                 got = True
-                if isinstance(fe, Discard):
-                    self._add(Rx(t, fe.raw, None, str(fe)))
-                else:
-                    self._add(Rx(t, fe.raw, decode(fe.raw, self.profile)))
+                self._add(t, fe.raw, not isinstance(fe, Discard))
         return got
 
-    def _add(self, rx: Rx) -> None:
-        self._record(rx.t, FROM_VEHICLE, rx.raw)
-        if rx.valid:
-            self.valid_in += 1
-        else:
-            self.garbage_in += 1
-        self.inbox.append(rx)
+    def _add(self, t: float, raw: bytes, line: bool) -> None:
+        t = self.rec.bytes(t, FROM_VEHICLE, raw)
+        if line:
+            self.lines_in += 1
+        self.inbox.append(Rx(t, raw, line))
 
     def next(self, deadline: float) -> Optional[Rx]:
-        """The next received run, waiting until wall time ``deadline`` (link time) at most."""
+        """The next received run, waiting until link time ``deadline`` at most."""
         while not self.inbox:
             left = deadline - self.now()
             if left <= 0:
@@ -221,9 +168,3 @@ class TesterLink:
             self.link.close()
         except Exception:  # noqa: BLE001
             pass
-        if self.wire is not None:
-            try:
-                self.wire.close()
-            except Exception:  # noqa: BLE001
-                pass
-            self.wire = None

@@ -9,7 +9,9 @@ __all__ = ["Progress"]
 
 
 class Progress:
-    """``start(total)``, ``step(label, verdict)``, ``note(text)``, ``stop()``."""
+    """``start(total)``, ``step(label, verdict)``, ``explore(ran, total, left_s)``, ``note(text)``,
+    ``stop()``. The verdict shown for a case is its subject clause's verdict as the ledger has it —
+    the word the report will use."""
 
     def __init__(self, stream: Optional[IO[str]] = None, enabled: bool = True):
         self.stream = stream or sys.stderr
@@ -46,6 +48,16 @@ class Progress:
             self.rich.update(self.task, advance=1, last=f"{label} {verdict}")
             return
         print(f"[{self.n}/{self.total}] {label} {verdict}", file=self.stream, flush=True)
+
+    def explore(self, ran: int, total: int, left_s: float) -> None:
+        """Exploration progress: sequences run of the examples asked for, and budget left."""
+        if not self.enabled:
+            return
+        text = f"exploration: sequence {ran}/{total}, {left_s:.0f} s of budget left"
+        if self.rich is not None:
+            self.rich.update(self.task, last=text)
+        else:
+            print(text, file=self.stream, flush=True)
 
     def note(self, text: str) -> None:
         if not self.enabled:

@@ -58,26 +58,24 @@ def load_replay(path: Path) -> dict:
 
 
 def redrive(doc: dict, session) -> tuple[str, str, Optional[str]]:
-    """Re-drive the steps on ``session``: (``fail``/``pass``, reason, clause)."""
-    from .judge import CaseFail, CaseInconclusive, CaseNotTested
+    """Re-drive the steps on ``session``: (``fail``/``pass``/``inconclusive``, reason, clause).
+
+    The steps start with the verified reset the sequence began with; the session's observer
+    judges every reply, as in any run."""
+    from .flow import CaseStop
     from .safety import BenchSafetyRefused
 
-    session.case, session.case_t0 = "replay", session.now()
-    session.mirror.fresh()
-    first = True
+    session.mark = session.ledger.mark()
     try:
         for st in doc["steps"]:
             if "send" in st:
                 raw = unescape(st["send"])
                 try:
-                    session.exchange(raw, judge=not first)
+                    session.exchange(raw)
                 except BenchSafetyRefused as e:
                     return "inconclusive", f"a step was not sent: {e}", None
-                first = False
             elif "wait" in st:
                 session.wait(float(st["wait"]))
-    except CaseFail as f:
-        return "fail", f"{f.clause}: {f.reason}", f.clause
-    except (CaseInconclusive, CaseNotTested) as e:
-        return "inconclusive", getattr(e, "reason", str(e)), None
+    except CaseStop as f:
+        return ("fail" if f.outcome == "fail" else "inconclusive"), f.reason, f.clause
     return "pass", f"all {len(doc['steps'])} steps agreed with the model", None

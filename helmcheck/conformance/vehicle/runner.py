@@ -1,14 +1,19 @@
 """One certification run of a vehicle: cases, exploration, results and reports.
 
-:func:`certify` opens the port, checks that something answers (a link that carries nothing, or
-only garbage, is INCONCLUSIVE with the reason), runs the selected clause cases in order with a
-verified reset before each (:mod:`.cases`), then the hypothesis exploration (:mod:`.explore`),
-and writes ``DIR/results.json`` (schema 1, ``role: vehicle``) after every case — atomically, so a
+:func:`certify` opens the port, records a ``link:`` note (the line's settings, RH-FRM-9), checks
+that something answers (a link that carries nothing, or only garbage, is INCONCLUSIVE with the
+reason), runs the selected clause cases in order (:mod:`.interpreter`), then the hypothesis
+exploration (:mod:`.explore`), and writes ``DIR/results.json`` after every case — atomically, so a
 crash or Ctrl-C leaves a valid partial report marked ``partial`` — plus ``DIR/wire.log`` and, at
-the end, every report format (:func:`helmcheck.reports.render.render_all`).
+the end, every report format.
 
-A vanished device stops the run: the clauses not yet judged are INCONCLUSIVE with that reason,
-and the report is still written.
+Every byte and note goes through one :class:`~helmcheck.conformance.recorder.Recorder`: to the
+wire log and to the one vehicle observer (:class:`~helmcheck.judge.vehicle.VehicleObserver`),
+which writes the one ledger. The clause verdicts in ``results.json`` are that ledger's; an
+offline ``check-log`` of ``wire.log`` feeds the same observer the same events.
+
+A vanished device stops the run: a ``run aborted`` note makes the clauses not yet judged
+INCONCLUSIVE with that reason, and the report is still written.
 """
 
 from __future__ import annotations
@@ -16,25 +21,26 @@ from __future__ import annotations
 import shutil
 import time
 from dataclasses import dataclass, field
+from fnmatch import fnmatchcase
 from pathlib import Path
 from typing import Optional
 
 from ... import __version__
 from ...clauses import vehicle_clauses
-from ...model.transitions import REMOTE_MODES
+from ...judge import Ledger
+from ...judge.vehicle import VehicleObserver
 from ...profile import Profile
 from ...reports import results as R
+from ..recorder import Recorder
 from ..transport import open_link
-from .cases import Case, run_case, select_cases
-from .judge import Book, CaseFail, CaseInconclusive, CaseNotTested
-from .link import LinkLost, TesterLink
+from .catalogue import select_cases
+from .flow import LinkLost, LinkSilent
+from .interpreter import run_case
+from .link import TesterLink
 from .progress import Progress
-from .session import LinkSilent, Session, frame
+from .session import Session, frame
 
-__all__ = ["Options", "certify", "Outcome"]
-
-_INTERRUPTS = ("OMS", "OMP", "OPK", "OMW", "OJW")
-_MAX_EVENTS = 5000
+__all__ = ["Options", "certify", "Outcome", "Run"]
 
 
 @dataclass
@@ -54,6 +60,7 @@ class Options:
     command: str = ""
     render: bool = True
     explore_budget_s: Optional[float] = None  #: wall seconds for exploration (default: the hypothesis profile's)
+    max_wait: Optional[float] = None  #: wall seconds any one wait may last (None: what the protocol needs)
 
 
 @dataclass
@@ -65,56 +72,7 @@ class Outcome:
     results: dict = field(default_factory=dict)
 
 
-class Recorder:
-    """Timeline, events and model coverage for ``results.json``."""
-
-    def __init__(self, results: dict):
-        self.r = results
-        self.modes: set = set()
-        self.transitions: set = set()
-        self.pairs: set = set()
-        self.last_mode: Optional[str] = None
-
-    def _event(self, t: float, kind: str, label: str) -> None:
-        if len(self.r["events"]) < _MAX_EVENTS:
-            R.add_event(self.r, round(t, 6), kind, label[:120])
-
-    def event(self, t: float, kind: str, label: str) -> None:
-        self._event(t, kind, label)
-
-    def command(self, t: float, raw: bytes) -> None:
-        text = raw.decode("latin-1", "replace").strip()
-        self._event(t, "command", text)
-
-    def answered(self, ex, before: str, after: str) -> None:
-        a = ex.ack
-        item = ex.item
-        cid = getattr(item, "ID", None) or getattr(item, "sentence_id", None) or "?"
-        if a is not None and a.status != 0:
-            self._event(ex.t_ack, "ack-error", f"$ACK,{a.type},{a.status},{a.err} for ${cid}")
-            if a.err == 26:
-                self._event(ex.t_ack, "lockout", f"${cid} refused: lockout (26)")
-        elif a is not None:
-            if before != after and cid != "OSD":
-                self.transitions.add((before, cid, after))
-            if before in REMOTE_MODES and cid in _INTERRUPTS:
-                self.pairs.add((before, cid))
-
-    def mode(self, t: float, mode: str) -> None:
-        R.add_mode(self.r, round(t, 6), mode)
-        self.modes.add(mode)
-        if self.last_mode is not None and self.last_mode != mode:
-            self.transitions.add((self.last_mode, "observed", mode))
-        self.last_mode = mode
-
-    def flush(self) -> None:
-        self.r["coverage"] = {"modes": sorted(self.modes),
-                              "transitions": [list(t) for t in sorted(self.transitions)],
-                              "interrupt_pairs": [list(p) for p in sorted(self.pairs)]}
-
-
-def _selected_ids(select: Optional[list]) -> list[str]:
-    from fnmatch import fnmatchcase
+def selected_ids(select: Optional[list]) -> list[str]:
     ids = [c.id for c in vehicle_clauses()]
     if not select:
         return ids
@@ -130,8 +88,10 @@ class Run:
         self.k = opts.time_scale
         self.dir = Path(opts.report_dir)
         self.dir.mkdir(parents=True, exist_ok=True)
-        self.ids = _selected_ids(opts.select)
-        self.book = Book(self.ids)
+        self.ids = selected_ids(opts.select)
+        #: every vehicle clause: a finding the observer makes outside the selection is kept
+        self.ledger = Ledger([c.id for c in vehicle_clauses()])
+        self.observer = VehicleObserver(self.p, self.ledger, time_scale=self.k, baud=self.p.baud)
         self.progress = Progress(enabled=opts.progress)
         self.aborted: Optional[str] = None
         self.partial = False
@@ -145,40 +105,49 @@ class Run:
             settings["seed"] = opts.seed
         if opts.examples is not None:
             settings["examples"] = opts.examples
-        prof = self.p.as_dict()
         self.results = R.new_results("vehicle", command=opts.command, tool_version=__version__,
                                      implementation={"port": opts.port, "protocol": self.p.protocol,
                                                      "osi_fields": self.p.osi_fields,
                                                      "fault_injection": self.p.fault_injection},
-                                     profile=prof, settings=settings, seed=opts.seed)
+                                     profile=self.p.as_dict(), settings=settings, seed=opts.seed)
         self.results["cases"] = []
-        self.rec = Recorder(self.results)
+        self.recorder: Optional[Recorder] = None
         self.link: Optional[TesterLink] = None
         self.session: Optional[Session] = None
-        self.log_file = None
         self.stats: dict = {}
 
     # ------------------------------------------------------------------ results
     def save(self, final: bool = False) -> None:
-        self.rec.flush()
         r = self.results
+        obs = self.observer
+        entries = {e["id"]: e for e in self.ledger.entries()}
+        chosen = set(self.ids)
         r["clauses"] = []
-        r_ids = set()
-        for cid in self.ids:
-            verdict, reason, cases, ev, n = self.book.verdict(cid, self._default_reason(cid))
-            if self.aborted and verdict == "not-tested" and cid not in self._not_applicable:
-                verdict, reason = "inconclusive", f"not judged: {self.aborted}"
-            R.add_clause(r, cid, verdict, reason, cases=cases, evidence=ev[-16:], offending_count=n)
-            r_ids.add(cid)
         for c in vehicle_clauses():
-            if c.id not in r_ids:
-                R.add_clause(r, c.id, "not-tested", "not selected (--select)")
+            e = entries[c.id]
+            if c.id not in chosen:
+                if e["verdict"] in ("fail", "non-strict"):
+                    e["reason"] = "not selected, but observed: " + e["reason"]
+                else:
+                    e = {"id": c.id, "verdict": "not-tested", "reason": "not selected (--select)", "level": c.level,
+                         "cases": [], "evidence": [], "offending_count": 0, "replay": None}
+            r["clauses"].append(e)
         for rep in r["replays"]:
             for c in r["clauses"]:
                 if c["id"] == rep["clause"]:
                     c["replay"] = rep["file"]
+        r["timeline"] = [{"t": t, "mode": m} for t, m in obs.timeline]
+        r["events"] = list(obs.events)
+        modes = sorted({m for _, m in obs.timeline})
+        pairs = [list(p) for p in sorted(obs.interrupt_pairs)]
+        steps = [[a, "observed", b] for (_, a), (_, b) in zip(obs.timeline, obs.timeline[1:]) if a != b]
+        r["coverage"] = {"modes": modes, "transitions": [list(x) for x in sorted({tuple(s) for s in steps})],
+                         "interrupt_pairs": pairs}
+        if obs.last_osi is not None and obs.last_osi.vehicle_name:
+            r["implementation"]["vehicle_name"] = obs.last_osi.vehicle_name
+        if self.link is not None:
+            r["settings"]["bench_safety"]["refused_lines"] = self.link.guard.refused
         if self.session is not None:
-            r["settings"]["bench_safety"]["refused_lines"] = self.session.link.guard.refused
             self.stats["forced_wait_s"] = round(self.session.forced_wait, 3)
         self.stats["wall_s"] = round(time.monotonic() - self.t_start, 3)
         r["stats"] = self.stats
@@ -190,30 +159,26 @@ class Run:
             r["verdict_reason"] = "The run is in progress."
         R.write_results_atomic(self.dir, r)
 
-    _not_applicable: set = set()
-
-    def _default_reason(self, cid: str) -> str:
-        return "no case exercised this clause"
-
     # ------------------------------------------------------------------ main
     def open(self) -> None:
-        wire_path = self.dir / R.WIRE_LOG_NAME
-        self.log_file = open(wire_path, "w", encoding="utf-8")
-        meta = (f"started {time.strftime('%Y-%m-%dT%H:%M:%SZ', time.gmtime())}  port {self.o.port}  "
-                f"baud {self.p.baud}  time_scale {self.k:g}")
+        wire = open(self.dir / R.WIRE_LOG_NAME, "w", encoding="utf-8")
+        meta = [f"started {time.strftime('%Y-%m-%dT%H:%M:%SZ', time.gmtime())}  port {self.o.port}  "
+                f"baud {self.p.baud}  time_scale {self.k:g}",
+                f"helmcheck {__version__} certify vehicle; profile {self.p.name}"]
+        self.recorder = Recorder(wire, meta, [self.observer])
         try:
             raw = open_link(self.o.port, role="client", baud=self.p.baud)
         except (OSError, ValueError) as e:
-            self.log_file.write("# helmcheck wire-log 1\n")
             raise LinkLost(f"cannot open {self.o.port}: {getattr(e, 'strerror', None) or e}") from None
-        self.link = TesterLink(raw, self.p, log=self.log_file, meta=meta)
+        self.link = TesterLink(raw, self.p, self.recorder)
         try:
             ser = getattr(raw, "ser", None)
             if ser is not None:
                 ser.reset_input_buffer()
         except Exception:  # noqa: BLE001
             pass
-        self.session = Session(self.link, self.p, self.k, self.book, self.rec)
+        self.link.note(f"link: {self.p.baud} baud 8N1 {self.o.port}")
+        self.session = Session(self.link, self.p, self.k, self.observer, max_wait=self.o.max_wait)
 
     def probe(self) -> None:
         """Does anything answer? Nothing at all, or only garbage, is a link fault."""
@@ -228,94 +193,57 @@ class Run:
                 rx = link.next(end)
                 if rx is None:
                     break
-                if rx.valid:  # something speaks the protocol; the cases judge the rest
+                if self.observer.alive_t is not None:
                     link.sleep(0.1)
                     link.drain()
                     return
         if link.bytes_in == 0:
             raise LinkSilent(f"no bytes at all from {self.o.port} in {link.now():.1f} s: is a vehicle on "
                              f"this port, powered, at {self.p.baud} baud?")
-        if link.valid_in == 0:
-            raise LinkLost(f"{link.bytes_in} bytes from {self.o.port}, none of them a valid sentence "
-                           f"(garbage: wrong baud or not a remote-helm vehicle?)")
-        raise LinkLost(f"{self.o.port}: no valid sentence in reply to $OSD,S")  # pragma: no cover
+        raise LinkLost(f"{link.bytes_in} bytes from {self.o.port}, none of them a valid sentence "
+                       f"(garbage: wrong baud or not a remote-helm vehicle?)")
 
-    def run_cases(self, cases: list[Case]) -> None:
+    def run_cases(self, cases: list) -> None:
         ses = self.session
         assert ses is not None
         for case in cases:
-            ses.case, ses.case_t0 = case.id, ses.now()
-            ses.link.note(f"case {case.id} {' '.join(case.clauses)}: {case.title}")
             entry = {"id": case.id, "clauses": list(case.clauses), "title": case.title,
-                     "expectation": case.expectation, "start": case.start,
-                     "steps": case.describe()["steps"]}
-            if all(self.book.failed(cid) for cid in case.clauses):
-                # first fail wins: a later case cannot change these clauses' verdicts
+                     "expectation": case.expectation, "start": case.start, "steps": case.describe()["steps"]}
+            if all(self.ledger.has_failed(cid) for cid in case.clauses):
                 entry.update(verdict="not-run", reason="its clauses had already failed", wall_s=0.0)
                 self.results["cases"].append(entry)
                 self.progress.step(f"{case.id} {case.subject}", "skipped (already failed)")
                 continue
             t0 = time.monotonic()
             try:
-                verdict, reason, _ = run_case(ses, case)
-                for cid in case.clauses:
-                    self.book.add(cid, "pass", reason, case.id, ses.evidence()[-6:])
-            except CaseFail as f:
-                verdict, reason = "fail", f"{f.clause}: {f.reason}"
-                ev = ses.evidence()
-                self.book.add(f.clause, "fail", f"{case.id}: {f.reason}", case.id, ev)
-                for extra in f.also:
-                    if extra != f.clause:
-                        self.book.add(extra, "fail", f"{case.id}: {f.reason}", case.id, ev)
-                if f.clause not in case.clauses:
-                    for cid in case.clauses:
-                        self.book.add(cid, "inconclusive", f"{case.id} stopped: {f.clause} failed first",
-                                      case.id, ev)
-            except CaseInconclusive as e:
-                verdict, reason = "inconclusive", e.reason
-                self.book.add(e.clause if e.clause in case.clauses or not e.clause else case.subject,
-                              "inconclusive", f"{case.id}: {e.reason}", case.id, ses.evidence())
-            except CaseNotTested as e:
-                verdict, reason = "not-tested", e.reason
-                for cid in case.clauses:
-                    self.book.add(cid, "not-tested", f"{case.id}: {e.reason}", case.id)
+                outcome, reason = run_case(ses, case)
             except LinkLost as e:
-                self.aborted = f"link fault during {case.id}: {e}"
-                entry.update(verdict="inconclusive", reason=str(e))
+                entry.update(verdict="inconclusive", reason=str(e), wall_s=round(time.monotonic() - t0, 3))
                 self.results["cases"].append(entry)
-                for cid in case.clauses:
-                    self.book.add(cid, "inconclusive", f"{case.id}: {e}", case.id, ses.evidence())
                 self.progress.step(case.id, "inconclusive (link)")
                 raise
-            entry.update(verdict=verdict, reason=reason, wall_s=round(time.monotonic() - t0, 3))
+            entry.update(verdict="pass" if outcome == "done" else outcome, reason=reason,
+                         wall_s=round(time.monotonic() - t0, 3))
             self.results["cases"].append(entry)
-            self.progress.step(f"{case.id} {case.subject}", verdict)
+            self.progress.step(f"{case.id} {case.subject}", self.ledger.verdict(case.subject).verdict
+                               if case.subject in self.ledger else outcome)
             self.save()
 
-    def finish_clauses(self) -> None:
-        """Clauses judged by all observations rather than by one case."""
-        b = self.book
-        link = self.session.link if self.session else None
-        if link is not None and link.garbage_in:
-            b.add("RH-FRM-1", "inconclusive" if link.garbage_in > 2 else "pass",
-                  f"{link.garbage_in} runs of bytes from the vehicle were not well-framed sentences "
-                  f"(line noise or a vehicle fault: cannot attribute)")
-        if self.p.fault_injection != "oxflt":
-            for cid in ("RH-SAF-1", "RH-SAF-2", "RH-SAF-3", "RH-SAF-4", "RH-SAF-5"):
-                if not b.outcomes.get(cid):
-                    b.add(cid, "not-tested", "the profile declares fault_injection = \"none\" and no safety "
-                                             "violation happened by itself during the run")
-            self._not_applicable = {"RH-SAF-1", "RH-SAF-2", "RH-SAF-3", "RH-SAF-4", "RH-SAF-5"}
-        if self.p.bench_safety.in_water is False:
-            self.stats["bench_safety"] = "enforced"
+    def end(self, reason: Optional[str]) -> None:
+        """Close the record: a ``run aborted`` note when it ended early, then the observer."""
+        if self.recorder is not None and self.link is not None:
+            if reason:
+                self.link.note(f"run aborted: {reason}")
+            else:
+                self.link.note("run ends")
+        self.observer.close()
 
 
 def certify(opts: Options) -> Outcome:
     """Run a whole certification (module docstring); never raises for vehicle or link faults."""
     run = Run(opts)
     cases = select_cases(opts.select, opts.profile)
-    n_steps = len(cases) + (1 if opts.explore else 0)
-    run.progress.start(n_steps)
+    run.progress.start(len(cases) + (1 if opts.explore else 0))
     try:
         run.save()
         try:
@@ -335,14 +263,13 @@ def certify(opts: Options) -> Outcome:
     finally:
         run.progress.stop()
         try:
-            run.finish_clauses()
-        except Exception:  # noqa: BLE001
-            pass
-        if run.link is not None:
-            run.link.close()
-        elif run.log_file is not None:
-            run.log_file.close()
-        run.save(final=True)
+            run.end(run.aborted)
+        finally:
+            if run.link is not None:
+                run.link.close()
+            if run.recorder is not None:
+                run.recorder.close()
+            run.save(final=True)
         if opts.wire_log is not None:
             try:
                 shutil.copyfile(run.dir / R.WIRE_LOG_NAME, opts.wire_log)

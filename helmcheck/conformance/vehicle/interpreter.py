@@ -1,0 +1,286 @@
+"""The interpreter of the clause cases: steps (:mod:`.steps`) into session calls (:mod:`.session`).
+
+:func:`run_case` writes the case's note (``case V-22 RH-INT-2: …``, so every finding inside it
+is booked on the clauses it is about), does the verified reset to its start state, runs its
+steps and closes it (``case V-22 end``). It returns the case's outcome for the report's case
+list — the *clause* verdicts are the observer's, in the ledger.
+
+Things the tester knows and the wire does not are written to the log as notes, so an offline
+check reaches the same verdicts: a case the profile does not let run (``not tested …``), a step
+the bench-safety interlock refused (``not tested <clause>: …`` — a clause is never passed by a
+step that was not sent), a state the case needed and the vehicle — conformingly — was not in
+(``inconclusive …``), a case whose expectation disagrees with the model (the tester's fault,
+``inconclusive``).
+"""
+
+from __future__ import annotations
+
+from decimal import Decimal
+from typing import Optional
+
+from ...grammar import checksum_hex
+from ...grammar import sentences as s
+from ...profile import Profile
+from .catalogue import unmet_need
+from .flow import CaseStop
+from .safety import BenchSafetyRefused
+from .session import Session, frame
+from .steps import (Burst, Case, Fault, MissionEnd, Octd, Poll, Raw, Send, SetRoundTrip, Settle, Start, Until,
+                    Wait, WithSetting)
+
+__all__ = ["run_case", "run_step", "raw_line", "context", "fill"]
+
+
+# ============================================================================ templates
+
+def context(session: Session) -> dict:
+    p = session.profile
+    lat, lon = session.here()
+    bench = p.bench_safety
+    speed = Decimal(str(min(2.0, p.max_speed_kn, bench.max_speed_kn if not bench.in_water else 99)))
+    motor = min(0x90, p.bench_safety.max_motor_byte if not bench.in_water else 0x90)
+    motor = max(0x80, motor)
+    nwp = p.mission_waypoints
+    base = p.waypoint_base
+    ctx = {"mission": p.mission, "speed": f"{speed.normalize():f}", "motor": f"{motor:02X}",
+           "wp_last": str(nwp - 1 + base), "wp_bad": str(nwp + base),
+           "depth_over": f"{p.max_depth + 1:g}", "speed_over": f"{p.max_speed_kn + 0.5:g}"}
+    _position(ctx, lat, lon)
+    _other(session, ctx)
+    return ctx
+
+
+def _position(ctx: dict, lat: str, lon: str) -> None:
+    ctx.update(lat=lat, lon=lon, near_lat=f"{float(lat) + 0.001:.6f}", near_lon=f"{float(lon) + 0.001:.6f}",
+               far_lat=f"{float(lat) + 1.0:.6f}")
+
+
+def _other(session: Session, ctx: dict) -> None:
+    """``{wp_other}``: a waypoint of the test mission that is not its (learnt) park waypoint."""
+    p = session.profile
+    entry = session.obs.missions.entry(p.mission)
+    park = entry.park_waypoint if entry is not None else None
+    n = max(1, p.mission_waypoints)
+    other = 1 % n if park is None else (park + 1) % n
+    ctx["wp_other"] = str(other + p.waypoint_base)
+
+
+def _here(session: Session, ctx: dict) -> None:
+    _position(ctx, *session.here())
+    _other(session, ctx)
+
+
+def fill(text: str, ctx: dict) -> str:
+    return text.format(**ctx) if "{" in text else text
+
+
+def raw_line(kind: str, body: str, profile: Profile) -> bytes:
+    """One negative (or boundary) line derived from ``body`` (:data:`.steps.RAW_KINDS`)."""
+    good = frame(body)
+    if kind == "badck":
+        ck = int(checksum_hex(body), 16) ^ 0x5A
+        return b"$" + body.encode() + b"*" + f"{ck:02X}".encode() + b"\r\n"
+    if kind == "lowerck":
+        pad = body
+        while body.startswith("OSD") and not any(c in "ABCDEF" for c in checksum_hex(pad)) and len(pad) < 60:
+            pad += ","  # $OSD takes empty fields (RH-RD-7): find a checksum with a hex letter
+        if not any(c in "ABCDEF" for c in checksum_hex(pad)):
+            pad = body + ("," if body.startswith("OSD") else "")
+        return frame(pad, lowercase=True)
+    if kind == "nock":
+        return b"$" + body.encode() + b"\r\n"
+    if kind == "shortck":
+        return b"$" + body.encode() + b"*" + checksum_hex(body)[:1].encode() + b"\r\n"
+    if kind == "twostar":
+        b2 = body + "*"
+        return b"$" + b2.encode() + b"*" + checksum_hex(b2).encode() + b"\r\n"
+    if kind == "unknown":
+        return good
+    if kind == "lowerid":
+        return frame(body.lower())
+    if kind in ("exact256", "overlong"):
+        want = profile.max_line_bytes + (1 if kind == "overlong" else 0)
+        pad = body
+        while len(frame(pad)) < want:
+            pad += ","
+        line = frame(pad)
+        if len(line) > want:  # cannot hit the size exactly with commas only (never happens)
+            line = line[:want - 2] + b"\r\n"
+        return line
+    if kind == "noise":
+        return b"\x00\xffnoise,junk*7F" + good
+    if kind == "torn":
+        return b"$" + body.encode() + b"," + frame("OSD,S")
+    if kind == "barelf":
+        return frame(body, terminator="\n")
+    raise ValueError(f"unknown raw line kind {kind!r}")
+
+
+# ============================================================================ steps
+
+def _not_reached(session: Session, what: str) -> CaseStop:
+    reason = f"{session.case}: {what} (as a conforming vehicle may); the case could not exercise its clause"
+    session.tester("inconclusive", session.case_clauses[:1], reason)
+    return CaseStop("inconclusive", reason)
+
+
+def _condition(session: Session, osi: s.OSI, mode: Optional[str], mode_not: Optional[str] = None,
+               park_below: Optional[int] = None) -> bool:
+    ok = True
+    if mode is not None and osi.mode not in mode.split("|"):
+        ok = False
+    if mode_not is not None and osi.mode == mode_not:
+        ok = False
+    if park_below is not None and not osi.park_time < park_below:
+        ok = False
+    return ok
+
+
+def _check_expect(session: Session, sent, text: str) -> None:
+    """The case's ``expect`` words must agree with the model (else it is the case's fault)."""
+    if not text.startswith("$ACK,") or sent is None or sent.ack is None:
+        return
+    want = text[5:].split(",")
+    model = next((r for r in sent.expected if isinstance(r, s.ACK)), None)
+    if model is None:
+        return
+    got = [str(model.type), str(model.status), str(model.err)]
+    if want[:3] != got:
+        reason = (f"{session.case}: the case expects $ACK,{','.join(want[:3])} but the reference model "
+                  f"answers $ACK,{','.join(got)} here (a fault of the case, not the vehicle)")
+        session.tester("inconclusive", session.case_clauses[:1], reason)
+        raise CaseStop("inconclusive", reason)
+
+
+def run_step(session: Session, st, ctx: dict) -> None:
+    """Carry out one step of a case."""
+    if isinstance(st, Send):
+        sent = session.exchange(frame(fill(st.body, ctx)))
+        _check_expect(session, sent, st.expect)
+    elif isinstance(st, Raw):
+        session.exchange(raw_line(st.kind, fill(st.body, ctx), session.profile))
+    elif isinstance(st, Poll):
+        osi = session.poll()
+        _here(session, ctx)
+        if not _condition(session, osi, st.mode, st.mode_not, st.park_below):
+            want = st.mode or (f"not {st.mode_not}" if st.mode_not else f"P below {st.park_below}")
+            raise _not_reached(session, f"the vehicle reports {osi.mode} P{osi.park_time} where the case "
+                                        f"needs {want}")
+    elif isinstance(st, Wait):
+        session.wait(st.vehicle_s, frame(fill(st.probe, ctx)) if st.probe else None)
+    elif isinstance(st, Settle):
+        session.settle(st.timer, frame(fill(st.probe, ctx)) if st.probe else None, session.case_clauses[0])
+        _here(session, ctx)
+    elif isinstance(st, Until):
+        _until(session, st)
+        _here(session, ctx)
+    elif isinstance(st, Fault):
+        session.exchange(frame(f"OXFLT,{st.code}"))
+    elif isinstance(st, Start):
+        p = session.profile
+        name = getattr(p, st.which)
+        session.start_mission(name, p.srp_mission if st.srp else "", st.ignore_gps)
+        _here(session, ctx)
+    elif isinstance(st, MissionEnd):
+        session.until(f"the end of {session.profile.end_mission} (S)", lambda o: o.mode == "S", st.cap_v,
+                      session.case_clauses[0])
+        _here(session, ctx)
+    elif isinstance(st, WithSetting):
+        _with_setting(session, st, ctx)
+    elif isinstance(st, Burst):
+        session.burst([frame(fill(b, ctx)) for b in st.bodies])
+    elif isinstance(st, SetRoundTrip):
+        _set_round_trip(session, st)
+    elif isinstance(st, Octd):
+        if "T" in session.profile.osd_letters:
+            session.exchange(frame("OSD,T"))
+    else:  # pragma: no cover
+        raise TypeError(st)
+
+
+def _until(session: Session, st: Until) -> None:
+    fix = session.profile.gps_fix_depth_m
+    srp = None if st.srp_active is None else ("True" if st.srp_active else "False")
+
+    def pred(o: s.OSI) -> bool:
+        flag = o.srp_active if session.profile.protocol == "rh5" else o.battery
+        return (_condition(session, o, st.mode, None, st.park_below)
+                and (not st.surface or (o.depth is not None and float(o.depth) <= fix))
+                and (srp is None or flag == srp))
+    session.until(st.what, pred, st.budget_v, session.case_clauses[0])
+
+
+def _with_setting(session: Session, st: WithSetting, ctx: dict) -> None:
+    """Read ``setting`` in ``S``, write it, run the steps; always write back what was read."""
+    read = session.exchange(frame(f"ORWSET,{st.setting},R"))
+    if read is None or not read.accepted or len(read.ack.extra) < 3:
+        raise _not_reached(session, f"reading {st.setting} in S gave no value to restore afterwards")
+    orig = list(read.ack.extra[2:])
+    w = session.exchange(frame(f"ORWSET,{st.setting},W,1,{st.value}"))
+    if w is None or not w.accepted:
+        raise _not_reached(session, f"writing {st.setting} = {st.value} in S was refused")
+    try:
+        for sub in st.steps:
+            run_step(session, sub, ctx)
+    finally:
+        _restore(session, st.setting, orig)
+
+
+def _restore(session: Session, setting: str, orig: list) -> None:
+    """Stop the mission (verified reset) and write ``orig`` back; verified by a read."""
+    stop, session.stop_on_fail = session.stop_on_fail, False
+    try:
+        session.reset(mission=False)
+        session.exchange(frame(f"ORWSET,{setting},W,{','.join(orig)}"))
+        back = session.exchange(frame(f"ORWSET,{setting},R"))
+        if back is None or back.ack is None or list(back.ack.extra[2:]) != orig:
+            session.note(f"restore: {setting} could not be verified as {','.join(orig)}")
+    finally:
+        session.stop_on_fail = stop
+
+
+def _set_round_trip(session: Session, st: SetRoundTrip) -> None:
+    """RH-SET-2: read, write a changed state and value, read back (the observer compares);
+    the original is always written back."""
+    read = session.exchange(frame(f"ORWSET,{st.setting},R"))
+    if read is None or not read.accepted or len(read.ack.extra) < 3:
+        raise _not_reached(session, f"reading {st.setting} gave no value to restore afterwards")
+    orig = list(read.ack.extra[2:])
+    new_state = "0" if orig[0] == "1" else "1"
+    try:
+        session.exchange(frame(f"ORWSET,{st.setting},W,{new_state},7"))
+        session.exchange(frame(f"ORWSET,{st.setting},R"))
+    finally:
+        stop, session.stop_on_fail = session.stop_on_fail, False
+        try:
+            session.exchange(frame(f"ORWSET,{st.setting},W,{','.join(orig)}"))
+        finally:
+            session.stop_on_fail = stop
+
+
+# ============================================================================ cases
+
+def run_case(session: Session, case: Case) -> tuple[str, str]:
+    """Run one case: its outcome for the report's case list, and why."""
+    why = unmet_need(case, session.profile)
+    if why:
+        session.tester("not-tested", case.clauses, f"{case.id}: {why}")
+        return "not-tested", why
+    session.begin_case(case.id, case.clauses, case.title)
+    try:
+        session.reset(mission=case.start in ("N", "P"), park=case.start == "P")
+        ctx = context(session)
+        for st in case.steps:
+            try:
+                run_step(session, st, ctx)
+            except BenchSafetyRefused as e:
+                session.tester("not-tested", case.clauses[:1],
+                               f"{case.id}: a step was not sent: {e} — the clause is not exercised by it")
+        got = session.failures()
+        if got:
+            return "fail", f"{got[0][0]}: {got[0][1]}"
+        return "done", f"{case.id}: {case.title.lower()} — ran to the end; the clause verdicts are the observer's"
+    except CaseStop as e:
+        return e.outcome, e.reason
+    finally:
+        session.end_case()

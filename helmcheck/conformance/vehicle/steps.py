@@ -1,0 +1,174 @@
+"""The step vocabulary of the clause cases: plain data, interpreted by :mod:`.interpreter`.
+
+A step says what the tester does; it never says what verdict follows — the vehicle observer
+judges every reply and report. Where a step names a state (``Poll(mode="A")``) it is an
+*exercise condition*: the case needs the vehicle there to exercise its clause. A conforming
+vehicle that is elsewhere (the observer found nothing wrong) means the case could not exercise
+the clause on this vehicle: INCONCLUSIVE with that reason, never PASS.
+
+Templates in step text: ``{mission}`` the profile's mission, ``{speed}`` a speed within the
+bench-safety limit, ``{motor}`` a motor byte within it, ``{lat}``/``{lon}`` the vehicle's last
+reported position, ``{near_lat}``/``{near_lon}`` a point ~110 m north/east of it, ``{far_lat}`` one
+~111 km north, ``{wp_last}``/``{wp_bad}`` the last and one-past-the-last waypoint number,
+``{wp_other}`` a waypoint of the test mission other than its learnt park waypoint,
+``{depth_over}`` a depth just over ``max_depth``, ``{speed_over}`` a speed just over
+``max_speed_kn``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Optional
+
+__all__ = ["Send", "Raw", "Poll", "Wait", "Settle", "Until", "Fault", "Start", "MissionEnd", "WithSetting",
+           "Burst", "SetRoundTrip", "Octd", "Case", "RAW_KINDS"]
+
+#: Mutations of a valid sentence (:func:`.interpreter.raw_line`), each tied to its clause.
+RAW_KINDS = {
+    "badck": "RH-FRM-2: a wrong checksum",
+    "lowerck": "RH-FRM-3: lower-case checksum hex",
+    "nock": "RH-FRM-4: no *hh",
+    "shortck": "RH-FRM-4: one hex digit",
+    "twostar": "RH-FRM-4, RH-RD-16: two '*'",
+    "unknown": "RH-FRM-5: an unknown ID (sent as is)",
+    "lowerid": "RH-FRM-5, RH-RD-16: a lower-case ID",
+    "exact256": "RH-FRM-6: exactly max_line_bytes with CR LF",
+    "overlong": "RH-FRM-6: one byte more",
+    "noise": "RH-FRM-7: bytes before '$'",
+    "torn": "RH-FRM-7: a sentence cut by the next '$'",
+    "barelf": "RH-FRM-7: a bare LF terminator",
+}
+
+
+@dataclass(frozen=True)
+class Send:
+    """Send a framed command. ``expect``: the answer in words, for people and replay files; the
+    interpreter checks it agrees with the model (a disagreement is the case's fault)."""
+
+    body: str
+    expect: str = ""
+
+
+@dataclass(frozen=True)
+class Raw:
+    """Send a mutated line (:data:`RAW_KINDS`)."""
+
+    kind: str
+    body: str
+
+
+@dataclass(frozen=True)
+class Poll:
+    """``$OSD,S``. ``mode``/``mode_not``/``park_below``: exercise conditions (module docstring)."""
+
+    mode: Optional[str] = None
+    mode_not: Optional[str] = None
+    park_below: Optional[int] = None
+
+
+@dataclass(frozen=True)
+class Wait:
+    """Let protocol time pass (vehicle seconds), polling; ``probe`` is sent each round."""
+
+    vehicle_s: float
+    probe: Optional[str] = None
+
+
+@dataclass(frozen=True)
+class Settle:
+    """Poll across a model timer's deadline until the vehicle left the state before it."""
+
+    timer: Optional[str] = None
+    probe: Optional[str] = None
+
+
+@dataclass(frozen=True)
+class Until:
+    """Poll until the ``$OSI`` shows ``mode`` (and ``park_below``, the surface, the SRP flag)."""
+
+    what: str
+    mode: Optional[str] = None
+    park_below: Optional[int] = None
+    budget_v: float = 600.0
+    surface: bool = False
+    srp_active: Optional[bool] = None
+
+
+@dataclass(frozen=True)
+class Fault:
+    """``$OXFLT,<code>``: raise a safety violation (RH-SAF-5); no ACK is due."""
+
+    code: str = "Sle"
+
+
+@dataclass(frozen=True)
+class Start:
+    """Start a mission by name (rh5 form): the profile key ``which`` names it; ``srp`` gives the
+    profile's ``srp_mission`` as the SRP (RH-RD-6); ``ignore_gps`` sets the first flag."""
+
+    ignore_gps: int = 0
+    which: str = "mission"
+    srp: bool = False
+
+
+@dataclass(frozen=True)
+class MissionEnd:
+    """Poll until the running mission ends (``S``), at most ``cap_v`` vehicle seconds."""
+
+    cap_v: float = 1800.0
+
+
+@dataclass(frozen=True)
+class WithSetting:
+    """Read ``setting`` (in ``S``), write state 1 and ``value``, run ``steps``; then stop the
+    mission (the verified reset) and write back what was read, verified by a read."""
+
+    setting: str
+    value: str
+    steps: tuple
+
+
+@dataclass(frozen=True)
+class Burst:
+    """Several commands written back to back before any reply is read (RH-ACK-6)."""
+
+    bodies: tuple
+
+
+@dataclass(frozen=True)
+class SetRoundTrip:
+    """Read a setting, write a changed state and value, read it back, restore it (RH-SET-2)."""
+
+    setting: str
+
+
+@dataclass(frozen=True)
+class Octd:
+    """``$OSD,T`` after an ``$OPOS`` that gave conductivity and temperature (RH-POS-2)."""
+
+
+@dataclass(frozen=True)
+class Case:
+    """One numbered case: the clauses it speaks to (the first is its subject), what it does."""
+
+    id: str
+    clauses: tuple
+    title: str
+    expectation: str
+    start: str  #: S (no mission), N (the test mission running), P (in its mission park)
+    steps: tuple
+    needs: tuple = ()
+
+    @property
+    def subject(self) -> str:
+        return self.clauses[0]
+
+    def describe(self) -> dict:
+        return {"id": self.id, "clauses": list(self.clauses), "title": self.title,
+                "expectation": self.expectation, "start": self.start,
+                "steps": [f"{type(st).__name__}{_args(st)}" for st in self.steps]}
+
+
+def _args(st) -> str:
+    parts = [repr(v) for v in vars(st).values() if v not in (None, "", ())] if hasattr(st, "__dict__") else []
+    return "(" + ", ".join(parts) + ")"

@@ -1,0 +1,15 @@
+"""The vehicle observer (§1–8): one sans-IO judge of a vehicle, fed live or from a log.
+
+* :mod:`.observer` — :class:`VehicleObserver`, the facade: wire events in, ledger findings out;
+* :mod:`.lines` — what a backseat line is to a vehicle; per-line judgement of vehicle output;
+* :mod:`.belief` — the mirror: the candidate states a conforming vehicle may be in;
+* :mod:`.candidate` — one candidate state and its bookkeeping;
+* :mod:`.closure` — unseen plant events, adopted with explicit time windows;
+* :mod:`.osichecks` — what a report shows beyond the mirror's fields;
+* :mod:`.blame` — which clauses a finding speaks to, and where it is booked;
+* :mod:`.catalog` — what the observer knows of the vehicle's missions.
+"""
+
+from .observer import Sent, VehicleObserver
+
+__all__ = ["VehicleObserver", "Sent"]

@@ -1,0 +1,387 @@
+"""The mirror: every state a conforming vehicle may be in, given everything seen on the wire.
+
+:class:`Beliefs` holds a small set of :class:`~.candidate.Candidate` s (reference models plus
+what was adopted to explain the wire), most plausible first (fewest unseen events). Two inputs:
+
+* :meth:`Beliefs.command` — a command the vehicle answered, at the vehicle time its ACK went out
+  (RH-RD-15; vehicle time is wall time × the declared time scale, RH-TIM-2). Each candidate
+  answers it nominally and, when the command lands within the RH-TIM-1 tolerance of a model timer,
+  on both sides of the race; before a command that freezes the mission (RH-INT-1) a candidate in
+  ``N`` also offers the state where the next waypoint was reached unseen just before it. The
+  candidates whose answer is the vehicle's survive. When none does, unseen events that change the
+  answer are tried (:func:`~.closure.explain_reply`); when that fails too, the answer is a
+  finding, and the observer follows the nominal state marked *desynchronised* until a state that
+  is known again (an accepted ``$OMSTOP`` or ``$OMSTART``).
+* :meth:`Beliefs.osi` — an ``$OSI`` produced between ``v_sent`` and ``v_recv``. The candidates
+  that explain it survive (:meth:`~.candidate.Candidate.check`, the RH-TIM-1 shadows of
+  :mod:`helmcheck.model.observe`); when none does, unseen plant events are adopted
+  (:func:`~.closure.explain_osi`); when that fails, it is a finding. The surviving candidates are
+  brought to ``v_sent`` and *confirmed*: the rows they applied since the last ``$OSI`` have been
+  seen to take effect (their clauses pass), timer transitions get their RH-TIM-1 bracket
+  (:class:`~.candidate.Timed`), and the ``$OSI``'s position, speed and depth become the plant
+  snapshot (GPS fix and surface rules, ``$OPK`` distance) — not the depth during the ascent,
+  where reaching the surface is an event to be adopted.
+
+Decision (spec open): at most :data:`CAP` candidates are kept; beyond, the least plausible go.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Optional
+
+from ...grammar import sentences as s
+from ...grammar.errors import SentenceError
+from ...model.timers import tolerance
+from ...model.vehicle import VehicleModel
+from ...profile import Profile
+from ..facts import ASCENT_REFUSED, INTERRUPTS, LOCKOUT_REFUSED
+from ..timing import judgeable
+from .candidate import Candidate, Timed
+from .closure import explain_osi, explain_reply, osi_depth_m, same_replies
+
+__all__ = ["Beliefs", "CommandResult", "OsiResult", "CAP"]
+
+CAP = 6
+_WP_ALT_EVENTS = INTERRUPTS
+#: Command events the lockout refuses (err 26) and the ascent does not: their answer tells them apart.
+_LOCK_ONLY = LOCKOUT_REFUSED - ASCENT_REFUSED
+
+
+@dataclass
+class CommandResult:
+    """What the mirror made of one answered command."""
+
+    expected: list  #: the replies of the explanation chosen (the nominal ones when none)
+    matched: bool
+    row: object = None  #: the table row the command met (None for a malformed command)
+    before: tuple = ("", "")  #: (mode, phase) of the chosen state just before the command
+    adopted: tuple = ()  #: unseen events adopted to explain the answer
+    mission_dependent: bool = False  #: the answer depends on mission files the observer lacks
+    desync: str = ""  #: why the state was already unknown (findings are then INCONCLUSIVE)
+    timings: list = field(default_factory=list)  #: (Timed, verdict, reason): the lockout's end
+
+
+@dataclass
+class OsiResult:
+    """What the mirror made of one ``$OSI``."""
+
+    findings: list = field(default_factory=list)  #: (clause, message) when nothing explains it
+    passes: set = field(default_factory=set)  #: clauses whose effect this $OSI confirmed
+    timings: list = field(default_factory=list)  #: (Timed, verdict, reason)
+    adopted: tuple = ()
+    desync: str = ""
+    causes: tuple = ()  #: clauses of what changed since the last confirmed report (for blame)
+    own: set = field(default_factory=set)  #: clauses this report passes by their own evidence
+
+
+def _pre_shown(tt: Timed, osi: s.OSI) -> Optional[bool]:
+    """Does ``osi`` show the state before timer ``tt`` (True), after it (False), or neither?"""
+    if tt.timer == "lockout":
+        return None
+    if tt.timer == "qpark":
+        return osi.mode == "W" and osi.park_time > 0
+    return osi.mode == tt.pre_mode
+
+
+class Beliefs:
+    """The candidate set (module docstring)."""
+
+    def __init__(self, profile: Profile, catalog, k: float):
+        self.profile = profile
+        self.catalog = catalog
+        self.k = k
+        self.cands: list[Candidate] = [Candidate(VehicleModel(profile, catalog))]
+        self.desync = ""
+        #: vehicle seconds: the longest command round trip since the state was last known — a
+        #: timer armed by a command started somewhere in that round trip (RH-RD-15)
+        self.arm_v = 0.0
+
+    @property
+    def primary(self) -> Candidate:
+        return self.cands[0]
+
+    # ------------------------------------------------------------------ commands
+    def _options(self, c: Candidate, item, v: float, slack_v: float) -> list:
+        m = c.model
+        times = [v]
+        dl = m.timer()
+        if dl is not None:
+            due, dur, _ = dl
+            if abs(due - v) <= tolerance(dur, slack_v + c.extra_v):
+                before = min(v, due - 1e-6)
+                if m.now is None or before >= m.now:
+                    times.append(before)
+                times.append(max(v, due + 1e-6))
+        out = []
+        for at in dict.fromkeys(times):
+            t = c.clone()
+            t.model.advance(at)
+            before = (t.model.mode, t.model.phase)
+            row = None if isinstance(item, SentenceError) else t.model.row_for(item)
+            out.append((t, t.model.receive(item, at), row, before))
+        if (isinstance(item, s.Command) and m.mode == "N" and m.phase == "none" and m.mission is not None
+                and VehicleModel.event_of(item) in _WP_ALT_EVENTS):
+            tp = min(max(c.seen_v if c.seen_v is not None else v, m.now or 0.0), v)
+            t = c.clone()
+            t.model.plant(_wp(), tp)
+            if t.model.mode in ("N", "P"):
+                t.adopted(f"mission waypoint reached just before the command (v={tp:.1f}..{v:.1f})", tp, v)
+                t.model.advance(v)
+                before = (t.model.mode, t.model.phase)
+                row = t.model.row_for(item)
+                out.append((t, t.model.receive(item, v), row, before))
+        return out
+
+    def command(self, item, v: float, slack_v: float, observed: list) -> CommandResult:
+        """Feed an answered command (module docstring); ``observed`` is the vehicle's replies."""
+        desync = self.desync
+        self.arm_v = max(self.arm_v, slack_v)
+        options = []
+        for c in self.cands:
+            options += self._options(c, item, v, slack_v)
+        nominal = options[0]
+        match = [o for o in options if same_replies(o[1], observed)]
+        if match:
+            self._keep([o[0] for o in match])
+            chosen = match[0]
+            result = CommandResult(chosen[1], True, chosen[2], chosen[3], chosen[0].story, False, desync)
+        else:
+            found = None
+            for c in self.cands:
+                tp = c.seen_v if c.seen_v is not None else (c.model.now or v)
+                found = explain_reply(c, item, v, observed, tp, self.catalog, self.profile.gps_fix_depth_m)
+                if found is not None:
+                    break
+            if found is not None:
+                cand, replies, mission_dep = found
+                self._keep([cand])
+                result = CommandResult(replies, True, nominal[2], nominal[3], cand.story, mission_dep, desync)
+            else:
+                self._keep([nominal[0]])
+                result = CommandResult(nominal[1], False, nominal[2], nominal[3], (), False, desync)
+                if not self.desync:
+                    self.desync = (f"the vehicle answered {_brief(observed)} where a conforming vehicle "
+                                   f"answers {_brief(nominal[1])}")
+        self._after_command(item, observed, v, slack_v, result)
+        return result
+
+    def _after_command(self, item, observed: list, v: float, slack_v: float, result: CommandResult) -> None:
+        """Bookkeeping after an answered command: the trace, the lockout's evidence (RH-SAF-1:
+        an err 26 to a command only the lockout refuses is the lockout seen; any other answer to
+        one, the lockout over), a known state again after ``$OMSTOP``/``$OMSTART``."""
+        ack = observed[-1] if observed and isinstance(observed[-1], s.ACK) else None
+        for c in self.cands:
+            c.drain()
+        if ack is None:
+            return
+        if ack.status == 0 and isinstance(item, (s.OMSTOP, s.OMSTART, s.OMSTARTPaper)):
+            self.desync = ""
+            self.arm_v = slack_v
+        event = VehicleModel.event_of(item) if not isinstance(item, SentenceError) else None
+        if event is None and isinstance(item, SentenceError) and item.ack_type is not None:
+            from ...model.transitions import EVENT_OF_ACK_TYPE
+            event = EVENT_OF_ACK_TYPE.get(item.ack_type)
+        telling = event in _LOCK_ONLY
+        for c in self.cands:
+            m = c.model
+            if ack.err == 26 and m.phase == "lockout":
+                c.refused_locked = True
+                if telling:
+                    c.locked_v = v
+            elif telling and ack.err != 26:
+                for tt in list(c.timed):
+                    if tt.timer == "lockout":
+                        c.timed.remove(tt)
+                        if c is self.cands[0]:
+                            result.timings.append(self._bracket(tt, v, slack_v))
+
+    def _keep(self, cands: list[Candidate]) -> None:
+        seen: dict = {}
+        for c in sorted(cands, key=lambda c: c.events):
+            key = c.signature()
+            if key not in seen:
+                seen[key] = c
+        self.cands = list(seen.values())[:CAP]
+
+    # ------------------------------------------------------------------ $OSI
+    def osi(self, osi: s.OSI, v_sent: float, v_recv: float, slack_v: float) -> OsiResult:
+        """Judge an ``$OSI`` produced in ``[v_sent, v_recv]`` (module docstring)."""
+        v = (v_sent + v_recv) / 2
+        slack = (v_recv - v_sent) / 2 + slack_v + self.arm_v
+        for c in self.cands:
+            if c.code_unknown and osi.error_state != "N" and c.model.phase != "none":
+                c.model.error_state = osi.error_state
+                c.code_unknown = False
+        explained = [c for c in self.cands if not c.check(osi, v, slack)]
+        result = OsiResult(desync=self.desync)
+        if not explained:
+            fix = self.profile.gps_fix_depth_m
+            for c in self.cands:
+                tp = c.seen_v if c.seen_v is not None else (c.model.now or v_sent)
+                got = explain_osi(c, osi, v, slack, tp, self.catalog, fix, self.profile.depth_unit)
+                if got is not None:
+                    explained.append(got)
+                    result.adopted = got.story
+                    break
+        if not explained:
+            p = self.primary
+            result.findings = p.check(osi, v, slack)
+            if not self.desync:
+                self.desync = f"an $OSI no conforming state explains ({result.findings[0][1]})"
+            if p.model.now is None or v_sent > p.model.now:
+                p.model.advance(v_sent)
+            p.drain()
+            causes = [c for row in p.pending for c in row.clauses]
+            causes += [c for tt in p.timed for c in tt.row.clauses]
+            released = any("RH-INT-2" in row.clauses for row in p.pending)
+            if released and "opk" in p.abandoned:
+                causes.insert(0, "RH-INT-3")  # the interrupted park came back: not abandoned
+            if released and "queue" in p.abandoned:
+                causes.insert(0, "RH-OMW-5")
+            if p.refused_locked and p.model.phase != "lockout":
+                causes.insert(0, "RH-SAF-2")
+            result.causes = tuple(dict.fromkeys(c for c in causes if c != "RH-OUT-4"))
+            self._confirm(p, osi, v_sent, v_recv, slack_v, passes=None, own=set())
+            return result
+        self._keep(explained)
+        for i, c in enumerate(self.cands):
+            own: set = set()
+            got = self._confirm(c, osi, v_sent, v_recv, slack_v + self.arm_v,
+                                passes=result.timings if i == 0 else [], own=own)
+            if i == 0:  # what the most plausible state says was seen to happen
+                result.passes, result.own = got, own
+        if osi.mode == "S" and osi.error_state == "N" and self.primary.model.mode == "S":
+            self.desync = ""
+        return result
+
+    def _confirm(self, c: Candidate, osi: s.OSI, v_sent: float, v_recv: float, slack_v: float,
+                 passes: Optional[list], own: set) -> set:
+        m = c.model
+        if m.now is None or v_sent > m.now:
+            m.advance(v_sent)
+        c.drain()
+        out: set = set()
+        for tt in list(c.timed):
+            shown = _pre_shown(tt, osi)
+            if shown is None:
+                continue
+            if shown:
+                tt.t_old = v_sent
+                continue
+            c.timed.remove(tt)
+            if passes is not None:
+                passes.append(self._bracket(tt, v_recv, slack_v))
+        released = False
+        if osi.mode == m.mode:  # the rows' effect is visible (a report still showing the state
+            for row in c.pending:  # before a timer, within its tolerance, confirms nothing yet)
+                out.update(row.clauses)
+                if "RH-INT-2" in row.clauses and row.event not in ("violation",):
+                    released = True
+            c.pending = []
+        if released and m.mode not in ("mP", "W", "A", "M"):
+            if "opk" in c.abandoned and osi.mode != "mP":
+                own.add("RH-INT-3")
+            if "queue" in c.abandoned and osi.mode != "W":
+                own.add("RH-OMW-5")
+            c.abandoned.clear()
+        if c.refused_locked and m.phase != "lockout":
+            own.add("RH-SAF-2")
+            c.refused_locked = False
+        self._plant(c, osi)
+        c.seen_v, c.seen_mode = v_sent, osi.mode
+        self._retime(c, osi, v_sent, v_recv, slack_v)
+        c.lapse_uncertainty()
+        if not c.timed:
+            m.drop_checkpoint()
+        return out
+
+    def _bracket(self, tt: Timed, v_new: float, slack_v: float) -> tuple:
+        """RH-TIM-1: how closely the observations bracket a timer's transition.
+
+        ``pass`` — the before-state was seen close enough before the deadline and the after-state
+        close enough after it (within half the duration, RH-TIM-1's last sentence, widened by the
+        tolerance); ``inconclusive`` — the observer's own uncertainty (timestamp step, jitter,
+        the arming command's round trip, an adopted event's window) is already too large;
+        ``not-tested`` — the transition was seen but not sampled near its deadline, so its timing
+        was not exercised (a later, closer observation may time it).
+        """
+        tol = tolerance(tt.duration)
+        own = slack_v + tt.extra_v
+        what = f"the {tt.duration:g} s {_name(tt)}"
+        if not judgeable(tt.duration, own):
+            return (tt, "inconclusive", f"the observer's own uncertainty of {own:.1f} s of vehicle time "
+                                        f"cannot bound {what} (RH-TIM-1)")
+        if tt.t_old is None:
+            return (tt, "not-tested", f"{what} ended, but the state before it was not observed after it "
+                                      f"started, so its timing was not exercised")
+        u = max(0.0, (tt.deadline - tol) - tt.t_old, v_new - (tt.deadline + tol)) + own
+        if judgeable(tt.duration, u):
+            return (tt, "pass", f"{what} ended within max(0.5 s, 5 %) = {tol:g} s, bracketed to ±{u:.2f} s "
+                                f"of vehicle time by the observations")
+        return (tt, "not-tested", f"{what} ended, but observations {u:.1f} s of vehicle time from its end "
+                                  f"did not time it")
+
+    def _plant(self, c: Candidate, osi: s.OSI) -> None:
+        """The ``$OSI``'s measured values become the candidate's plant snapshot."""
+        m = c.model
+        changes = {"lat": float(osi.lat), "lon": float(osi.lon), "speed_kn": float(osi.speed)}
+        depth = osi_depth_m(osi, self.profile.depth_unit)
+        if depth is not None and m.phase != "ascent":
+            changes["depth_m"] = depth
+        snap = m.snapshot
+        if any(getattr(snap, k) != val for k, val in changes.items()):
+            m.update_plant(snap.with_(**changes))
+            c.drain()
+
+    def _retime(self, c: Candidate, osi: s.OSI, v_sent: float, v_recv: float, slack_v: float) -> None:
+        """A countdown started by an adopted event: the displayed park time narrows its start."""
+        if c.window is None or c.extra_v <= 0:
+            return
+        m = c.model
+        name = {"mP": "opk", "P": "park", "W": "qpark"}.get(m.mode)
+        if name is None or not m.timers.armed(name) or osi.mode != m.mode:
+            return
+        dur = m.timers.duration(name) or 0.0
+        deadline = m.timers.deadline(name) or 0.0
+        start = deadline - dur
+        lo_w, hi_w = c.window
+        if not lo_w - 1e-6 <= start <= hi_w + 1e-6:
+            return
+        lo = max(lo_w, v_sent - dur + osi.park_time - 1.0 - slack_v)
+        hi = min(hi_w, v_recv - dur + osi.park_time + slack_v)
+        if lo > hi:
+            return
+        mid = (lo + hi) / 2
+        m.timers.arm(name, mid, dur)
+        c.window = (lo, hi)
+        c.extra_v = (hi - lo) / 2
+        for tt in c.timed:
+            tt.extra_v = min(tt.extra_v, c.extra_v)
+
+
+def _wp():
+    from ...model.plant import WaypointReached
+    return WaypointReached()
+
+
+def _name(tt: Timed) -> str:
+    return {"remote": "timeout", "opk": "$OPK park", "qpark": "park on a queued waypoint",
+            "park": "mission park", "lockout": "lockout"}.get(tt.timer, tt.timer)
+
+
+def _brief(replies: list) -> str:
+    if not replies:
+        return "nothing"
+    out = []
+    for r in replies:
+        if isinstance(r, s.ACK):
+            out.append(f"$ACK,{r.type},{r.status},{r.err}")
+        else:
+            out.append("$" + r.ID)
+    return ", ".join(out)
+
+
+def finite(x: Optional[float]) -> bool:
+    return x is not None and math.isfinite(x)

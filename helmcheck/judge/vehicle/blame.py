@@ -1,0 +1,97 @@
+"""Which clauses an observation speaks to, and where a finding is booked.
+
+Every finding names an ordered tuple of *candidate* clauses, the most specific first:
+
+* an answered command — :func:`command_clauses`: a malformed command's field clause and RH-ACK-3
+  (``$OSD`` letters: RH-OSD-2); a command the table refuses: the refusing row's clauses (the
+  precondition and RH-ACK-4, or the lockout's RH-SAF-1/RH-SAF-3); an accepted one: its row's
+  clauses. Readings (``RH-RD-*``) are never booked: they say how a clause is read, not what a
+  vehicle must do;
+* an ``$OSI`` no conforming state explains — RH-OUT-4 and the clauses of what changed since the
+  last confirmed report (a timer's row, an accepted command's row);
+* a line the vehicle must discard but answered — the discard's own clause (RH-FRM-2/4/5/6/7),
+  whatever else is wrong with the answer.
+
+:func:`targets` books a finding: inside a clause case (its ``case …`` note) on the candidates the
+case is about, if any (a failure inside a case belongs to its subject, not to a neighbour it
+touched); otherwise on the first candidate.
+
+:data:`OWN_EVIDENCE` lists the clauses a row's confirmation does not pass by itself, because
+their text asks for more than the mode the row leads to; each passes only on its own
+observation (named beside it).
+"""
+
+from __future__ import annotations
+
+from typing import Iterable, Optional
+
+from ...clauses import catalogue
+from ...grammar import sentences as s
+from ...grammar.errors import SentenceError
+
+__all__ = ["command_clauses", "targets", "vehicle_clause", "OWN_EVIDENCE", "passable"]
+
+#: clause → the observation that passes it (instead of a row's confirmation).
+OWN_EVIDENCE = {
+    "RH-PK-2": "an $OSI in mP counting down while on station",
+    "RH-PRM-3": "an $OSI in M showing the commanded fins and motor",
+    "RH-SRV-4": "the RH-TIM-1 bracket of the servo timeout",
+    "RH-PRM-4": "the RH-TIM-1 bracket of the primitive timeout (and neutral fins and motor from S)",
+    "RH-PK-3": "the RH-TIM-1 bracket of the $OPK park",
+    "RH-SAF-1": "an err 26 in the lockout, the code in field 8, the lockout's RH-TIM-1 bracket",
+    "RH-SAF-2": "an $OSI after the lockout, confirming refused commands had no effect",
+    "RH-SAF-4": "the at-surface action confirmed at the surface",
+    "RH-INT-3": "a release after an interrupted $OPK park, to the mission",
+    "RH-OMW-5": "a release after an interrupted queue, to the mission",
+    "RH-MSN-3": "an $OSI in S with neutral fins and motor after $OMSTOP",
+    "RH-MSN-4": "an $OSI in S at the mission's end",
+    "RH-POS-2": "the $OSI position and $OCTD values after $OPOS",
+    "RH-SET-2": "an $ORWSET reply showing what was written",
+    "RH-OSD-1": "the data sentences of an $OSD, in request order",
+    "RH-TIM-1": "an RH-TIM-1 bracket", "RH-TIM-2": "an RH-TIM-1 bracket at the declared time scale",
+}
+
+_KNOWN = None
+
+
+def vehicle_clause(cid: str) -> bool:
+    """A clause a vehicle is judged on (§1–8; not a §8b reading, not §9)."""
+    global _KNOWN
+    if _KNOWN is None:
+        _KNOWN = {c for c, v in catalogue().items() if v.role == "vehicle"}
+    return cid in _KNOWN
+
+
+def passable(clauses: Iterable[str]) -> list[str]:
+    """The clauses a confirmation passes: vehicle clauses without their own evidence."""
+    return [c for c in clauses if vehicle_clause(c) and c not in OWN_EVIDENCE]
+
+
+def _dedupe(xs: Iterable[str]) -> tuple[str, ...]:
+    return tuple(dict.fromkeys(x for x in xs if vehicle_clause(x)))
+
+
+def command_clauses(item, expected_ack: Optional[s.ACK], row) -> tuple[str, ...]:
+    """The clauses an answered command speaks to, most specific first (module docstring)."""
+    if isinstance(item, SentenceError):
+        if expected_ack is not None and expected_ack.err == 26:
+            return ("RH-SAF-1",) if row is None else _dedupe(row.clauses)
+        first = "RH-OSD-2" if item.sentence_id == "OSD" else item.clause
+        return _dedupe((first, "RH-ACK-3")) or ("RH-ACK-3",)
+    if row is None:
+        return ("RH-ACK-1",)
+    out = _dedupe(row.clauses)
+    if expected_ack is not None and expected_ack.status == 1 and row.error is None:
+        # accepted by the table, refused by a data check (index, count, file, distance): the
+        # row's own clause (RH-JW-1, RH-LOG-2, RH-MSN-1/2, RH-PK-1) says what was checked
+        out = out[:1]
+    return out or ("RH-ACK-1",)
+
+
+def targets(candidates: tuple[str, ...], case_clauses: tuple[str, ...]) -> tuple[str, ...]:
+    """Where a finding is booked (module docstring)."""
+    if case_clauses:
+        inside = tuple(c for c in candidates if c in case_clauses)
+        if inside:
+            return inside
+    return candidates[:1]

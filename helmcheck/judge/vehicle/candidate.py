@@ -1,0 +1,192 @@
+"""One state a conforming vehicle may be in: a reference model plus what the observer adopted.
+
+A :class:`Candidate` wraps a :class:`~helmcheck.model.vehicle.VehicleModel` (with its row
+``trace`` on) and keeps, besides the model, what judging needs and the model does not:
+
+* ``events`` / ``story`` — the unseen plant events adopted to explain the wire (fewer is more
+  plausible) and what they were;
+* ``extra_v`` — vehicle seconds of uncertainty an adopted event's time window adds to every
+  timer it started (RH-TIM-1: the observer widens by what it cannot see); it lapses when no timer
+  started inside the window is left;
+* ``pending`` — table rows applied since the last confirming ``$OSI``: their clauses pass when an
+  ``$OSI`` confirms the state they led to (rows that change nothing visible pass at their ACK);
+* ``timed`` — timer-driven transitions awaiting their RH-TIM-1 bracket (:class:`Timed`);
+* ``abandoned`` — an ``$OPK`` park or an ``$OMW`` queue interrupted by another control: the next
+  confirmed release shows whether it was really abandoned (RH-INT-3, RH-OMW-5);
+* ``s_cause`` — the clause whose transition put the vehicle in ``S`` (``$OMSTOP``: RH-MSN-3,
+  a primitive timeout from ``S``: RH-PRM-4), for the neutral fins-and-motor check;
+* ``refused_locked`` — a command was refused during the lockout; the first ``$OSI`` confirmed
+  after the lockout shows it had no effect (RH-SAF-2);
+* ``seen_v`` / ``seen_mode`` / ``locked_v`` — the latest observations that tell a timer's
+  before-state: the ``$OSI`` mode, and the last err 26 to a command only the lockout refuses.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Optional
+
+from ...model.observe import quick_expectation
+from ...model.transitions import STAY, Row
+from ...model.vehicle import VehicleModel
+
+__all__ = ["Candidate", "Timed", "sig"]
+
+#: Clauses of a timer's row whose RH-TIM-1 duration the bracket judges.
+TIMED_CLAUSES = frozenset({"RH-SRV-4", "RH-PRM-4", "RH-PK-3", "RH-SAF-1", "RH-OMW-4"})
+#: What a mission-park expiry's timing speaks to (its row names only the reading RH-RD-5).
+_PARK_CLAUSE = "RH-OUT-4"
+
+
+@dataclass
+class Timed:
+    """A timer-driven transition (RH-TIM-1): the vehicle must leave ``pre_mode`` (or the
+    lockout) at ``deadline`` ± tolerance; ``t_old`` is the latest observation of the
+    before-state (vehicle seconds), ``None`` when the observer never saw it near the deadline."""
+
+    timer: str
+    row: Row
+    deadline: float
+    duration: float
+    pre_mode: str
+    t_old: Optional[float]
+    extra_v: float = 0.0
+
+    @property
+    def clauses(self) -> tuple[str, ...]:
+        if self.timer == "park":
+            return (_PARK_CLAUSE,)
+        return tuple(c for c in self.row.clauses if c in TIMED_CLAUSES)
+
+
+def sig(m: VehicleModel) -> tuple:
+    """What an ``$OSI`` shows of the judged state: mode, field 3, error state, SRP flag."""
+    return (m.mode, m.osi_waypoint, m.error_state, m.srp_active)
+
+
+class Candidate:
+    """See the module docstring."""
+
+    __slots__ = ("model", "events", "story", "extra_v", "window", "pending", "timed", "abandoned",
+                 "s_cause", "refused_locked", "seen_v", "seen_mode", "locked_v", "code_unknown",
+                 "_mode", "_phase")
+
+    def __init__(self, model: VehicleModel):
+        if model.trace is None:
+            model.trace = []
+        self.model = model
+        self.events = 0
+        self.story: tuple[str, ...] = ()
+        self.extra_v = 0.0
+        self.window: Optional[tuple[float, float]] = None
+        self.pending: list[Row] = []
+        self.timed: list[Timed] = []
+        self.abandoned: set[str] = set()
+        self.s_cause = ""
+        self.refused_locked = False
+        self.seen_v: Optional[float] = None
+        self.seen_mode = ""
+        self.locked_v: Optional[float] = None
+        self.code_unknown = False
+        self._mode = model.mode
+        self._phase = model.phase
+
+    def clone(self) -> "Candidate":
+        c = Candidate.__new__(Candidate)
+        c.model = self.model.clone()
+        c.model.trace = list(self.model.trace or [])
+        c.events, c.story, c.extra_v, c.window = self.events, self.story, self.extra_v, self.window
+        c.pending = list(self.pending)
+        c.timed = [Timed(**vars(t)) for t in self.timed]
+        c.abandoned = set(self.abandoned)
+        c.s_cause, c.refused_locked = self.s_cause, self.refused_locked
+        c.seen_v, c.seen_mode, c.locked_v = self.seen_v, self.seen_mode, self.locked_v
+        c.code_unknown = self.code_unknown
+        c._mode, c._phase = self._mode, self._phase
+        return c
+
+    def adopted(self, what: str, lo: float, hi: float, n: int = 1) -> "Candidate":
+        """Book ``n`` unseen events that happened in ``[lo, hi]`` (vehicle seconds)."""
+        self.events += n
+        self.story = self.story + (what,)
+        width = max(0.0, hi - lo)
+        self.extra_v = max(self.extra_v, width)
+        self.window = (lo, hi)
+        return self
+
+    # ------------------------------------------------------------------ the trace
+    def drain(self) -> list:
+        """Fold the rows the model applied since the last call into the bookkeeping; returns
+        the timer-fired steps (for the caller's own use)."""
+        trace = self.model.trace
+        if not trace:
+            return []
+        steps, self.model.trace = list(trace), []
+        fired = []
+        for st in steps:
+            row = st.row
+            before_mode, before_phase = self._mode, self._phase
+            if row.error is None:
+                if row.target != STAY:
+                    self._mode = row.target
+                if row.phase_to is not None:
+                    self._phase = row.phase_to
+            if st.timer:
+                fired.append(st)
+                t_old = None
+                start = st.at - st.duration
+                if st.timer == "lockout":
+                    if self.locked_v is not None and self.locked_v >= start:
+                        t_old = self.locked_v
+                elif self.seen_v is not None and self.seen_v >= start and self.seen_mode == before_mode:
+                    t_old = self.seen_v
+                self.timed.append(Timed(st.timer, row, st.at, st.duration, before_mode, t_old, self.extra_v))
+            self._book(row, before_mode, before_phase)
+        return fired
+
+    def _book(self, row: Row, before_mode: str, before_phase: str) -> None:
+        if row.error is not None:
+            return
+        if row.target != STAY or row.phase_to is not None:
+            self.pending.append(row)  # a row that changes nothing visible passes at its ACK
+        ev = row.event
+        if ev in ("OMSTOP", "OMSTART", "OJW", "violation"):
+            self.abandoned.clear()
+        elif before_mode == "mP" and row.target not in (STAY, "mP") and ev != "opk_expired":
+            self.abandoned.add("opk")
+        elif before_mode == "W" and row.target not in (STAY, "W") and ev not in (
+                "queue_wp_reached", "queue_park_expired", "OMW_CLEAR"):
+            self.abandoned.add("queue")
+        if row.target == "S" and before_mode != "S":
+            self.s_cause = "RH-MSN-3" if ev == "OMSTOP" else ("RH-PRM-4" if ev == "primitive_timeout" else "")
+        elif row.target not in (STAY, "S"):
+            self.s_cause = ""
+
+    # ------------------------------------------------------------------ questions
+    def check(self, osi, v: float, slack_v: float) -> list[tuple[str, str]]:
+        """``[]`` when this candidate explains ``osi`` at ``v`` (RH-OUT-4, RH-TIM-1)."""
+        return quick_expectation(self.model, v, slack_v + self.extra_v).check(osi)
+
+    def lapse_uncertainty(self) -> None:
+        """Drop ``extra_v`` once no timer started inside the adoption window remains."""
+        if self.window is None:
+            return
+        lo, hi = self.window
+        t = self.model.timers
+        for name in t.names():
+            d, dur = t.deadline(name), t.duration(name)
+            if d is not None and dur is not None and lo - 1e-6 <= d - dur <= hi + 1e-6:
+                return
+        if any(x.extra_v for x in self.timed):
+            return
+        self.window = None
+        self.extra_v = 0.0
+
+    def signature(self) -> tuple:
+        """Equal signatures: the same future as far as judging goes (for de-duplication)."""
+        m = self.model
+        t = m.timers
+        timers = tuple(sorted((n, round(t.deadline(n) or 0.0, 3)) for n in t.names()))
+        return (m.mode, m.phase, m.mission_wp, m.mission_mode, m.error_state, m.srp_active,
+                len(m.queue), m.queue_parking, timers, m.mission.name if m.mission else "",
+                m.park_left, m.opk_seconds if m.opk else None, self.code_unknown)

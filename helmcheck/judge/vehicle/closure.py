@@ -1,0 +1,322 @@
+"""Unseen plant events: adopted when, and only when, nothing else explains what the vehicle says.
+
+What the vehicle physically does is not on the wire: a mission waypoint reached, on station at
+an ``$OPK`` position or a queued ``$OMW`` waypoint, the surface after a lockout, a safety rule
+tripping by itself (RH-SAF-5), the end of a mission of unknown length. The observer adopts such
+an event for a candidate state only when a report cannot be explained without it, and places it
+in an explicit **time window**: it happened after ``tp`` (the last observation that showed it had
+not, or the model's last input) and before the report that reveals it. The event is applied at
+the window's start and the window's width is carried as extra slack on every timer it started
+(:class:`~.candidate.Candidate`), so any moment in the window is accepted.
+
+:func:`explain_osi` tries, in order of plausibility (fewest events first), the events that fit
+the candidate's mode, and keeps the first that explains the ``$OSI``:
+
+=====================  ===================================================================
+``surface``            in the ascent (or a lockout that ends in the window), the ``$OSI``
+                       depth is at the surface: the at-surface action runs (RH-SAF-4)
+``violation``          field 8 shows a safety code the candidate lacks (RH-SAF-1, RH-SAF-5);
+                       with ``surface`` after it when the window also covers the lockout
+``waypoint`` ×n        mode ``N``: the next mission waypoint(s) reached, up to
+                       :data:`MAX_WAYPOINTS` (legs of any length)
+``mission park``       a mission park at a waypoint whose park time is not known yet (learnt)
+``mission end``        ``S`` where only the end of a mission of unknown length explains it
+``on station``         ``mP``: the ``$OPK`` countdown starts; ``W``: the queued waypoint is
+                       reached (×n for the queue)
+=====================  ===================================================================
+
+:func:`explain_reply` does the same for an ``$ACK`` the candidate cannot explain, with the events
+that change an answer: a violation (an unexpected err 26; its code is learnt from the next
+``$OSI``), the mission's end (a command refused for want of a running mission), the surface (a
+command the ascent refuses accepted). Mission names the observer knows nothing about are learnt
+from the vehicle's answer; the answer is then adopted but not judged (``mission_dependent``).
+"""
+
+from __future__ import annotations
+
+from typing import Callable, Optional
+
+from ...grammar import sentences as s
+from ...grammar.errors import SentenceError
+from ...model.plant import OnStation, QueueWaypointReached, SafetyViolation, WaypointReached
+from ...profile import SAFETY_CODES
+from .candidate import Candidate
+from .catalog import UnknownMission, _LearntOpen
+
+__all__ = ["explain_osi", "explain_reply", "same_replies", "MAX_WAYPOINTS", "osi_depth_m"]
+
+#: The most mission (or queue) waypoints the observer assumes passed between two reports.
+MAX_WAYPOINTS = 8
+_FT = 0.3048
+_SAFETY = frozenset(SAFETY_CODES)
+
+
+def _key(r) -> tuple:
+    if isinstance(r, str):
+        return (r,)
+    if isinstance(r, s.ACK):
+        return ("ACK", r.type, r.status, r.err)
+    return (type(r).__name__,)
+
+
+def same_replies(want: list, got: list) -> bool:
+    """Two reply lists agree on what is judged: ACK type/status/err, data sentence kinds."""
+    return [_key(r) for r in want] == [_key(r) for r in got]
+
+
+def osi_depth_m(osi: s.OSI, depth_unit: str) -> Optional[float]:
+    if osi.depth is None:
+        return None
+    d = float(osi.depth)
+    return d * _FT if depth_unit == "ft" else d
+
+
+# =============================================================================== $OSI
+
+def explain_osi(c: Candidate, osi: s.OSI, v: float, slack_v: float, tp: float, catalog,
+                fix_depth: float, depth_unit: str) -> Optional[Candidate]:
+    """A copy of ``c`` with the unseen events that explain ``osi`` (module docstring), or None."""
+    m = c.model
+    tp = max(tp, m.now if m.now is not None else tp)
+    tp = min(tp, v)
+    gap = max(0.0, v - tp)
+    depth = osi_depth_m(osi, depth_unit)
+    at_surface = depth is not None and depth <= fix_depth
+
+    def ok(trial: Optional[Candidate]) -> bool:
+        return trial is not None and not trial.check(osi, v, slack_v + gap)
+
+    def run(name: str, build: Callable[[Candidate], Optional[Candidate]], n: int = 1,
+            learn: Optional[Callable[[], None]] = None) -> Optional[Candidate]:
+        trial = build(c.clone())
+        if ok(trial):
+            if learn is not None:
+                learn()
+            return trial.adopted(f"{name} between v={tp:.1f} and v={v:.1f}", tp, v, n)  # type: ignore[union-attr]
+        return None
+
+    def surfaced(t: Candidate) -> Candidate:
+        t.model.advance(tp)
+        t.model.update_plant(t.model.snapshot.with_(depth_m=depth))
+        return t
+
+    def violation(t: Candidate, then_surface: bool = False) -> Candidate:
+        t.model.plant(SafetyViolation(osi.error_state), tp)
+        if then_surface:
+            t.model.update_plant(t.model.snapshot.with_(depth_m=depth))
+        return t
+
+    trials: list = []
+    if at_surface and m.phase in ("ascent", "lockout"):
+        trials.append(("the surface", surfaced, 1, None))
+    if osi.error_state in _SAFETY and osi.error_state != m.error_state:
+        if c.code_unknown and m.phase != "none":
+            t = c.clone()
+            t.model.error_state = osi.error_state
+            t.code_unknown = False
+            if ok(t):
+                return t
+        trials.append((f"safety violation {osi.error_state}", violation, 1, None))
+        if at_surface:
+            trials.append((f"safety violation {osi.error_state} and the surface",
+                           lambda t: violation(t, True), 2, None))
+    if m.phase == "none":
+        trials += _motion_trials(c, osi, tp, gap, catalog)
+    for name, build, n, learn in trials:
+        got = run(name, build, n, learn)
+        if got is not None:
+            return got
+    return None
+
+
+def _motion_trials(c: Candidate, osi: s.OSI, tp: float, gap: float, catalog) -> list:
+    m = c.model
+    out: list = []
+    if m.mode == "N" and m.mission is not None:
+        def waypoints(n: int):
+            def build(t: Candidate) -> Optional[Candidate]:
+                for _ in range(n):
+                    if t.model.mode != "N":
+                        return None
+                    t.model.plant(WaypointReached(), tp)
+                return t
+            return build
+        for n in range(1, MAX_WAYPOINTS + 1):
+            out.append(("mission waypoint reached" if n == 1 else f"{n} mission waypoints reached",
+                        waypoints(n), n, None))
+        out += _park_and_end(c, osi, tp, gap, catalog)
+    elif m.mode == "P" and m.mission is not None and osi.mode == "S":
+        out += _park_and_end(c, osi, tp, gap, catalog)
+    elif m.mode == "mP":
+        def on_station(t: Candidate) -> Candidate:
+            t.model.plant(OnStation(), tp)
+            return t
+        out.append(("on station at the $OPK position", on_station, 1, None))
+    elif m.mode == "W":
+        def queue(n: int):
+            def build(t: Candidate) -> Optional[Candidate]:
+                for _ in range(n):
+                    if t.model.mode != "W" or t.model.queue_parking:
+                        return None
+                    t.model.plant(QueueWaypointReached(), tp)
+                return t
+            return build
+        for n in range(1, min(len(m.queue), MAX_WAYPOINTS) + 1):
+            out.append(("queued waypoint reached" if n == 1 else f"{n} queued waypoints reached",
+                        queue(n), n, None))
+    return out
+
+
+def _park_and_end(c: Candidate, osi: s.OSI, tp: float, gap: float, catalog) -> list:
+    """Learning a mission park, or the end of a mission of unknown length (RH-RD-5, RH-MSN-4)."""
+    m = c.model
+    run = m.mission
+    entry = catalog.entry(run.name) if run is not None else None
+    if entry is None:
+        return []
+    out: list = []
+    wp = m.mission_wp
+
+    def swap(t: Candidate, mission) -> None:
+        tm = t.model
+        for attr in ("mission", "loaded", "srp_mission"):
+            if getattr(tm, attr) is run:
+                setattr(tm, attr, mission)
+
+    if m.mode == "N" and not entry.park_known(wp):
+        if osi.mode == "P" and osi.next_waypoint == wp:
+            seconds = osi.park_time + gap
+
+            def learn_p():
+                entry.learn_park(wp, seconds)
+
+            def build_p(t: Candidate) -> Candidate:
+                swap(t, _with_park(run, wp, seconds))
+                t.model.plant(WaypointReached(wp), tp)
+                return t
+            out.append(("a mission park (learnt)", build_p, 1, learn_p))
+        elif osi.mode == "N" and osi.next_waypoint == wp + 1:
+            def learn_0():
+                entry.learn_park(wp, 0.0)
+
+            def build_0(t: Candidate) -> Candidate:
+                swap(t, _with_park(run, wp, 0.0))
+                t.model.plant(WaypointReached(wp), tp)
+                return t
+            out.append(("mission waypoint reached (no park)", build_0, 1, learn_0))
+    if osi.mode == "S" and run.is_open:
+        base = m.checkpoint
+        if base is not None and base.mode == "P" and base.mission is run and m.mode == "N":
+            last = base.mission_wp
+            origin = "checkpoint"
+        else:
+            last = wp
+            origin = m.mode
+
+        def learn_end():
+            entry.learn_end(last)
+
+        def build_end(t: Candidate) -> Optional[Candidate]:
+            if origin == "checkpoint":
+                t.model = base.clone()
+                t.model.trace = []
+            swap(t, entry.finite(last + 1))
+            if t.model.mode == "N":
+                t.model.plant(WaypointReached(last), tp)
+            return t
+        out.append(("the mission's end (its length learnt)", build_end, 1, learn_end))
+    return out
+
+
+def _with_park(run, wp: int, seconds: float):
+    """``run`` with a park of ``seconds`` at waypoint ``wp`` (a candidate's trial copy)."""
+    from ...model.missions import Mission, Waypoint
+    wps = run.waypoints
+    if run.is_open:
+        parks = dict(getattr(wps, "parks", {}))
+        parks[wp] = seconds
+        return Mission(run.name, _LearntOpen(parks))
+    lst = list(wps)
+    w = lst[wp]
+    lst[wp] = Waypoint(w.lat, w.lon, w.depth, w.speed, seconds)
+    return Mission(run.name, tuple(lst))
+
+
+# =============================================================================== $ACK
+
+def explain_reply(c: Candidate, item, v: float, observed: list, tp: float, catalog,
+                  fix_depth: float) -> Optional[tuple[Candidate, list, bool]]:
+    """``(candidate, replies, mission_dependent)`` with unseen events (or a mission name learnt
+    from the vehicle's answer) that explain ``observed`` for ``item`` at ``v``; else None."""
+    m = c.model
+    tp = min(max(tp, m.now if m.now is not None else tp), v)
+    ack = next((r for r in observed if isinstance(r, s.ACK)), None)
+    if ack is None:
+        return None
+
+    def attempt(name: str, prepare: Callable[[Candidate], Optional[Candidate]], n: int = 1):
+        t = prepare(c.clone())
+        if t is None:
+            return None
+        replies = t.model.receive(item, v)
+        if same_replies(replies, observed):
+            return t.adopted(f"{name} between v={tp:.1f} and v={v:.1f}", tp, v, n), replies
+        return None
+
+    trials: list = []
+    if ack.err == 26 and m.phase == "none":
+        def violated(t: Candidate) -> Candidate:
+            t.model.plant(SafetyViolation("Sop"), tp)
+            t.code_unknown = True  # learnt from the next $OSI field 8
+            return t
+        trials.append(("a safety violation (code not yet shown)", violated))
+    if m.phase in ("ascent", "lockout") and ack.err != 26:
+        def surfaced(t: Candidate) -> Candidate:
+            t.model.advance(tp)
+            t.model.update_plant(t.model.snapshot.with_(depth_m=0.0))
+            return t
+        trials.append(("the surface", surfaced))
+    if m.mission is not None and m.mode in ("N", "P") and m.phase == "none":
+        def ended(t: Candidate) -> Optional[Candidate]:
+            tm = t.model
+            run = tm.mission
+            entry = catalog.entry(run.name)
+            if run.is_open and entry is not None:
+                finite = entry.finite(tm.mission_wp + 1)
+                for attr in ("mission", "loaded"):
+                    if getattr(tm, attr) is run:
+                        setattr(tm, attr, finite)
+            elif tm.mission_wp != tm.mission.last:
+                return None
+            if tm.mode == "P":
+                tm.advance(tp)
+                return t if tm.mode == "S" else None
+            tm.plant(WaypointReached(tm.mission_wp), tp)
+            return t if tm.mode == "S" else None
+        trials.append(("the mission's end", ended))
+    for name, prep in trials:
+        got = attempt(name, prep)
+        if got is not None:
+            return got[0], got[1], False
+    got = _learn_name(c, item, v, observed, catalog)
+    if got is not None:
+        return got[0], got[1], True
+    return None
+
+
+def _learn_name(c: Candidate, item, v: float, observed: list, catalog):
+    """An ``$OMSTART``/``$OMLOAD`` naming a mission the observer knows nothing about: follow the
+    vehicle's answer (its mission files decide; the answer is not judged)."""
+    if isinstance(item, SentenceError) or not isinstance(item, (s.OMSTART, s.OMLOAD)):
+        return None
+    names = [item.name] + ([item.srp] if isinstance(item, s.OMSTART) and item.srp else [])
+    unknown = [n for n in names if isinstance(catalog.lookup(n), UnknownMission)]
+    if not unknown:
+        return None
+    ack = observed[-1]
+    if ack.status == 0:
+        for n in unknown:
+            catalog.learn_present(n)
+    t = c.clone()
+    replies = t.model.receive(item, v)  # adopted either way: the files decide, not the observer
+    return t, replies

@@ -1,0 +1,156 @@
+"""One line at a time: what a backseat line is to a vehicle, and whether a vehicle line is valid.
+
+:func:`classify` reads a line (or a discarded run) the backseat sent the way a conforming vehicle
+does (RH-FRM-4..7, RH-RD-16) and says what it owes: an ``$ACK`` of a type (a command, or a
+malformed command answered with its "incorrect values" error, RH-ACK-3), nothing (a line it must
+discard silently, with the clause that says so), or nothing because it is the ``$OXFLT`` test
+extension (RH-SAF-5). A command the profile does not claim is an unknown ID (RH-FRM-5).
+
+:class:`OutputJudge` judges every line the vehicle sends on its own (RH-FRM-1/2/3/6/8,
+RH-OUT-1/2/3) into the ledger. Bytes from the vehicle that frame into no sentence cannot be
+attributed (line noise looks the same) and are INCONCLUSIVE for RH-FRM-1 — except the same bytes
+before reply after reply (a modem or vehicle prefix), which is an RH-FRM-1 FAIL quoting them.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+from typing import Optional
+
+from ...grammar import Decoded, decode
+from ...grammar import sentences as s
+from ...grammar.capture import escape
+from ...grammar.errors import SentenceError
+from ...profile import Profile
+from ..ledger import Evidence, Ledger
+
+__all__ = ["Kind", "classify", "OutputJudge", "ID_ACK_TYPE", "PREFIX_REPEAT"]
+
+#: Sentence ID → the ACK type a vehicle answers it with (for a line it must not answer).
+ID_ACK_TYPE = {cls.ID: cls.ACK_TYPE for cls in (s.OMS, s.OMP, s.OJW, s.OMSTOP, s.OMLOAD, s.OMSTART,
+                                                 s.OPOS, s.OSD, s.OLOGL, s.OLOGD, s.ORWSET, s.ODVL,
+                                                 s.OPK, s.OMW)}
+#: Replies in a row preceded by the same discarded bytes before that is called a prefix (RH-FRM-1).
+PREFIX_REPEAT = 3
+_ID = re.compile(rb"\$([A-Za-z]+)[,*\r\n]")
+#: Vehicle-output decode errors → the clause a vehicle breaks by sending it.
+_OUT_CLAUSE = {"RH-FRM-4": "RH-FRM-2", "RH-FRM-5": "RH-FRM-1", "RH-FRM-7": "RH-FRM-1", "RH-ACK-3": "RH-FRM-1"}
+
+
+@dataclass(frozen=True, slots=True)
+class Kind:
+    """What a backseat line is to a conforming vehicle."""
+
+    kind: str  #: command | error | discard | oxflt
+    item: object = None  #: the Command, or the SentenceError a vehicle answers
+    ack_type: Optional[int] = None  #: the ACK owed (None: nothing may answer)
+    clause: str = ""  #: discard: the clause that says it is discarded
+    would_be: Optional[int] = None  #: discard: the ACK type its ID would have
+    variant: str = ""  #: a command in a form a vehicle must still read (RH-FRM-3 hex, RH-FRM-7)
+
+
+def _id_type(raw: bytes) -> Optional[int]:
+    m = _ID.search(raw)
+    return ID_ACK_TYPE.get(m.group(1).decode().upper()) if m else None
+
+
+def classify(d: Optional[Decoded], raw: bytes, profile: Profile, discard_clause: str = "") -> Kind:
+    """What ``raw`` (decoded as ``d``; ``None`` for a framer discard) is to a vehicle."""
+    if d is None:
+        return Kind("discard", clause=discard_clause or "RH-FRM-7", would_be=_id_type(raw))
+    sent = d.sentence
+    variant = ""
+    for f in d.findings:
+        if f.clause in ("RH-FRM-3", "RH-FRM-7"):
+            variant = f.clause
+    if len(raw) >= profile.max_line_bytes:
+        variant = "RH-FRM-6"  # a line of exactly the limit must still be read
+    if isinstance(sent, s.OXFLT):
+        if profile.fault_injection == "oxflt":
+            return Kind("oxflt", sent)
+        return Kind("discard", clause="RH-FRM-5")
+    if isinstance(sent, s.Command):
+        if sent.ID not in profile.commands:
+            return Kind("discard", clause="RH-FRM-5", would_be=sent.ACK_TYPE)
+        return Kind("command", sent, sent.ACK_TYPE, variant=variant)
+    if sent is not None:  # a vehicle sentence sent by the backseat: an unknown command ID
+        return Kind("discard", clause="RH-FRM-5")
+    err: SentenceError = d.error  # type: ignore[assignment]
+    if err.answered and err.sentence_id in profile.commands:
+        return Kind("error", err, err.ack_type, variant=variant)
+    clause = err.clause if err.clause.startswith("RH-FRM") else "RH-FRM-5"
+    return Kind("discard", clause=clause, would_be=_id_type(raw))
+
+
+class OutputJudge:
+    """Per-line judgement of the vehicle's output (module docstring)."""
+
+    def __init__(self, ledger: Ledger, profile: Profile):
+        self.ledger = ledger
+        self.profile = profile
+        self.noise_before: Optional[bytes] = None  #: a discarded run just before the next line
+        self.prefix: Optional[bytes] = None
+        self.prefix_count = 0
+        self.prefix_reported = False
+        self.discards = 0
+
+    def discard(self, raw: bytes, length: int, clause: str, ev: Evidence, case: str) -> None:
+        """Bytes from the vehicle that frame into no sentence."""
+        self.discards += 1
+        if clause == "RH-FRM-6":
+            self.ledger.failed("RH-FRM-6", f"the vehicle sent a line of {length} bytes, over the "
+                                           f"{self.profile.max_line_bytes}-byte limit", [ev], case)
+            return
+        self.noise_before = raw
+        self.ledger.inconclusive("RH-FRM-1", "bytes from the vehicle that frame into no sentence "
+                                             "(line noise or a vehicle fault: cannot attribute)", [ev], case)
+
+    def line(self, d: Decoded, ev: Evidence, case: str) -> Optional[s.Sentence]:
+        """Judge one vehicle line; returns the sentence when it is valid."""
+        led = self.ledger
+        self._prefix(ev, case)
+        if d.terminator != "\r\n":
+            led.failed("RH-FRM-1", "the vehicle ended a sentence without CR LF", [ev], case)
+        for f in d.findings:
+            if f.clause == "RH-FRM-3":
+                led.failed("RH-FRM-3", f"the vehicle emitted lower-case checksum hex: {f.message}", [ev], case)
+        sent = d.sentence
+        if sent is None:
+            err = d.error
+            clause = _OUT_CLAUSE.get(err.clause, err.clause) if err is not None else "RH-FRM-1"
+            led.failed(clause, f"the vehicle sent an invalid {d.sentence_id or 'line'}: {err}", [ev], case)
+            return None
+        if isinstance(sent, s.Command):
+            led.failed("RH-FRM-1", f"the vehicle sent a command sentence ${sent.ID}", [ev], case)
+            return None
+        led.passed("RH-FRM-1", "vehicle sentences are $ID,fields*hh CR LF", [ev], case)
+        led.passed("RH-FRM-2", "vehicle checksums are right", [ev], case)
+        if not d.findings:
+            led.passed("RH-FRM-3", "vehicle checksums are upper-case hex", [ev], case)
+        if isinstance(sent, s.ACK):
+            return sent
+        led.passed("RH-OUT-3", "numeric fields within their physical ranges", [ev], case)
+        if isinstance(sent, s.OSI):
+            led.passed("RH-OUT-1", f"$OSI with {sent.field_count} fields", [ev], case)
+        else:
+            led.passed("RH-OUT-2", f"${sent.ID} in its format", [ev], case)
+            if isinstance(sent, s.Compass):
+                led.passed("RH-FRM-8", "$C has no commas", [ev], case)
+        return sent
+
+    def _prefix(self, ev: Evidence, case: str) -> None:
+        """RH-FRM-1: the same bytes before reply after reply are the vehicle's (or a modem's)."""
+        before, self.noise_before = self.noise_before, None
+        if before is None:
+            self.prefix, self.prefix_count = None, 0
+            return
+        if before == self.prefix:
+            self.prefix_count += 1
+        else:
+            self.prefix, self.prefix_count = before, 1
+        if self.prefix_count >= PREFIX_REPEAT and not self.prefix_reported:
+            self.prefix_reported = True
+            self.ledger.failed("RH-FRM-1", f"{self.prefix_count} replies in a row are preceded by the same "
+                                           f"bytes {escape(before)!r} (a vehicle or modem prefix, not line "
+                                           f"noise)", [ev], case)
