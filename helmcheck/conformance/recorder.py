@@ -46,6 +46,11 @@ class Recorder:
                 self.write_error = f"{getattr(e, 'strerror', None) or e}"
         return self.lineno
 
+    @property
+    def last_t(self) -> float:
+        """The time of the latest record (0 before the first)."""
+        return self._last_t
+
     def _time(self, t: float) -> float:
         t = float(f"{max(t, self._last_t):.6f}")
         self._last_t = t

@@ -276,19 +276,20 @@ def explore(run) -> None:
     best = state.best
     if best is None:
         return
-    cid = best["clause"]
-    confirmed = _confirm(run, best)
+    cid = best["clause"] or best["reason"].split(":", 1)[0]
+    session.begin_case("explore-confirm", ("RH-OUT-4",), "the smallest failing sequence, driven again")
+    try:
+        confirmed = _confirm(run, best)
+    finally:
+        session.end_case()
     flaky = confirmed < 2
     run.stats["explore"]["confirmed"] = f"{confirmed}/2"
+    if cid not in run.ledger:
+        return
     n = sum(1 for r in run.results["replays"] if r["clause"] == cid) + 1
     rel = f"replays/{cid}-{n}.json"
     save_replay(run.dir / rel, cid, best["reason"], best["steps"], run.k, p)
     from ...reports import results as R
     R.add_replay(run.results, cid, best["steps"], file=rel)
-    if flaky:
-        run.book.add(cid, "inconclusive", f"exploration: an intermittent failure (the shrunk sequence failed "
-                     f"again {confirmed} of 2 times): {best['reason']}; replay {rel}", "explore")
-    else:
-        run.book.add(cid, "fail", f"exploration: {best['reason']} (shrunk to {len(best['steps'])} steps; "
-                     f"replay {rel})", "explore",
-                     [{"t": x.get("t", 0.0), "dir": ">", "line": x["send"]} for x in best["steps"] if "send" in x][-16:])
+    run.stats["explore"]["replay"] = rel
+    run.stats["explore"]["flaky"] = flaky

@@ -182,8 +182,7 @@ def run_step(session: Session, st, ctx: dict) -> None:
         session.start_mission(name, p.srp_mission if st.srp else "", st.ignore_gps)
         _here(session, ctx)
     elif isinstance(st, MissionEnd):
-        session.until(f"the end of {session.profile.end_mission} (S)", lambda o: o.mode == "S", st.cap_v,
-                      session.case_clauses[0])
+        _mission_end(session, st)
         _here(session, ctx)
     elif isinstance(st, WithSetting):
         _with_setting(session, st, ctx)
@@ -208,6 +207,27 @@ def _until(session: Session, st: Until) -> None:
                 and (not st.surface or (o.depth is not None and float(o.depth) <= fix))
                 and (srp is None or flag == srp))
     session.until(st.what, pred, st.budget_v, session.case_clauses[0])
+
+
+def _mission_end(session: Session, st: MissionEnd) -> None:
+    """Poll until ``S`` (the observer judges the end, RH-MSN-4); a vehicle that reports more time
+    left than the cap allows (``$OSI`` field 13, rh5) is not waited for: INCONCLUSIVE at once."""
+    name = session.profile.end_mission
+    v0 = session.obs.v(session.now())
+
+    def pred(o: s.OSI) -> bool:
+        if o.mode == "S":
+            return True
+        left = float(o.remaining_time) * 3600.0 if (session.profile.protocol == "rh5" and
+                                                     o.remaining_time is not None) else 0.0
+        spent = session.obs.v(session.now()) - v0
+        if left and spent + left > st.cap_v:
+            reason = (f"{session.case}: the vehicle reports about {left:.0f} s of {name} left {spent:.0f} s after "
+                      f"its start, past the cap of {st.cap_v:g} s; a shorter end_mission would be judged")
+            session.tester("inconclusive", session.case_clauses[:1], reason)
+            raise CaseStop("inconclusive", reason)
+        return False
+    session.until(f"the end of {name} (S)", pred, st.cap_v, session.case_clauses[0])
 
 
 def _with_setting(session: Session, st: WithSetting, ctx: dict) -> None:

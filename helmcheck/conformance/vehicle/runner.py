@@ -231,11 +231,9 @@ class Run:
 
     def end(self, reason: Optional[str]) -> None:
         """Close the record: a ``run aborted`` note when it ended early, then the observer."""
-        if self.recorder is not None and self.link is not None:
-            if reason:
-                self.link.note(f"run aborted: {reason}")
-            else:
-                self.link.note("run ends")
+        if self.recorder is not None:
+            t = self.link.now() if self.link is not None else self.recorder.last_t
+            self.recorder.note(t, f"run aborted: {reason}" if reason else "run ends")
         self.observer.close()
 
 
