@@ -133,7 +133,15 @@ def test_cli_writes_reports_and_exit_codes(tmp_path, capsys):
                      "--no-render"]) == 1
     assert "RH-ACK-3 fail: lines 13" in capsys.readouterr().out
     assert cli_main(["check-log", str(LOGS / "backseat_only.log"), "--report-dir", str(tmp_path / "b"),
+                     "--no-render"]) == 0
+    coarse = tmp_path / "coarse.log"  # 2 × 1100 bytes stamped 1 s apart: within a second or not?
+    flood = "$OSD*58\\r\\n" * 122 + "$OSD"
+    coarse.write_text(f"# helmcheck wire-log 1\n0 >~ {flood}\n1 >~ *58\\r\\n{flood}\n2 > *58\n")
+    assert cli_main(["check-log", str(coarse), "--role", "backseat", "--report-dir", str(tmp_path / "c"),
                      "--no-render"]) == 2
+    doc = json.loads((tmp_path / "c" / "results.json").read_text())
+    assert {c["id"]: c["verdict"] for c in doc["clauses"]}["RH-BS-4"] == "inconclusive"
+    capsys.readouterr()
     assert cli_main(["check-log", str(tmp_path / "missing.log")]) == 64
     assert "missing.log" in capsys.readouterr().err
     junk = tmp_path / "junk.bin"
