@@ -452,3 +452,24 @@ def test_results_document_strict_and_partial():
     never = build_results(None, profile=DEFAULT, settings={}, command="x", port="/dev/ttyX",
                           started="2026-01-01T00:00:00Z", reason="cannot open /dev/ttyX: no such file")
     assert not validate(never) and never["verdict"] == "inconclusive"
+
+
+def test_backseat_observer_does_no_io_and_reads_no_clock():
+    """The observer is sans-IO: it imports no clock, port, thread or event loop."""
+    import ast
+    from pathlib import Path
+
+    import helmcheck.judge.backseat as pkg
+
+    forbidden = {"time", "serial", "threading", "asyncio", "socket", "os", "subprocess", "select"}
+    files = list(Path(pkg.__file__).parent.glob("*.py"))
+    assert len(files) >= 8
+    for path in files:
+        assert len(path.read_text().splitlines()) < 500, path.name
+        for node in ast.walk(ast.parse(path.read_text())):
+            names = []
+            if isinstance(node, ast.Import):
+                names = [a.name.split(".")[0] for a in node.names]
+            elif isinstance(node, ast.ImportFrom) and node.level == 0 and node.module:
+                names = [node.module.split(".")[0]]
+            assert not forbidden & set(names), (path.name, names)

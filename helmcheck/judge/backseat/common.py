@@ -33,6 +33,7 @@ __all__ = ["Settings", "SentLine", "spacing", "gap", "PASS", "INCONCLUSIVE", "VI
 BS_CLAUSES = tuple(f"RH-BS-{i}" for i in range(1, 9))
 PASS, INCONCLUSIVE, VIOLATION = "pass", "inconclusive", "violation"
 _ID = re.compile(rb"\$([A-Z]+)[,*]")
+_UNSET = object()
 
 
 @dataclass
@@ -59,6 +60,7 @@ class SentLine:
     discard: Optional[Discard] = None
     ack_type: Optional[int] = None  #: the ``$ACK`` type a vehicle answers it with, if any
     deferred: Optional[list] = None  #: RH-BS-3 checks waiting for this line's ``$ACK``
+    _event: object = _UNSET
 
     @property
     def command(self) -> Optional[s.Command]:
@@ -68,8 +70,10 @@ class SentLine:
     @property
     def event(self) -> Optional[str]:
         """The transition-table event of the command (``None`` for anything else)."""
-        cmd = self.command
-        return VehicleModel.event_of(cmd) if cmd is not None else None
+        if self._event is _UNSET:
+            cmd = self.command
+            self._event = VehicleModel.event_of(cmd) if cmd is not None else None
+        return self._event
 
     @property
     def sid(self) -> str:

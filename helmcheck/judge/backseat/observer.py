@@ -76,8 +76,9 @@ class BackseatObserver:
         self._framer = Framer(profile.max_line_bytes)
         self._vframer = Framer(max(profile.max_line_bytes, 1024))
         self._records: deque[tuple[int, float, int]] = deque()  # (stream offset, t, lineno)
-        self._offset = 0  #: backseat stream offset of the next byte
-        self._consumed = 0  #: backseat stream offset of the first byte not yet framed
+        # stream offsets count only the bytes that went through the framers
+        self._offset = 0  #: backseat framer offset of the next byte
+        self._consumed = 0  #: backseat framer offset of the first byte not yet framed
         self._voffset = 0
         self._cache: dict[bytes, Decoded] = {}
         self.arrivals = Arrivals(st.baud)
@@ -157,6 +158,13 @@ class BackseatObserver:
             t, lineno = rt, rl
         return t, lineno
 
+    @staticmethod
+    def _whole_line(fr: Framer, data: bytes) -> bool:
+        """A record that is exactly one line, with nothing pending before it: the framer would
+        return it whole, so it is taken as it is (the common case, and the fast one)."""
+        return (not fr.pending and data[:1] == b"$" and data.count(b"$") == 1
+                and data.find(b"\n") == len(data) - 1 and len(data) <= fr.max_line)
+
     def _backseat(self, ev: WireEvent) -> None:
         data = ev.data
         if not data:
@@ -168,6 +176,10 @@ class BackseatObserver:
             self.started = ev.t
             self.polling.start(ev.t, rec)
         self.budget.record(ev.t, len(data), rec)
+        if self._whole_line(self._framer, data):
+            self._records.clear()
+            self._line(SentLine(data, ev.t, ev.lineno, self._decode(data)))
+            return
         self._records.append((self._offset, ev.t, ev.lineno))
         self._offset += len(data)
         for e in self._framer.feed(data):
@@ -208,17 +220,21 @@ class BackseatObserver:
         if not data:
             return
         self.arrivals.record(ev.t, len(data))
+        if self._whole_line(self._vframer, data):
+            self._report(data, ev.t, self.arrivals.arrival(len(data)))
+            return
         base = self._voffset
         self._voffset += len(data)
         for e in self._vframer.feed(data):
-            if not isinstance(e, Line):
-                continue
-            arrived = self.arrivals.arrival(e.offset + len(e.raw) - base)
-            r = self._decode(e.raw).sentence
-            if isinstance(r, s.OSI):
-                self._osi(r, ev.t, arrived)
-            elif isinstance(r, s.ACK):
-                self._ack(r, ev.t, arrived)
+            if isinstance(e, Line):
+                self._report(e.raw, ev.t, self.arrivals.arrival(e.offset + len(e.raw) - base))
+
+    def _report(self, raw: bytes, t: float, arrived: float) -> None:
+        r = self._decode(raw).sentence
+        if isinstance(r, s.OSI):
+            self._osi(r, t, arrived)
+        elif isinstance(r, s.ACK):
+            self._ack(r, t, arrived)
 
     def _osi(self, r: s.OSI, t: float, arrived: float) -> None:
         """``$OSI``: field 2 is a state report (RH-BS-3), field 8 a lockout sign (RH-BS-5)."""
