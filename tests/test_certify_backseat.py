@@ -120,7 +120,7 @@ def clauses(run: dict) -> dict[str, dict]:
 
 
 @pytest.mark.parametrize("scale", SCALES)
-def test_well_behaved_backseat_passes_every_scenario(runs, scale):
+def test_rh_bs_1_to_8_well_behaved_backseat_passes_every_scenario(runs, scale):
     run = runs["good", scale]
     r = run["results"]
     bad = {cid: (c["verdict"], c["reason"], c["evidence"]) for cid, c in clauses(run).items()
@@ -136,9 +136,12 @@ def test_well_behaved_backseat_passes_every_scenario(runs, scale):
         assert (run["dir"] / name).stat().st_size > 0
 
 
+FAULT_PARAMS = [pytest.param(f, id=f"{FAULTS[f][0]}-{f}") for f in sorted(FAULTS)]
+
+
 @pytest.mark.parametrize("scale", SCALES)
-@pytest.mark.parametrize("fault", sorted(FAULTS))
-def test_faulty_backseat_is_caught_on_its_clause(runs, fault, scale):
+@pytest.mark.parametrize("fault", FAULT_PARAMS)
+def test_rh_bs_faulty_backseat_is_caught_on_its_clause(runs, fault, scale):
     """Mutation coverage: each faulty backseat is caught on its own clause, and only there."""
     run = runs[fault, scale]
     clause, verdict = FAULTS[fault]
@@ -155,7 +158,7 @@ def test_faulty_backseat_is_caught_on_its_clause(runs, fault, scale):
     assert run["rc"] == (1 if verdict == "fail" else 0)
 
 
-def test_every_backseat_clause_has_a_fault_that_is_caught():
+def test_rh_bs_1_to_8_every_backseat_clause_has_a_fault_that_is_caught():
     """RH-BS-1..8: the faulty backseats cover every backseat clause."""
     assert {c for c, _ in FAULTS.values()} == {f"RH-BS-{i}" for i in range(1, 9)}
 
@@ -166,8 +169,8 @@ def _offline(run: dict) -> dict[str, dict]:
 
 
 @pytest.mark.parametrize("scale", SCALES)
-@pytest.mark.parametrize("name", ["good", *sorted(FAULTS)])
-def test_check_log_of_the_wire_log_agrees_with_the_certification(runs, name, scale):
+@pytest.mark.parametrize("name", [pytest.param("good", id="good"), *FAULT_PARAMS])
+def test_rh_bs_1_to_8_check_log_of_the_wire_log_agrees_with_the_certification(runs, name, scale):
     """One judge: ``check-log --role backseat`` on the run's own wire.log, same profile, gives
     the verdict the certification gave for every clause it judged (RH-BS-1..8)."""
     run = runs[name, scale]
