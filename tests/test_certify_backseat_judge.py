@@ -233,6 +233,15 @@ def test_rh_bs_3_command_behind_an_unanswered_start_is_judged_by_its_outcome():
     assert r.fails("RH-BS-3") == 1
 
 
+def test_rh_bs_3_a_start_the_vehicle_never_answered_is_not_waited_for_forever():
+    r = Run().bs(0.0, POLL).veh(0.1, osi("S"))
+    r.bs(2.0, frame("OMSTART,0,0,0,0,conformance.mis,"))  # no answer, ever
+    r.bs(2.1, OMS)  # behind it: waits for its outcome
+    assert r.ledger.counts("RH-BS-3")["fail"] == 0
+    r.bs(10.0, frame("OMS,11.0,2.0,20.0,1.0,10"))  # long after: judged on the S reported
+    assert r.fails("RH-BS-3") == 1
+
+
 def test_rh_bs_3_mission_end_in_flight_is_not_blamed():
     r = Run().veh(0.0, osi("A")).veh(1.0, osi("S"))
     r.bs(1.2, OMS)

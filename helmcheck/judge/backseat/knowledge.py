@@ -13,7 +13,10 @@ profile's ``reaction_s`` (RH-BS-3/5) to that arrival.
 * :class:`Pending` — the backseat's commands waiting for their ``$ACK``. ACKs come in command
   order (RH-ACK-6), so an ``$ACK`` of type ``n`` answers the oldest waiting command of that
   type; older ones of other types that it overtakes will never be answered and are dropped.
-  An ``$ACK`` no waiting command expects is ignored.
+  An ``$ACK`` no waiting command expects is ignored. Decision: a command still unanswered
+  when an ``$ACK`` could no longer be merely late (:func:`~helmcheck.judge.timing.ack_fail_after`
+  of the longest :func:`~helmcheck.judge.timing.ack_allowance`) waits no more: the vehicle
+  missed it (RH-ACK-1), and a later answer is not taken for it.
 * :class:`Lockout` — the safety lockout as the backseat could know it (RH-BS-5, RH-SAF-1).
   See its docstring for where an episode starts and ends.
 """
@@ -103,6 +106,12 @@ class Pending:
         self._q.append(line)
         if len(self._q) > self._limit:
             self._q.popleft()
+
+    def expire(self, t: float, max_wait: float) -> None:
+        """Give up on commands sent more than ``max_wait`` before ``t`` (module docstring)."""
+        q = self._q
+        while q and q[0].t < t - max_wait:
+            q.popleft()
 
     def answer(self, ack_type: int) -> Optional[SentLine]:
         """The waiting command an ``$ACK`` of ``ack_type`` answers (removed), or None."""

@@ -37,6 +37,7 @@ from ...grammar.capture import escape
 from ...profile import Profile
 from ..facts import LOCKOUT_REFUSED, NEEDS_MISSION, NEEDS_RUNNING, NEEDS_STOPPED
 from ..ledger import Evidence, Ledger
+from ..timing import ack_allowance, ack_fail_after
 from ..wire import FROM_VEHICLE, NOTE, TO_VEHICLE, WireEvent, parse_note
 from .budget import LineBudget
 from .common import BS_CLAUSES, SentLine, Settings
@@ -91,6 +92,10 @@ class BackseatObserver:
         self.reaction = Reaction(st, ledger, self.lockout)
         self.servo = ServoRefresh(st, ledger)
         self.polling = Polling(st, ledger)
+        #: how long an answer may be awaited (RH-ACK-2's allowance for the longest line and
+        #: the most replies before it, and the margin past which a late ACK is a fault)
+        self.max_wait = ack_fail_after(ack_allowance(profile.ack_window_s, profile.max_line_bytes, 1024,
+                                                     st.baud, st.resolution))
         self.silent = False
         self.started: Optional[float] = None  #: time of the backseat's first byte
         self.ended: Optional[float] = None
@@ -199,6 +204,7 @@ class BackseatObserver:
             recs.pop()
 
     def _line(self, line: SentLine) -> None:
+        self.pending.expire(line.t, self.max_wait)
         self.lines.line(line)
         d = line.decoded
         cmd = line.command
@@ -219,6 +225,7 @@ class BackseatObserver:
         data = ev.data
         if not data:
             return
+        self.pending.expire(ev.t, self.max_wait)
         self.arrivals.record(ev.t, len(data))
         if self._whole_line(self._vframer, data):
             self._report(data, ev.t, self.arrivals.arrival(len(data)))
