@@ -2,13 +2,19 @@
 
 Every certification runs the real command (:func:`helmcheck.conformance.backseat.cli.run`, in
 a thread of this process so the grammar is built once) on its own pty, with the backseat a real
-subprocess (pyserial) that opens the printed port. All of them run at once, at time scale 5, for
-20 s of judged run each (every scenario), so the module takes about 25 s of wall time. One more
-test runs ``helmcheck certify backseat`` as a subprocess to check the ``port:`` line and Ctrl-C.
+subprocess (pyserial) that opens the printed port. The good backseat and every faulty one run
+at two time scales (5 and 10), each batch at once, for 18 s of judged run each (every scenario);
+the module takes about 45 s of wall time. One more test runs ``helmcheck certify backseat`` as a
+subprocess to check the ``port:`` line and Ctrl-C.
 
-The judge's slack (1.0 s reaction, 0.2 s jitter) and the example backseats' margins (polls
-every second against a 5 s limit, servo refresh at a third of its timeout) keep the verdicts
-stable on a loaded machine.
+Besides the verdicts themselves (mutation coverage: every fault caught on its clause, RH-BS-1..8,
+at both scales), every run's ``wire.log`` is checked again offline with ``check-log --role
+backseat`` and the same profile: the verdict of every clause the certification judged must be
+the same (one judge for live and offline).
+
+The example backseats' margins (polls every second against a 5 s limit, servo refresh at a
+third of its timeout, 1.5 s back-off after a rejection) keep the verdicts stable on a loaded
+machine.
 """
 
 from __future__ import annotations
@@ -24,13 +30,16 @@ from pathlib import Path
 import pytest
 
 from helmcheck.conformance.backseat import cli
+from helmcheck.conformance.checklog.checker import check_log
+from helmcheck.profile import DEFAULT
 from helmcheck.reports.results import load_results
 
 HERE = Path(__file__).resolve().parent / "backseats"
 GOOD = HERE / "good_backseat.py"
 FAULTY = HERE / "faulty_backseat.py"
 K = 5.0
-DURATION = 20.0
+SCALES = (5.0, 10.0)
+DURATION = 18.0
 
 #: fault -> (clause, verdict); see tests/backseats/faulty_backseat.py
 FAULTS = {
@@ -41,6 +50,7 @@ FAULTS = {
     "short-omp": ("RH-BS-2", "fail"),
     "rwset-after-start": ("RH-BS-3", "fail"),
     "oms-while-stopped": ("RH-BS-3", "fail"),
+    "hasty-oms": ("RH-BS-3", "fail"),
     "flood": ("RH-BS-4", "fail"),
     "lockout-ignore": ("RH-BS-5", "non-strict"),
     "fast-resend": ("RH-BS-5", "non-strict"),
@@ -56,7 +66,7 @@ def parse(argv: list[str]) -> argparse.Namespace:
 
 
 def certify(report_dir: Path, backseat: list[str] | None, *, extra: tuple[str, ...] = (),
-            connect_timeout: float = 20.0) -> dict:
+            connect_timeout: float = 20.0, scale: float = K) -> dict:
     """One certification on a new pty; ``backseat`` is the script's argv after the port."""
     procs: list[subprocess.Popen] = []
     errs = report_dir.parent / f"{report_dir.name}.backseat.err"
@@ -67,7 +77,7 @@ def certify(report_dir: Path, backseat: list[str] | None, *, extra: tuple[str, .
                                           stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
                                           stderr=open(errs, "wb")))
 
-    args = parse(["--duration", str(DURATION), "--time-scale", str(K), "--report-dir", str(report_dir),
+    args = parse(["--duration", str(DURATION), "--time-scale", str(scale), "--report-dir", str(report_dir),
                   "--connect-timeout", str(connect_timeout), *extra])
     try:
         rc = cli.run(args, on_port=on_port)
@@ -78,31 +88,40 @@ def certify(report_dir: Path, backseat: list[str] | None, *, extra: tuple[str, .
             except subprocess.TimeoutExpired:
                 p.kill()
                 p.wait()
-    return {"rc": rc, "results": load_results(report_dir), "dir": report_dir,
+    return {"rc": rc, "results": load_results(report_dir), "dir": report_dir, "scale": scale,
             "backseat_rc": procs[0].returncode if procs else None,
             "backseat_err": errs.read_text(errors="replace") if errs.exists() else ""}
 
 
 @pytest.fixture(scope="module")
 def runs(tmp_path_factory):
-    """Every certification of this module, run at once."""
+    """Every certification of this module, one batch per time scale (each batch at once).
+    Keys: ``(name, scale)``."""
     root = tmp_path_factory.mktemp("certify-backseat")
-    jobs = {"good": [GOOD, "--time-scale", str(K)],
-            "crash": [GOOD, "--time-scale", str(K), "--crash-after", "6"]}
-    for fault in FAULTS:
-        jobs[fault] = [FAULTY, "--fault", fault, "--time-scale", str(K)]
-    with ThreadPoolExecutor(max_workers=len(jobs) + 1) as pool:
-        futures = {name: pool.submit(certify, root / name, argv) for name, argv in jobs.items()}
-        futures["never"] = pool.submit(certify, root / "never", None, connect_timeout=1.5)
-        return {name: f.result() for name, f in futures.items()}
+    out = {}
+    for scale in SCALES:
+        ks = f"{scale:g}"
+        jobs = {"good": [GOOD, "--time-scale", ks]}
+        for fault in FAULTS:
+            jobs[fault] = [FAULTY, "--fault", fault, "--time-scale", ks]
+        if scale == K:
+            jobs["crash"] = [GOOD, "--time-scale", ks, "--crash-after", "6"]
+        with ThreadPoolExecutor(max_workers=len(jobs) + 1) as pool:
+            futures = {name: pool.submit(certify, root / f"{name}-k{ks}", argv, scale=scale)
+                       for name, argv in jobs.items()}
+            if scale == K:
+                futures["never"] = pool.submit(certify, root / "never", None, connect_timeout=1.5)
+            out.update({(name, scale): f.result() for name, f in futures.items()})
+    return out
 
 
 def clauses(run: dict) -> dict[str, dict]:
     return {c["id"]: c for c in run["results"]["clauses"]}
 
 
-def test_well_behaved_backseat_passes_every_scenario(runs):
-    run = runs["good"]
+@pytest.mark.parametrize("scale", SCALES)
+def test_rh_bs_1_to_8_well_behaved_backseat_passes_every_scenario(runs, scale):
+    run = runs["good", scale]
     r = run["results"]
     bad = {cid: (c["verdict"], c["reason"], c["evidence"]) for cid, c in clauses(run).items()
            if c["verdict"] != "pass"}
@@ -117,9 +136,14 @@ def test_well_behaved_backseat_passes_every_scenario(runs):
         assert (run["dir"] / name).stat().st_size > 0
 
 
-@pytest.mark.parametrize("fault", sorted(FAULTS))
-def test_faulty_backseat_is_caught_on_its_clause(runs, fault):
-    run = runs[fault]
+FAULT_PARAMS = [pytest.param(f, id=f"{FAULTS[f][0]}-{f}") for f in sorted(FAULTS)]
+
+
+@pytest.mark.parametrize("scale", SCALES)
+@pytest.mark.parametrize("fault", FAULT_PARAMS)
+def test_rh_bs_faulty_backseat_is_caught_on_its_clause(runs, fault, scale):
+    """Mutation coverage: each faulty backseat is caught on its own clause, and only there."""
+    run = runs[fault, scale]
     clause, verdict = FAULTS[fault]
     cs = clauses(run)
     c = cs[clause]
@@ -134,8 +158,36 @@ def test_faulty_backseat_is_caught_on_its_clause(runs, fault):
     assert run["rc"] == (1 if verdict == "fail" else 0)
 
 
+def test_rh_bs_1_to_8_every_backseat_clause_has_a_fault_that_is_caught():
+    """RH-BS-1..8: the faulty backseats cover every backseat clause."""
+    assert {c for c, _ in FAULTS.values()} == {f"RH-BS-{i}" for i in range(1, 9)}
+
+
+def _offline(run: dict) -> dict[str, dict]:
+    out = check_log(run["dir"] / "wire.log", profile=DEFAULT, role="backseat")
+    return {c["id"]: c for c in out.clauses}
+
+
+@pytest.mark.parametrize("scale", SCALES)
+@pytest.mark.parametrize("name", [pytest.param("good", id="good"), *FAULT_PARAMS])
+def test_rh_bs_1_to_8_check_log_of_the_wire_log_agrees_with_the_certification(runs, name, scale):
+    """One judge: ``check-log --role backseat`` on the run's own wire.log, same profile, gives
+    the verdict the certification gave for every clause it judged (RH-BS-1..8)."""
+    run = runs[name, scale]
+    live = clauses(run)
+    offline = _offline(run)
+    judged = [c for c, x in live.items() if x["verdict"] != "not-tested"]
+    assert judged
+    differ = {c: (live[c]["verdict"], offline[c]["verdict"], live[c]["reason"], offline[c]["reason"])
+              for c in judged if offline[c]["verdict"] != live[c]["verdict"]}
+    assert not differ, differ
+    for c in live:  # never FAIL against PASS, in either direction
+        pair = {live[c]["verdict"], offline[c]["verdict"]}
+        assert not (pair & {"fail", "non-strict"} and "pass" in pair), (c, pair)
+
+
 def test_backseat_that_crashes_mid_run_is_inconclusive(runs):
-    run = runs["crash"]
+    run = runs["crash", K]
     r = run["results"]
     assert run["backseat_rc"] == 3
     assert r["verdict"] == "inconclusive" and r["partial"] and run["rc"] == 2
@@ -145,7 +197,7 @@ def test_backseat_that_crashes_mid_run_is_inconclusive(runs):
 
 
 def test_backseat_that_never_connects_is_inconclusive(runs):
-    run = runs["never"]
+    run = runs["never", K]
     r = run["results"]
     assert r["verdict"] == "inconclusive" and run["rc"] == 2
     assert "never connected" in r["verdict_reason"]

@@ -133,7 +133,15 @@ def test_cli_writes_reports_and_exit_codes(tmp_path, capsys):
                      "--no-render"]) == 1
     assert "RH-ACK-3 fail: lines 13" in capsys.readouterr().out
     assert cli_main(["check-log", str(LOGS / "backseat_only.log"), "--report-dir", str(tmp_path / "b"),
+                     "--no-render"]) == 0
+    coarse = tmp_path / "coarse.log"  # 2 × 1100 bytes stamped 1 s apart: within a second or not?
+    flood = "$OSD*58\\r\\n" * 122 + "$OSD"
+    coarse.write_text(f"# helmcheck wire-log 1\n0 >~ {flood}\n1 >~ *58\\r\\n{flood}\n2 > *58\n")
+    assert cli_main(["check-log", str(coarse), "--role", "backseat", "--report-dir", str(tmp_path / "c"),
                      "--no-render"]) == 2
+    doc = json.loads((tmp_path / "c" / "results.json").read_text())
+    assert {c["id"]: c["verdict"] for c in doc["clauses"]}["RH-BS-4"] == "inconclusive"
+    capsys.readouterr()
     assert cli_main(["check-log", str(tmp_path / "missing.log")]) == 64
     assert "missing.log" in capsys.readouterr().err
     junk = tmp_path / "junk.bin"
@@ -192,3 +200,38 @@ def test_committed_emulator_log_checks_clean():
             (c["id"], c["reason"]) for c in out.clauses if c["verdict"] not in ("pass", "not-tested")]
         v = verdicts(out)
         assert v["RH-SAF-1"]["verdict"] == "pass" and v["RH-SRV-4"]["verdict"] == "pass"
+
+
+def _log(tmp_path, records: list[tuple[float, str, str]], scale: float = 1.0) -> Path:
+    """A hand-made wire log: (t, dir, payload) records; '>'/'<' payloads are sentence bodies."""
+    from helmcheck.grammar import checksum_hex
+
+    lines = ["# helmcheck wire-log 1", f"# hand-made  baud 19200  time_scale {scale:g}"]
+    for t, d, body in records:
+        text = body if d == "!" else f"${body}*{checksum_hex(body)}"
+        lines.append(f"{t:.6f} {d} {text}")
+    p = tmp_path / "made.log"
+    p.write_text("\n".join(lines) + "\n")
+    return p
+
+
+def _osi(mode: str, err: str = "N") -> str:
+    return (f"OSI,8080808080,{mode},0,41.52,-71.32,0.00,0.00,{err},0.00,P0,-14.5,,0.0,0.0,0.00,95.0,"
+            f"False,IVER3-EMU,0.0,False,False")
+
+
+def test_rh_bs_6_refresh_within_the_rh_tim_1_tolerance_is_in_time(tmp_path):
+    """RH-BS-6: an $OMS with a 10 s timeout refreshed 10.3 s after its ACK is within
+    max(0.5 s, 5 %) = 0.5 s of the timeout: in time (PASS), offline as live."""
+    recs = [(0.0, ">", "OSD,S"), (0.01, "<", _osi("S")), (0.011, "<", "ACK,8,0,0"),
+            (0.5, ">", "OMSTART,0,0,0,0,conformance.mis,"), (0.51, "<", "ACK,3,0,0"),
+            (1.0, ">", "OMS,180,3,20,2,10"), (1.01, "<", "ACK,9,0,0")]
+    t = 1.01
+    for i in range(1, 5):
+        recs += [(t + 2.0 * i, ">", "OSD,S"), (t + 2.0 * i + 0.01, "<", _osi("A")),
+                 (t + 2.0 * i + 0.011, "<", "ACK,8,0,0")]
+    recs += [(1.01 + 10.3, ">", "OMS,181,3,20,2,10"), (11.32, "<", "ACK,9,0,0"),
+             (11.5, ">", "OSD,S"), (11.51, "<", _osi("A")), (11.511, "<", "ACK,8,0,0")]
+    out = check_log(_log(tmp_path, recs), profile=PROFILE, role="backseat")
+    v = verdicts(out)
+    assert v["RH-BS-6"]["verdict"] == "pass", v["RH-BS-6"]

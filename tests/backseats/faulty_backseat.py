@@ -16,6 +16,7 @@ short-omp           RH-BS-2    every 3 s an ``$OMP`` built with ``%x``: a byte b
                                loses a digit (nine hex digits)
 rwset-after-start   RH-BS-3    reads a setting with ``$ORWSET`` once the mission runs
 oms-while-stopped   RH-BS-3    sends ``$OMS`` while the vehicle reports ``S``
+hasty-oms           RH-BS-3    sends one ``$OMS`` 0.5 s after the vehicle reported ``S``
 flood               RH-BS-4    once, 300 empty ``$OSD`` requests in one write (2700 bytes)
 lockout-ignore      RH-BS-5    keeps driving ``$OMS`` through a safety lockout
 fast-resend         RH-BS-5    resends a rejected command every 0.3 s
@@ -106,6 +107,29 @@ class OmsWhileStopped(Backseat):
             self.send_oms(now)  # drives although the vehicle reports S
 
 
+class HastyOms(Backseat):
+    """Each time the vehicle reports ``S``, one ``$OMS`` half a second later (a backseat that
+    acts on a stale idea of the mission), then carries on as the good one."""
+
+    s_since: float | None = None
+    sent_hasty = False
+
+    def when_running(self, now: float) -> None:
+        self.s_since = None
+        self.sent_hasty = False
+        super().when_running(now)
+
+    def when_stopped(self, now: float) -> None:
+        if self.s_since is None:
+            self.s_since = now
+        if not self.sent_hasty and now - self.s_since >= 0.5:
+            self.sent_hasty = True
+            self.send_oms(now)
+            return
+        if self.sent_hasty and now - self.s_since >= 1.5:
+            super().when_stopped(now)
+
+
 class Flood(Backseat):
     flooded = False
 
@@ -147,7 +171,7 @@ class NoPoll(Backseat):
 FAULTS = {
     "bad-checksum": BadChecksum, "unpadded-checksum": UnpaddedChecksum, "lowercase-hex": LowercaseHex,
     "bare-lf": BareLf, "short-omp": ShortOmp, "rwset-after-start": RwsetAfterStart,
-    "oms-while-stopped": OmsWhileStopped, "flood": Flood, "lockout-ignore": LockoutIgnore,
+    "oms-while-stopped": OmsWhileStopped, "hasty-oms": HastyOms, "flood": Flood, "lockout-ignore": LockoutIgnore,
     "fast-resend": FastResend, "late-refresh": LateRefresh, "no-poll": NoPoll,
 }
 

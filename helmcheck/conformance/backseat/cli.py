@@ -3,7 +3,8 @@
 The command opens the port (``--port pty`` prints ``port: /dev/pts/N`` as its first line on
 standard output, flushed, for the backseat to open; a device path is opened 8N1 at the
 profile's baud; ``socket://HOST:PORT`` serves one client), plays the reference vehicle, stages
-the scenarios of :mod:`.scenarios` and judges every byte the backseat sends (:mod:`.judge`).
+the scenarios of :mod:`.scenarios` and judges every byte the backseat sends
+(:class:`helmcheck.judge.backseat.BackseatObserver`, the judge ``check-log`` uses too).
 At the end (also after Ctrl-C, a backseat that never connected or one that went away) it writes
 ``results.json``, ``wire.log`` and every report format into ``--report-dir``, prints one verdict
 line on standard output and exits 0 (pass; non-strict without ``--strict``), 1 (fail), 2
@@ -115,6 +116,7 @@ class _Progress:
 def run(args: argparse.Namespace, *, on_port: Optional[Callable[[str], None]] = None) -> int:  # noqa: C901
     """Carry out ``certify backseat``; returns the exit status. ``on_port(name)`` is called
     once the port is open (after the ``port:`` line), for callers that start the backseat."""
+    from ...judge.timing import JITTER_S
     from ...profile import ProfileError, load_profile
     from ..transport import BAUD_RATES, parse_port_spec
     from .scenarios import make_plan
@@ -152,7 +154,7 @@ def run(args: argparse.Namespace, *, on_port: Optional[Callable[[str], None]] = 
                                 "duration_s": float(args.duration), "planned_s": round(plan.total, 3),
                                 "scenarios": list(dict.fromkeys(names)), "baud": baud,
                                 "connect_timeout_s": float(args.connect_timeout),
-                                "reaction_s": 1.0, "jitter_s": 0.2}
+                                "reaction_s": float(profile.reaction_s), "jitter_s": JITTER_S}
     command = "helmcheck certify backseat " + " ".join(sys.argv[3:] if sys.argv[1:3] == ["certify", "backseat"]
                                                        else [f"--port {args.port}"])
     started = started_dt.isoformat(timespec="seconds").replace("+00:00", "Z")
@@ -182,12 +184,10 @@ def _certify(args, profile, spec, plan, report_dir: Path, log_file, settings, co
                 sys.stdout.flush()
             except OSError:
                 pass
-            from ...grammar.capture import WireLogWriter  # the grammar loads after the port line
-            from ..emulator.missionfile import DirectoryCatalog, builtin_dir
+            from ..emulator.missionfile import DirectoryCatalog, builtin_dir  # after the port line
             from .runner import Runner
-            log = WireLogWriter(log_file, meta=(f"started {started_dt.strftime('%Y-%m-%dT%H:%M:%S.%fZ')}  "
-                                                f"port {link.name}  baud {profile.baud}  "
-                                                f"time_scale {profile.time_scale:g}"))
+            meta = [f"started {started_dt.strftime('%Y-%m-%dT%H:%M:%S.%fZ')}  port {link.name}  "
+                    f"baud {profile.baud}  time_scale {profile.time_scale:g}"]
             print(f"helmcheck certify backseat: {link.description}, profile {profile.name}, time scale "
                   f"{profile.time_scale:g}, baud {profile.baud}, scenarios {', '.join(s.name for s in plan.slots)} "
                   f"over {plan.total:.1f} s; waiting up to {args.connect_timeout:g} s for the backseat",
@@ -198,7 +198,7 @@ def _certify(args, profile, spec, plan, report_dir: Path, log_file, settings, co
             if on_port is not None:
                 on_port(link.name)
             runner = Runner(link, profile, plan, time_scale=profile.time_scale,
-                            missions=DirectoryCatalog([builtin_dir()]), log=log,
+                            missions=DirectoryCatalog([builtin_dir()]), log=log_file, meta=meta,
                             connect_timeout=args.connect_timeout, progress=progress)
             old = {}
             if threading.current_thread() is threading.main_thread():

@@ -1,8 +1,10 @@
 """From a finished (or cut short) run to ``results.json`` and every report format.
 
 The document is schema 1 (:mod:`helmcheck.reports.results`) with ``"role": "backseat"``: one
-entry per §9 clause (RH-BS-1..8) with its verdict, reason, ``offending_count`` and the first
-offending lines quoted as evidence; the scenarios staged, the mode timeline, the staged events.
+entry per §9 clause (RH-BS-1..8) exactly as the verdict ledger combined the observer's findings
+(:meth:`helmcheck.judge.ledger.Ledger.entries`: verdict, reason, the scenarios it was observed
+in as cases, ``offending_count`` and the first offending lines quoted as evidence); the
+scenarios staged, the mode timeline, the staged events. This module judges nothing.
 A MUST not met is ``fail``; a SHOULD not met ``non-strict`` (``fail`` with ``--strict``). A run
 that never started or was cut short (the backseat never connected, closed the port, crashed,
 or Ctrl-C) is ``partial`` and cannot certify: INCONCLUSIVE, with the reason first in
@@ -15,10 +17,10 @@ from pathlib import Path
 from typing import Any, Optional
 
 from ...clauses import backseat_clauses
+from ...judge.backseat import BS_CLAUSES
 from ...profile import Profile
 from ...reports import render_all
 from ...reports.results import add_clause, add_event, add_mode, finish, new_results, write_results_atomic
-from .judge import BS_CLAUSES
 from .runner import Outcome
 
 __all__ = ["build_results", "write_reports"]
@@ -38,10 +40,9 @@ def build_results(outcome: Optional[Outcome], *, profile: Profile, settings: dic
         for cid in BS_CLAUSES:
             add_clause(results, cid, "not-tested", f"not judged: {why}", level=levels[cid])
     else:
-        for r in outcome.judge.results(levels):
-            cases = r.cases if r.offending_count else ([] if r.verdict == "not-tested" else outcome.scenarios_run)
-            add_clause(results, r.id, r.verdict, r.reason, cases=cases, evidence=r.evidence,
-                       offending_count=r.offending_count, level=r.level)
+        for e in outcome.observer.ledger.entries():
+            add_clause(results, e["id"], e["verdict"], e["reason"], cases=e["cases"], evidence=e["evidence"],
+                       offending_count=e["offending_count"], level=e["level"])
         for t, kind, label in outcome.events:
             add_event(results, round(t, 6), kind, label)
         seen: list[str] = []
@@ -53,8 +54,8 @@ def build_results(outcome: Optional[Outcome], *, profile: Profile, settings: dic
         results["scenarios"] = list(outcome.scenarios_run)
         results["run"] = {"status": outcome.status, "connected_at": outcome.connected_at,
                           "ended_at": round(outcome.ended_at, 3), "planned_s": round(outcome.planned, 3),
-                          "bytes_from_backseat": outcome.judge.stats["bytes"],
-                          "lines_from_backseat": outcome.judge.stats["lines"],
+                          "bytes_from_backseat": outcome.observer.stats["bytes"],
+                          "lines_from_backseat": outcome.observer.stats["lines"],
                           "vehicle": outcome.vehicle_stats}
     partial = status != "complete"
     finish(results, partial=partial, strict=strict,

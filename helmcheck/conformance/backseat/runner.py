@@ -1,13 +1,22 @@
-"""The I/O loop of ``certify backseat``: one link, the reference vehicle, the judge, the plan.
+"""The I/O loop of ``certify backseat``: one link, the reference vehicle, the recorder, the plan.
 
-This module owns the clock, the descriptors and the wire log; the vehicle's behaviour is the
+This module owns the clock, the descriptors and the recording; the vehicle's behaviour is the
 emulator core's (:class:`~helmcheck.conformance.emulator.core.EmulatorCore`, exactly the
-model's), the judging is :class:`~.judge.BackseatJudge`'s and the staging is
-:mod:`.scenarios`'. Every byte from the backseat goes first to the judge, which hands back
-complete lines; each line then goes to the vehicle unless a scenario says otherwise (a
-``silence`` drops it, a ``reject`` window answers it with an error ``$ACK`` in the vehicle's
-place, queued by the core behind its own output, in order and paced like it). Every byte the
-vehicle writes is shown to the judge when it goes out (what the backseat could know).
+model's), the judging is the backseat observer's
+(:class:`~helmcheck.judge.backseat.BackseatObserver`, fed by the
+:class:`~helmcheck.conformance.recorder.Recorder`, which writes ``wire.log`` too) and the
+staging is :mod:`.scenarios`'. The loop judges nothing itself: it records every byte from the
+backseat as it is read (``>``), every byte to the backseat as it is written (``<``) and every
+staged fact as a note (``scenario X starts``, ``reject: …``, ``silence starts``/``ends``,
+``lockout starts (<code>)``/``lockout ends``, the emulator core's own notes), so that
+``check-log`` of the same ``wire.log`` judges what the certification judged.
+
+Driving: the backseat's bytes are framed here (:class:`~helmcheck.grammar.Framer`) and each
+complete line goes to the vehicle unless a scenario says otherwise (a ``silence`` drops it, a
+``reject`` window answers a command with an error ``$ACK`` in the vehicle's place, queued by
+the core behind its own output, in order and paced like it). Before the bytes of a read are
+recorded the vehicle is brought up to that moment, so a lockout that has ended is noted before
+the bytes that follow it.
 
 Link life (decisions): the run starts at the backseat's first byte; none within
 ``connect_timeout`` is "never connected". On a pty the loop lets go of its own copy of the
@@ -20,19 +29,23 @@ end it early as "interrupted".
 
 from __future__ import annotations
 
+import re
 import select
 import time
 from collections import deque
 from dataclasses import dataclass, field
-from typing import Any, Callable, Optional
+from typing import IO, Any, Callable, Iterable, Optional
 
+from ...grammar import Discard, Framer, decode
 from ...grammar import sentences as s
-from ...grammar.capture import TO_VEHICLE, WireLogWriter
+from ...grammar.capture import FROM_VEHICLE, TO_VEHICLE
+from ...judge.backseat import BS_CLAUSES, BackseatObserver
+from ...judge.ledger import Ledger
 from ...model.missions import MissionCatalog
 from ...profile import Profile
 from ..emulator.core import EmulatorCore
+from ..recorder import Recorder
 from ..transport import Link, LinkClosed
-from .judge import BackseatJudge, Piece
 from .link import HangupPty
 from .scenarios import LOCKOUT_CODE, Plan
 
@@ -40,6 +53,23 @@ __all__ = ["Runner", "Outcome", "HangupPty", "MAX_OUT"]
 
 MAX_OUT = 256 * 1024  #: bytes waiting for a link nobody reads; beyond this they are dropped
 _TICK = 0.05
+#: the core's note about an overlong run it logged in part; the recorder here logs every byte
+_PARTIAL = re.compile(r"^RH-FRM-\d+: \d+ bytes discarded, first \d+ logged$")
+
+
+class _CoreNotes:
+    """The emulator core's log: its notes go to the recorder; its bytes do not, because the
+    loop records the bytes itself as they cross the link."""
+
+    def __init__(self, recorder: Recorder):
+        self.recorder = recorder
+
+    def bytes(self, t: float, direction: str, raw: bytes) -> None:
+        pass
+
+    def note(self, t: float, text: str) -> None:
+        if not _PARTIAL.match(text):
+            self.recorder.note(t, text)
 
 
 @dataclass
@@ -48,7 +78,7 @@ class Outcome:
 
     status: str  #: complete | never-connected | disconnected | interrupted
     reason: str
-    judge: BackseatJudge
+    observer: BackseatObserver
     connected_at: Optional[float] = None
     ended_at: float = 0.0
     planned: float = 0.0
@@ -62,25 +92,25 @@ class Runner:
     """Runs one certification on ``link``. See the module docstring."""
 
     def __init__(self, link: Link, profile: Profile, plan: Plan, *, time_scale: float,
-                 missions: Optional[MissionCatalog] = None, log: Optional[WireLogWriter] = None,
-                 connect_timeout: float = 30.0, clock: Callable[[], float] = time.monotonic,
-                 progress: Any = None, reaction_s: float = 1.0, jitter_s: float = 0.2):
+                 missions: Optional[MissionCatalog] = None, log: Optional[IO[str]] = None,
+                 meta: Iterable[str] = (), connect_timeout: float = 30.0,
+                 clock: Callable[[], float] = time.monotonic, progress: Any = None):
         self.link = link
         self.profile = profile
         self.plan = plan
         self.time_scale = time_scale
-        self.log = log
         self.connect_timeout = connect_timeout
         self.clock = clock
         self.progress = progress
         self.launch = clock()
+        self.ledger = Ledger(BS_CLAUSES)
+        self.observer = BackseatObserver(profile, self.ledger, time_scale=time_scale, baud=profile.baud)
+        self.recorder = Recorder(log, meta, observers=[self.observer])
         self.core = EmulatorCore(profile.replace(fault_injection="none"), missions, start=self.launch,
-                                 time_scale=time_scale, baud=profile.baud, log=log)
-        self.judge = BackseatJudge(profile, time_scale=time_scale, reaction_s=reaction_s,
-                                   jitter_s=jitter_s)
+                                 time_scale=time_scale, baud=profile.baud, log=_CoreNotes(self.recorder))
+        self._framer = Framer(profile.max_line_bytes)
         self._stop: Optional[str] = None
         self._out = bytearray()
-        self._held: deque[Piece] = deque()
         self._actions = deque(plan.actions)
         self._silent = False
         self._rejecting = False
@@ -90,7 +120,7 @@ class Runner:
         self._scenario = ""
         self._dropped_out = 0
         self.connected_at: Optional[float] = None
-        self.outcome = Outcome("interrupted", "", self.judge, planned=plan.total)
+        self.outcome = Outcome("interrupted", "", self.observer, planned=plan.total)
 
     # ------------------------------------------------------------------ control
     def stop(self, why: str = "interrupted") -> None:
@@ -135,10 +165,9 @@ class Runner:
                     break
         finally:
             now = self.clock()
-            for piece in self.judge.close(self.rel(now)):
-                self._held.append(piece)
-            self._flush_input_to_vehicle(now)
-            self._note(now, f"run ended: {reason}")
+            end = self.recorder.note(self.rel(now), f"run ended: {reason}")
+            self.observer.close(end)
+            self.recorder.close()
             o.status, o.reason = status, reason
             o.connected_at = self.connected_at
             o.ended_at = self.rel(now)
@@ -186,33 +215,29 @@ class Runner:
             if self.progress is not None:
                 self.progress.start(self.plan.total)
             self._due(now)
-        self._held.extend(self.judge.backseat_bytes(data, self.rel(now)))
-        self._flush_input_to_vehicle(now)
-
-    def _flush_input_to_vehicle(self, now: float) -> None:
-        """Hand complete lines to the vehicle in order."""
-        while self._held:
-            piece = self._held.popleft()
-            self._deliver(piece, now)
+        self._service(now)  # the vehicle up to now first: a lockout that ended is noted before
+        self.recorder.bytes(self.rel(now), TO_VEHICLE, data)
+        for ev in self._framer.feed(data):
+            self._deliver(ev.raw, None if isinstance(ev, Discard) else ev.raw, now)
             self._after_vehicle(now)
 
-    def _deliver(self, piece: Piece, now: float) -> None:
-        t = self.rel(now)
+    def _deliver(self, raw: bytes, line: Optional[bytes], now: float) -> None:
+        """One framed run from the backseat to the vehicle (``line`` None: a discarded run)."""
         if self._silent:
-            self._log_bytes(t, TO_VEHICLE, piece.raw)
             if not self._silence_noted:
                 self._silence_noted = True
                 self._note(now, "silence: the vehicle neither reads nor answers")
             return
-        cmd = piece.command
-        if (self._rejecting and cmd is not None and cmd.ACK_TYPE is not None and not isinstance(cmd, s.OSD)
-                and cmd.ID in self.profile.commands):
-            self._log_bytes(t, TO_VEHICLE, piece.raw)
-            if len(self.outcome.events) < 500:
-                self.outcome.events.append((t, "ack-error", f"staged rejection of ${cmd.ID}: err {cmd.ERR}"))
-            self._emit(self.core.queue_reply(s.ACK(cmd.ACK_TYPE, 1, cmd.ERR), now))
-            return
-        self._emit(self.core.feed(piece.raw, now))
+        if self._rejecting and line is not None:
+            cmd = decode(line, self.profile).sentence
+            if (isinstance(cmd, s.Command) and cmd.ACK_TYPE is not None and not isinstance(cmd, s.OSD)
+                    and cmd.ID in self.profile.commands):
+                t = self.rel(now)
+                if len(self.outcome.events) < 500:
+                    self.outcome.events.append((t, "ack-error", f"staged rejection of ${cmd.ID}: err {cmd.ERR}"))
+                self._emit(self.core.queue_reply(s.ACK(cmd.ACK_TYPE, 1, cmd.ERR), now))
+                return
+        self._emit(self.core.feed(raw, now))
 
     # ------------------------------------------------------------------ vehicle side
     def _service(self, now: float) -> None:
@@ -222,7 +247,6 @@ class Runner:
                 self._note(now, f"silence: {len(out)} bytes of replies not sent")
         else:
             self._emit(out)
-        self._flush_input_to_vehicle(now)
         self._after_vehicle(now)
         self._write(now)
 
@@ -246,7 +270,7 @@ class Runner:
                 return
             if n <= 0:
                 return
-            self.judge.vehicle_bytes(bytes(self._out[:n]), self.rel(now))
+            self.recorder.bytes(self.rel(now), FROM_VEHICLE, bytes(self._out[:n]))
             del self._out[:n]
         self._dropped_out = 0
 
@@ -256,7 +280,7 @@ class Runner:
         lock = core.lockout_active
         if lock != self._lockout:
             self._lockout = lock
-            self.judge.lockout(lock, self.rel(now))
+            self._note(now, f"lockout starts ({m.error_state})" if lock else "lockout ends")
             self.outcome.events.append((self.rel(now), "lockout",
                                         f"lockout {'starts' if lock else 'ends'} ({m.error_state})"))
         if m.mode != self._mode:
@@ -269,13 +293,12 @@ class Runner:
         while self._actions and start + self._actions[0].at <= now:
             self._act(self._actions.popleft(), now)
         if self.progress is not None:
-            self.progress.update(self._elapsed(now), self._scenario, self.judge.counts)
+            self.progress.update(self._elapsed(now), self._scenario, self.observer.offences())
 
     def _act(self, a, now: float) -> None:
         t = self.rel(now)
         if a.kind == "scenario":
             self._scenario = a.name
-            self.judge.scenario(a.name, t)
             self.outcome.scenarios_run.append(a.name)
             self._note(now, f"scenario {a.name} starts")
             self.outcome.events.append((t, "note", f"scenario {a.name}"))
@@ -285,13 +308,13 @@ class Runner:
         elif a.kind == "silence":
             self._silent = a.on
             self._silence_noted = False
-            self.judge.silence(a.on, t)
             self._note(now, "silence starts" if a.on else "silence ends")
             self.outcome.events.append((t, "note", "silence starts" if a.on else "silence ends"))
         elif a.kind == "lockout":
-            self._emit(self.core.inject_fault(LOCKOUT_CODE, now, source="scenario lockout"))
+            out = self.core.inject_fault(LOCKOUT_CODE, now, source="scenario lockout")
             self.outcome.events.append((t, "lockout", f"safety violation {LOCKOUT_CODE} raised"))
-            self._after_vehicle(now)
+            self._after_vehicle(now)  # the note before any byte that could show the lockout
+            self._emit(out)
         elif a.kind == "mission-end":
             self._end_mission(now)
 
@@ -307,10 +330,6 @@ class Runner:
         self.outcome.events.append((self.rel(now), "note", "mission ended on the vehicle"))
         self._after_vehicle(now)
 
-    # ------------------------------------------------------------------ logs
+    # ------------------------------------------------------------------ notes
     def _note(self, now: float, text: str) -> None:
-        self.core.note(now, text)
-
-    def _log_bytes(self, t: float, direction: str, raw: bytes) -> None:
-        if self.log is not None:
-            self.log.bytes(t, direction, raw)
+        self.recorder.note(self.rel(now), text)

@@ -14,7 +14,8 @@ Modules, one concern each:
   the judges, vehicle framing/content clauses (RH-FRM-*, RH-OUT-1..3), bounded bookkeeping.
 * :mod:`.vehicle` — the replay through the model: RH-ACK-*, RH-OUT-4, the command and timer
   clauses, plant events from recorder notes or inferred from ``$OSI``.
-* :mod:`.backseat` — RH-BS-1..8.
+* RH-BS-1..8 are judged by :class:`helmcheck.judge.backseat.BackseatObserver`, the observer
+  ``certify backseat`` uses, fed every record by the checker.
 * :mod:`.accounting` — per-clause counts, bounded evidence, verdicts.
 * :mod:`.report` — ``results.json``, the log copy, the rendered reports.
 """

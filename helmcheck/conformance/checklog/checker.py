@@ -1,4 +1,4 @@
-"""The log checker: one pass over a capture, both judges, per-clause results.
+"""The log checker: one pass over a capture, the vehicle judge and the backseat observer, per-clause results.
 
 This module owns :func:`check_log` — Jepsen's ``analyze`` / TLA+ trace validation for the remote
 helm line: the whole log is consumed, in order, and every byte is attributed. Its steps:
@@ -9,7 +9,11 @@ helm line: the whole log is consumed, in order, and every byte is attributed. It
    line it started on;
 3. decode every line (:func:`helmcheck.grammar.decode`); vehicle output is judged for framing
    (RH-FRM-1/2/3, RH-FRM-8 via the grammar) and content (RH-OUT-1/2/3), then handed to the
-   vehicle judge (:mod:`.vehicle`); backseat lines go to both judges (:mod:`.backseat`);
+   vehicle judge (:mod:`.vehicle`); backseat lines go to the vehicle judge too;
+   for role ``backseat``/``both`` every record (notes included) is also fed, as a
+   :class:`~helmcheck.judge.wire.WireEvent`, to the backseat observer
+   (:class:`~helmcheck.judge.backseat.BackseatObserver`, the judge ``certify backseat`` uses),
+   which writes RH-BS-1..8 into its own :class:`~helmcheck.judge.ledger.Ledger` (:class:`_Backseat`);
 4. recorder notes are applied as plant events when they are (``plant: …``) and otherwise
    attributed as notes; a log line that cannot be read is a finding with its line number
    (charged to RH-FRM-1 / RH-BS-1 as INCONCLUSIVE: the bytes there are unknown).
@@ -29,10 +33,12 @@ from typing import Callable, Optional
 from ...grammar import Discard, Framer, Line, decode
 from ...grammar import sentences as s
 from ...grammar.capture import escape
+from ...judge.backseat import BS_CLAUSES, BackseatObserver
+from ...judge.ledger import Evidence as LedgerEvidence, Ledger
+from ...judge.wire import WireEvent
 from ...model.missions import MissionCatalog
 from ...profile import DEFAULT, Profile
 from .accounting import ClauseBook, Evidence
-from .backseat import BACKSEAT_CLAUSES, BackseatJudge
 from .readers import NOTE, UNREADABLE, Chunk, LogMeta, detect_format, read_chunks, timestamp_resolution
 from .vehicle import VEHICLE_CLAUSES, VehicleJudge, parse_plant_note
 
@@ -161,6 +167,33 @@ class _Hashing:
             yield raw
 
 
+class _Backseat:
+    """The backseat side of a check: every record to the backseat observer, its own ledger.
+
+    The records are fed exactly as ``certify backseat``'s recorder fed them live (same times,
+    same line numbers, notes included), so a wire log gets the verdicts the run got."""
+
+    def __init__(self, profile: Profile, scale: float, resolution: float, baud: int):
+        self.ledger = Ledger(BS_CLAUSES)
+        self.observer = BackseatObserver(profile, self.ledger, time_scale=scale, baud=baud,
+                                         resolution=resolution)
+
+    def chunk(self, c: Chunk) -> None:
+        if c.direction == NOTE:
+            self.observer.feed(WireEvent(c.t, NOTE, b"", c.note, c.lineno))
+        elif c.direction == UNREADABLE:
+            self.ledger.inconclusive("RH-BS-1", "a log line could not be read; the bytes there are unknown",
+                                     [LedgerEvidence(c.t, "!", f"{c.note}: {c.text[:120]}", c.lineno)])
+        else:
+            self.observer.feed(WireEvent(c.t, c.direction, c.data, "", c.lineno))
+
+    def close(self, t: float, backseat_traffic: bool) -> None:
+        if not backseat_traffic:
+            for c in BS_CLAUSES:
+                self.ledger.not_tested(c, "One-direction log: it has no backseat→vehicle traffic.")
+        self.observer.close(t)
+
+
 class _Checker:
     def __init__(self, profile: Profile, role: str, catalog, scale: float, resolution: float, baud: int):
         self.profile = profile
@@ -168,9 +201,8 @@ class _Checker:
         ids: list[str] = []
         if role in ("vehicle", "both"):
             ids += list(VEHICLE_CLAUSES)
-        if role in ("backseat", "both"):
-            ids += list(BACKSEAT_CLAUSES)
         self.book = ClauseBook(ids)
+        self.backseat = _Backseat(profile, scale, resolution, baud) if role in ("backseat", "both") else None
         self.scale = scale
         self.r = resolution
         self.timeline: list = []
@@ -181,14 +213,8 @@ class _Checker:
                       "lines_from_vehicle": 0, "discarded_to_vehicle": 0, "discarded_from_vehicle": 0,
                       "plant_notes": 0, "bytes_to_vehicle": 0, "bytes_from_vehicle": 0}
         self.last_t = 0.0
-        self.reported_running: Optional[bool] = None
         self.vehicle = VehicleJudge(self.book, profile, catalog, time_scale=scale, resolution=resolution,
                                     baud=baud, on_mode=self._mode, on_event=self._event)
-        self.vehicle.on_answer = self._answered
-        self.backseat = BackseatJudge(self.book, profile, baud=baud, resolution=resolution,
-                                      running=lambda: self.reported_running,
-                                      in_lockout=self._in_lockout)
-        self.backseat.time_scale = scale
         self.streams = {">": _Stream(profile.max_line_bytes), "<": _Stream(profile.max_line_bytes)}
         self._mode(0.0, "S")
         self._cache: dict = {}
@@ -204,23 +230,6 @@ class _Checker:
         if len(self.events) < MAX_EVENTS:
             self.events.append({"t": round(max(0.0, t), 6), "kind": kind, "label": label})
 
-    def _in_lockout(self) -> Optional[bool]:
-        if not self.vehicle.saw_vehicle:
-            return None
-        return self.vehicle.model.phase == "lockout"
-
-    def _answered(self, p, a: s.ACK) -> None:
-        if a.status == 1:
-            self.backseat.rejected(p.text, p.t)
-        elif isinstance(p.cmd, (s.OMSTART, s.OMSTARTPaper)):
-            self.reported_running = True
-        elif isinstance(p.cmd, s.OMSTOP):
-            self.reported_running = False
-        elif isinstance(p.cmd, s.OMS):
-            self.backseat.oms_accepted(p.t, p.cmd.timeout)
-        if a.status == 0 and not isinstance(p.cmd, (s.OMS, s.OSD, s.OPOS, s.ODVL, s.OLOGD, s.ORWSET)):
-            self.backseat.control_changed()
-
     def _finding(self, lineno: int, text: str) -> None:
         self.finding_count += 1
         if len(self.findings) < MAX_FINDINGS:
@@ -231,6 +240,8 @@ class _Checker:
         self.stats["records"] += 1
         if c.t > self.last_t:
             self.last_t = c.t
+        if self.backseat is not None:
+            self.backseat.chunk(c)
         d = c.direction
         if d == ">" or d == "<":
             st = self.streams[d]
@@ -241,7 +252,6 @@ class _Checker:
                     self._discard(d, e, c.t, lineno)
             if d == ">":
                 self.stats["bytes_to_vehicle"] += len(c.data)
-                self.backseat.bytes_sent(c.t, len(c.data), Evidence(c.t, ">", c.lineno, c.text[:120]))
             else:
                 self.stats["bytes_from_vehicle"] += len(c.data)
             return
@@ -257,7 +267,6 @@ class _Checker:
             self._finding(c.lineno, c.note)
             ev = Evidence(c.t, "!", c.lineno, f"{c.note}: {c.text[:120]}")
             self.book.inconclusive("RH-FRM-1", "a log line could not be read; the bytes there are unknown", [ev])
-            self.book.inconclusive("RH-BS-1", "a log line could not be read; the bytes there are unknown", [ev])
 
     def _discard(self, d: str, e: Discard, t: float, lineno: int) -> None:
         ev = Evidence(t, d + "~", lineno, escape(e.raw[:120]))
@@ -265,7 +274,6 @@ class _Checker:
                               f"{e.reason} ({e.length} bytes)")
         if d == ">":
             self.stats["discarded_to_vehicle"] += 1
-            self.backseat.discarded(ev, e.reason)
             self.vehicle.silent_recent.append((t, lineno, ev.text, None))
             self.book.ok("RH-FRM-6" if e.clause == "RH-FRM-6" else "RH-FRM-7")
         else:
@@ -284,8 +292,6 @@ class _Checker:
         dec, text = hit
         if d == ">":
             self.stats["lines_to_vehicle"] += 1
-            ev = Evidence(t, ">", lineno, text)
-            self.backseat.line(dec, t, ev)
             sent = dec.sentence
             if sent is not None:
                 if isinstance(sent, s.Command):
@@ -331,10 +337,6 @@ class _Checker:
         passes["RH-OUT-3"] += 1
         if isinstance(sent, s.OSI):
             passes["RH-OUT-1"] += 1
-            if sent.mode in ("N", "P", "mP", "A", "W"):
-                self.reported_running = True
-            elif sent.mode == "S":
-                self.reported_running = False
         else:
             passes["RH-OUT-2"] += 1
             if isinstance(sent, s.Compass):
@@ -345,6 +347,8 @@ class _Checker:
         for d, st in self.streams.items():
             for e, lineno in st.close():
                 self._discard(d, e, self.last_t, lineno)
+        if self.backseat is not None:
+            self.backseat.close(self.last_t, bool(self.stats["bytes_to_vehicle"]))
 
     # ------------------------------------------------------------------ result
     def outcome(self, path: Path, fmt: str, meta: LogMeta, sha: str) -> CheckOutcome:
@@ -358,15 +362,12 @@ class _Checker:
                                       "vehicle's answers cannot be judged.")
         if self.stats["lines_to_vehicle"] == 0 and self.stats["discarded_to_vehicle"] == 0:
             one = "vehicle" if one is None else "empty"
-            for c in BACKSEAT_CLAUSES:
-                self.book.untested(c, "One-direction log: it has no backseat→vehicle traffic.")
             for c in ("RH-ACK-1", "RH-ACK-2", "RH-ACK-3", "RH-ACK-4", "RH-ACK-5", "RH-ACK-6", "RH-OUT-4"):
                 self.book.untested(c, "One-direction log: without the commands the answers cannot be "
                                       "matched; only framing and sentence contents are judged.")
         v.finish(self.last_t)
-        if self.backseat.saw and self.stats["lines_to_vehicle"]:
-            self.book.untested("RH-BS-6", "No $OMS refresh in the log.")
-        return CheckOutcome(path=path, format=fmt, role=self.role, clauses=self.book.verdicts(), meta=meta,
+        clauses = self.book.verdicts() + (self.backseat.ledger.entries() if self.backseat is not None else [])
+        return CheckOutcome(path=path, format=fmt, role=self.role, clauses=clauses, meta=meta,
                             time_scale=self.scale, resolution=self.r, stats=dict(self.stats),
                             findings=list(self.findings), timeline=list(self.timeline),
                             events=list(self.events), sha256=sha, one_direction=one,

@@ -1,0 +1,308 @@
+"""The backseat observer: the facade every driver feeds, and the dispatch of each event to its rule.
+
+:class:`BackseatObserver` is sans-IO. A driver hands it every record of a run as a
+:class:`~helmcheck.judge.wire.WireEvent`, in order — ``certify backseat`` through its
+:class:`~helmcheck.conformance.recorder.Recorder` as the bytes cross the line, ``check-log``
+from the wire log (or a socat capture) — and calls :meth:`~BackseatObserver.close` at the end
+of the run or of the log. Every finding goes to the :class:`~helmcheck.judge.ledger.Ledger` it
+was given; the same events give the same ledger, whoever feeds them.
+
+Dispatch:
+
+* backseat bytes (``>``) — RH-BS-4 per record (:mod:`.budget`); re-framed exactly as a receiver
+  frames them (:class:`~helmcheck.grammar.Framer`), each line keeping the time and log line of
+  the record that held its first byte (:class:`~.common.SentLine`); each line to RH-BS-1/2/7
+  (:mod:`.lines`), each decoded command to RH-BS-3 (:mod:`.preconditions`), RH-BS-6
+  (:mod:`.servo`), RH-BS-8 (:mod:`.polling`), each line with a sentence ID to RH-BS-5
+  (:mod:`.reaction`); a line a vehicle answers waits for its ``$ACK`` (:class:`~.knowledge.Pending`);
+* vehicle bytes (``<``) — re-framed; each ``$OSI`` and ``$ACK`` is knowledge
+  (:mod:`.knowledge`) from the time it had fully arrived; an ``$ACK`` answers a waiting command;
+* notes (``!``, :func:`~helmcheck.judge.wire.parse_note`) — ``scenario X starts`` (findings
+  then carry ``X`` as their case), ``lockout starts (<code>)`` / ``lockout ends``, ``silence
+  starts`` / ``silence ends`` (no answer is expected meanwhile, and servo control is not
+  judged across it), ``link: <baud> baud 8N1`` (the line's baud from then on). Other notes are
+  not needed: a staged rejection is an ``$ACK`` like any other.
+
+The observer imports no ``serial``, ``time``, ``threading`` or ``asyncio``.
+"""
+
+from __future__ import annotations
+
+from collections import deque
+from typing import Optional
+
+from ...grammar import Decoded, Discard, Framer, Line, decode
+from ...grammar import sentences as s
+from ...grammar.capture import escape
+from ...profile import Profile
+from ..facts import LOCKOUT_REFUSED, NEEDS_MISSION, NEEDS_RUNNING, NEEDS_STOPPED
+from ..ledger import Evidence, Ledger
+from ..timing import ack_allowance, ack_fail_after
+from ..wire import FROM_VEHICLE, NOTE, TO_VEHICLE, WireEvent, parse_note
+from .budget import LineBudget
+from .common import BS_CLAUSES, SentLine, Settings
+from .knowledge import Arrivals, Lockout, Pending, StateReports
+from .lines import LineRules
+from .polling import Polling
+from .preconditions import Preconditions
+from .reaction import Reaction
+from .servo import ServoRefresh
+
+__all__ = ["BackseatObserver", "BS_CLAUSES"]
+
+_CACHE = 4096
+_NOT_TESTED = {
+    "RH-BS-1": "the backseat sent no line",
+    "RH-BS-2": "the backseat sent no well-framed command",
+    "RH-BS-3": ("no command with a state precondition ("
+                + ", ".join(sorted("$" + e for e in NEEDS_RUNNING | NEEDS_STOPPED))
+                + ") was sent while the vehicle's state was known"),
+    "RH-BS-4": "the backseat sent nothing",
+    "RH-BS-5": "no command was rejected and no lockout was known to the backseat",
+    "RH-BS-6": "the backseat never refreshed an accepted $OMS while it held servo control",
+    "RH-BS-7": "the backseat sent no line",
+    "RH-BS-8": "the backseat was never active",
+}
+
+
+class BackseatObserver:
+    """Judges a backseat against RH-BS-1..8 from wire events (module docstring)."""
+
+    def __init__(self, profile: Profile, ledger: Ledger, *, time_scale: float, baud: int,
+                 resolution: float = 1e-6):
+        self.profile = profile
+        self.ledger = ledger
+        self.settings = st = Settings(profile, float(time_scale), int(baud), float(resolution),
+                                      float(profile.reaction_s), float(profile.lockout_s))
+        self._framer = Framer(profile.max_line_bytes)
+        self._vframer = Framer(max(profile.max_line_bytes, 1024))
+        self._records: deque[tuple[int, float, int]] = deque()  # (stream offset, t, lineno)
+        # stream offsets count only the bytes that went through the framers
+        self._offset = 0  #: backseat framer offset of the next byte
+        self._consumed = 0  #: backseat framer offset of the first byte not yet framed
+        self._voffset = 0
+        self._cache: dict[bytes, Decoded] = {}
+        self.arrivals = Arrivals(st.baud)
+        self.reports = StateReports()
+        self.pending = Pending()
+        self.lockout = Lockout(st)
+        self.lines = LineRules(st, ledger)
+        self.budget = LineBudget(st, ledger)
+        self.preconditions = Preconditions(st, ledger, self.reports, self.pending)
+        self.reaction = Reaction(st, ledger, self.lockout)
+        self.servo = ServoRefresh(st, ledger)
+        self.polling = Polling(st, ledger)
+        #: how long an answer may be awaited (RH-ACK-2's allowance for the longest line and
+        #: the most replies before it, and the margin past which a late ACK is a fault)
+        self.max_wait = ack_fail_after(ack_allowance(profile.ack_window_s, profile.max_line_bytes, 1024,
+                                                     st.baud, st.resolution))
+        self.silent = False
+        self.started: Optional[float] = None  #: time of the backseat's first byte
+        self.ended: Optional[float] = None
+
+    # ================================================================ read-only facts
+    @property
+    def stats(self) -> dict:
+        """Counts for the report."""
+        return {"bytes": self.budget.bytes, "lines": self.lines.lines, "commands": self.lines.commands,
+                "rejections": self.reaction.rejections, "lockouts": self.lockout.count,
+                "polls": self.polling.polls, "servo_accepted": self.servo.accepted,
+                "max_window_bytes": self.budget.max_window_bytes}
+
+    def offences(self) -> dict[str, int]:
+        """Violations so far per clause (for a progress display)."""
+        return {c: self.ledger.counts(c)["fail"] for c in BS_CLAUSES if c in self.ledger}
+
+    # ================================================================ input
+    def feed(self, ev: WireEvent) -> None:
+        """One record, in order."""
+        if ev.dir == TO_VEHICLE:
+            self._backseat(ev)
+        elif ev.dir == FROM_VEHICLE:
+            self._vehicle(ev)
+        elif ev.dir == NOTE:
+            self._note(ev)
+
+    def close(self, t: float) -> None:
+        """The run (or the log) ended at ``t``. Of the bytes not yet framed, a line begun with
+        ``$`` is not judged (the recording cut it); bytes before any ``$`` are noise whatever
+        follows (RH-BS-1)."""
+        if self.ended is not None:
+            return
+        self.ended = t
+        if self._records:
+            for e in self._framer.close():
+                if e.raw[:1] != b"$":
+                    rt, lineno = self._first_byte(e.offset)
+                    self.lines.discarded(SentLine(e.raw, rt, lineno, None, e))
+        self.polling.close(t)
+        ep = self.lockout.episode
+        if ep is not None:
+            if ep.end is None or ep.end > t:
+                ep.end = t
+            self.reaction.episode_over(ep)
+        self.reaction.close()
+        self.pending.clear()
+        for cid, why in _NOT_TESTED.items():
+            self.ledger.not_tested(cid, why)
+
+    # ================================================================ the backseat
+    def _decode(self, raw: bytes) -> Decoded:
+        d = self._cache.get(raw)
+        if d is None:
+            if len(self._cache) >= _CACHE:
+                self._cache.clear()
+            d = self._cache[raw] = decode(raw, self.profile)
+        return d
+
+    def _first_byte(self, offset: int) -> tuple[float, int]:
+        t, lineno = self._records[0][1], self._records[0][2]
+        for start, rt, rl in self._records:
+            if start > offset:
+                break
+            t, lineno = rt, rl
+        return t, lineno
+
+    @staticmethod
+    def _whole_line(fr: Framer, data: bytes) -> bool:
+        """A record that is exactly one line, with nothing pending before it: the framer would
+        return it whole, so it is taken as it is (the common case, and the fast one)."""
+        return (not fr.pending and data[:1] == b"$" and data.count(b"$") == 1
+                and data.find(b"\n") == len(data) - 1 and len(data) <= fr.max_line)
+
+    def _backseat(self, ev: WireEvent) -> None:
+        data = ev.data
+        if not data:
+            return
+        line_like = data.endswith(b"\r\n") and b"\n" not in data[:-1]
+        rec = Evidence(ev.t, ">" if line_like else ">~",
+                       escape((data[:-2] if line_like else data)[:200]), ev.lineno)
+        if self.started is None:
+            self.started = ev.t
+            self.polling.start(ev.t, rec)
+        self.budget.record(ev.t, len(data), rec)
+        if self._whole_line(self._framer, data):
+            self._records.clear()
+            self._line(SentLine(data, ev.t, ev.lineno, self._decode(data)))
+            return
+        self._records.append((self._offset, ev.t, ev.lineno))
+        self._offset += len(data)
+        for e in self._framer.feed(data):
+            t, lineno = self._first_byte(e.offset)
+            if isinstance(e, Discard):
+                self.lines.discarded(SentLine(e.raw, t, lineno, None, e))
+                self._consumed = e.offset + e.length
+            else:
+                self._line(SentLine(e.raw, t, lineno, self._decode(e.raw)))
+                self._consumed = e.offset + len(e.raw)
+        # Every byte not yet framed belongs to the one open run, which begins at ``_consumed``:
+        # keep only the record holding that byte (later events begin in records still to come).
+        recs = self._records
+        while len(recs) > 1 and recs[1][0] <= self._consumed:
+            recs.popleft()
+        while len(recs) > 1:
+            recs.pop()
+
+    def _line(self, line: SentLine) -> None:
+        self.pending.expire(line.t, self.max_wait)
+        self.lines.line(line)
+        d = line.decoded
+        cmd = line.command
+        if cmd is not None:
+            line.ack_type = cmd.ACK_TYPE
+            self.preconditions.command(line)
+            self.servo.sent(line)
+            self.polling.sent(line)
+        elif d.error is not None and d.error.answered:
+            line.ack_type = d.error.ack_type
+        if line.sid:
+            self.reaction.sent(line)
+        if line.ack_type is not None and not self.silent:
+            self.pending.expect(line)
+
+    # ================================================================ the vehicle
+    def _vehicle(self, ev: WireEvent) -> None:
+        data = ev.data
+        if not data:
+            return
+        self.pending.expire(ev.t, self.max_wait)
+        self.arrivals.record(ev.t, len(data))
+        if self._whole_line(self._vframer, data):
+            self._report(data, ev.t, self.arrivals.arrival(len(data)))
+            return
+        base = self._voffset
+        self._voffset += len(data)
+        for e in self._vframer.feed(data):
+            if isinstance(e, Line):
+                self._report(e.raw, ev.t, self.arrivals.arrival(e.offset + len(e.raw) - base))
+
+    def _report(self, raw: bytes, t: float, arrived: float) -> None:
+        r = self._decode(raw).sentence
+        if isinstance(r, s.OSI):
+            self._osi(r, t, arrived)
+        elif isinstance(r, s.ACK):
+            self._ack(r, t, arrived)
+
+    def _osi(self, r: s.OSI, t: float, arrived: float) -> None:
+        """``$OSI``: field 2 is a state report (RH-BS-3), field 8 a lockout sign (RH-BS-5)."""
+        if r.mode in NEEDS_MISSION:
+            self.reports.report(t, arrived, True)
+        elif r.mode == "S":
+            self.reports.report(t, arrived, False)
+            self.servo.end(arrived)
+        if r.error_state == "N":
+            self.reaction.episode_over(self.lockout.clear(t, reset_code=True))
+        else:
+            self._sign(arrived, r.error_state, True)
+
+    def _sign(self, arrived: float, code: str, field8: bool) -> None:
+        before = self.lockout.episode
+        known = before.known if before is not None else None
+        self.reaction.episode_over(self.lockout.sign(arrived, code, field8))
+        ep = self.lockout.episode
+        if ep is not None and ep.known is not None and (ep is not before or known is None):
+            self.servo.end(arrived)  # remote control ends for good at a violation (RH-RD-11)
+
+    def _ack(self, a: s.ACK, t: float, arrived: float) -> None:
+        """``$ACK``: an accepted start/stop is a state report; err 26 a lockout sign; it answers
+        the oldest waiting command of its type (RH-ACK-6)."""
+        if a.status == 0 and a.type == 3:
+            self.reports.report(t, arrived, True)
+        elif a.status == 0 and a.type == 1:
+            self.reports.report(t, arrived, False)
+        if a.status != 0 and a.err == 26:
+            self._sign(arrived, "", False)
+        line = self.pending.answer(a.type)
+        if line is None:
+            return
+        accepted = a.status == 0
+        self.reaction.answered(line, a.status, arrived)
+        self.preconditions.answered(line, accepted)
+        event = line.event
+        if event == "OMS":
+            self.servo.answered(line, accepted, t)
+        if accepted and event in LOCKOUT_REFUSED:
+            ended = self.lockout.clear(t, reset_code=event in ("OMSTART", "OMSTOP"))
+            self.reaction.episode_over(ended)
+
+    # ================================================================ notes
+    def _note(self, ev: WireEvent) -> None:
+        n = parse_note(ev.note)
+        if n is None:
+            return
+        st = self.settings
+        if n.kind == "scenario":
+            st.case = n.text
+        elif n.kind == "lockout":
+            self.reaction.episode_over(self.lockout.note_start(ev.t, n.code))
+        elif n.kind == "lockout-end":
+            self.reaction.episode_over(self.lockout.note_end(ev.t))
+        elif n.kind == "silence":
+            self.silent = True
+            self.pending.clear()
+            self.servo.end(ev.t)
+        elif n.kind == "silence-end":
+            self.silent = False
+        elif n.kind == "link" and n.value:
+            st.baud = int(n.value)
+            self.arrivals.baud = st.baud
