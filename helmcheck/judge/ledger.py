@@ -108,8 +108,8 @@ class Ledger:
         if not lv.reason and reason:
             lv.reason = reason
         ev = list(evidence)
-        if ev and len(lv.lines) < MAX_LINES and ev[0].lineno:
-            lv.lines.append(ev[0].lineno)
+        if ev and len(lv.lines) < MAX_LINES and ev[-1].lineno:
+            lv.lines.append(ev[-1].lineno)  # evidence runs in time order: the last line is the offending one
         if not lv.evidence and ev:
             lv.evidence = ev[:MAX_EVIDENCE]
         if case:

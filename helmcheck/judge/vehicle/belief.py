@@ -159,13 +159,37 @@ class Beliefs:
                 self._keep([cand])
                 result = CommandResult(replies, True, nominal[2], nominal[3], cand.story, mission_dep, desync)
             else:
-                self._keep([nominal[0]])
                 result = CommandResult(nominal[1], False, nominal[2], nominal[3], (), False, desync)
-                if not self.desync:
-                    self.desync = (f"the vehicle answered {_brief(observed)} where a conforming vehicle "
-                                   f"answers {_brief(nominal[1])}")
+                want = nominal[1][-1] if nominal[1] and isinstance(nominal[1][-1], s.ACK) else None
+                got = observed[-1] if observed and isinstance(observed[-1], s.ACK) else None
+                if got is not None and got.status == 1:
+                    pass  # refused (rightly or not): a refused command changes nothing (RH-ACK-3)
+                elif want is not None and want.status == 0:
+                    self._keep([nominal[0]])  # accepted as it should be; only its data differ
+                else:  # accepted where a conforming vehicle refuses: its state is now unknown
+                    self._keep([nominal[0]])
+                    if not self.desync:
+                        self.desync = (f"the vehicle answered {_brief(observed)} where a conforming "
+                                       f"vehicle answers {_brief(nominal[1])}")
         self._after_command(item, observed, v, slack_v, result)
         return result
+
+    def unanswered(self, item, v: float) -> list:
+        """A command the vehicle has processed — a later one is being answered (RH-ACK-6) — but not
+        answered (yet): it may have acted on it, or dropped it. Both stay candidates (acted on
+        first: a vehicle acts on every command it reads); returns the replies a conforming
+        vehicle owes it."""
+        out, replies = [], []
+        for c in self.cands:
+            t = c.clone()
+            t.model.advance(v)
+            got = t.model.receive(item, v)
+            t.drain()
+            if not replies:
+                replies = got
+            out += [t, c]
+        self._keep(out)
+        return replies
 
     def _after_command(self, item, observed: list, v: float, slack_v: float, result: CommandResult) -> None:
         """Bookkeeping after an answered command: the trace, the lockout's evidence (RH-SAF-1:

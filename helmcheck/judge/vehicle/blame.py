@@ -14,7 +14,8 @@ Every finding names an ordered tuple of *candidate* clauses, the most specific f
 
 :func:`targets` books a finding: inside a clause case (its ``case …`` note) on the candidates the
 case is about, if any (a failure inside a case belongs to its subject, not to a neighbour it
-touched); otherwise on the first candidate.
+touched); otherwise on the first candidate (and, when that is the generic RH-OUT-4, on the first
+specific cause as well).
 
 :data:`OWN_EVIDENCE` lists the clauses a row's confirmation does not pass by itself, because
 their text asks for more than the mode the row leads to; each passes only on its own
@@ -88,10 +89,17 @@ def command_clauses(item, expected_ack: Optional[s.ACK], row) -> tuple[str, ...]
     return out or ("RH-ACK-1",)
 
 
+#: Clauses that say only "the report must be consistent": outside a case, a finding on one of
+#: them is booked on its first specific cause too (what the vehicle did wrong to get there).
+GENERIC = frozenset({"RH-OUT-4"})
+
+
 def targets(candidates: tuple[str, ...], case_clauses: tuple[str, ...]) -> tuple[str, ...]:
     """Where a finding is booked (module docstring)."""
     if case_clauses:
         inside = tuple(c for c in candidates if c in case_clauses)
         if inside:
             return inside
+    if candidates and candidates[0] in GENERIC and len(candidates) > 1:
+        return candidates[:2]
     return candidates[:1]

@@ -84,6 +84,7 @@ class Sent:
     negative: bool = False  #: a conforming vehicle refuses it: the tester's own negative test
     overtaken: bool = False  #: the ACK of a later command came first
     waited: float = 0.0  #: how long the observer waited before calling its ACK missing
+    branched: bool = False  #: a later command was answered first: taken into the mirror unanswered
 
     @property
     def done(self) -> bool:
@@ -130,6 +131,7 @@ class VehicleObserver:
         self.timeline: list[tuple[float, str]] = []
         self.events: list[dict] = []
         self.checks = osichecks.OsiChecks(self)
+        self._decoded: dict = {}
         self.closed = False
         self.aborted = ""
         #: (mode before, command ID) of every accepted control command in a remote mode (coverage)
@@ -186,14 +188,31 @@ class VehicleObserver:
     def feed(self, ev: WireEvent) -> None:
         self._advance(ev.t)
         if ev.dir == TO_VEHICLE:
-            for fe in self.framers[TO_VEHICLE].feed(ev.data):
+            for fe in self._frame(TO_VEHICLE, ev.data):
                 self._backseat(fe, ev)
         elif ev.dir == FROM_VEHICLE:
             self.vbytes += len(ev.data)
-            for fe in self.framers[FROM_VEHICLE].feed(ev.data):
+            for fe in self._frame(FROM_VEHICLE, ev.data):
                 self._vehicle(fe, ev)
         elif ev.dir == NOTE:
             self._note(ev)
+
+    def _frame(self, d: str, data: bytes):
+        """The framer's events for ``data``; a record that is one whole line skips the framer."""
+        fr = self.framers[d]
+        if (not fr.pending and data[:1] == b"$" and data.count(b"$") == 1 and data.find(b"\n") == len(data) - 1
+                and len(data) <= fr.max_line):
+            return (Line(data, 0),)
+        return fr.feed(data)
+
+    def decode(self, raw: bytes):
+        """:func:`~helmcheck.grammar.decode` with a bounded cache (sessions repeat their lines)."""
+        hit = self._decoded.get(raw)
+        if hit is None:
+            if len(self._decoded) >= 4096:
+                self._decoded.clear()
+            hit = self._decoded[raw] = decode(raw, self.profile)
+        return hit
 
     def _evidence(self, ev: WireEvent, raw: bytes, direction: str) -> Evidence:
         if raw.endswith(b"\r\n") and b"\n" not in raw[:-1]:
@@ -216,6 +235,7 @@ class VehicleObserver:
                     self.ledger.inconclusive(cid, n.text, [Evidence(ev.t, "!", ev.note, ev.lineno)], self.case)
         elif n.kind == "link":
             self.link_baud = n.value
+            self.baud = n.value  # the line's rate as the tester opened it: what transmit times use
         elif n.kind == "aborted":
             self.aborted = n.text
         elif n.kind in ("plant", "fault"):
@@ -243,7 +263,7 @@ class VehicleObserver:
             self.after_discard = True
         else:
             raw = fe.raw
-            k = classify(decode(raw, self.profile), raw, self.profile)
+            k = classify(self.decode(raw), raw, self.profile)
             if self.after_discard and k.kind in ("command", "error") and not k.variant:
                 k = Kind(k.kind, k.item, k.ack_type, variant="RH-FRM-7")
             self.after_discard = False
@@ -270,7 +290,7 @@ class VehicleObserver:
         if isinstance(fe, Discard):
             self.out.discard(fe.raw, fe.length, fe.clause, self._evidence(ev, fe.raw, "<"), self.case)
             return
-        d = decode(fe.raw, self.profile)
+        d = self.decode(fe.raw)
         evd = self._evidence(ev, fe.raw, "<")
         sent = self.out.line(d, evd, self.case)
         if sent is not None:
@@ -287,9 +307,21 @@ class VehicleObserver:
                                                                       "OYSI", "OCTD", "OINS"):
             self._data(None, _class_of_id(d.sentence_id), ev.t, evd)
 
+    def _processed(self, upto: "Sent", t: float) -> None:
+        """Commands sent before ``upto`` that the vehicle is answering: it has processed them
+        (RH-ACK-6), answered or not; the unanswered ones go into the mirror unanswered."""
+        for q in self.pending:
+            if q is upto:
+                break
+            if not q.branched:
+                q.branched = True
+                q.expected = self.beliefs.unanswered(q.kind.item, self.v(t))
+
     def _data(self, sentence, cls: str, t: float, evd: Evidence) -> None:
         """A data sentence: it belongs to the oldest ``$OSD`` still waiting (RH-ACK-5)."""
         p = next((q for q in self.pending if q.kind.ack_type == 8), None)
+        if p is not None:
+            self._processed(p, t)
         if p is None:
             last = self.last_osd
             if self.first_command_t is None:
@@ -311,9 +343,15 @@ class VehicleObserver:
         if a.type in _UNSOLICITED:
             self.ledger.passed("RH-ACK-1", "an unsolicited $ACK of its own type", [evd], self.case)
             return
-        idx = next((i for i, p in enumerate(self.pending) if p.kind.ack_type == a.type), None)
+        # the oldest waiting command of its type keeps the order; one the ACK of a later command
+        # already overtook is matched only when no other waits (then it is out of order, RH-ACK-6)
+        idx = next((i for i, p in enumerate(self.pending) if p.kind.ack_type == a.type and not p.overtaken),
+                   None)
+        if idx is None:
+            idx = next((i for i, p in enumerate(self.pending) if p.kind.ack_type == a.type), None)
         if idx is not None:
             p = self.pending[idx]
+            self._processed(p, t)
             del self.pending[idx]
             for i in range(idx):  # still waiting: an ACK that comes is out of order, none is missing
                 self.pending[i].overtaken = True
@@ -374,6 +412,9 @@ class VehicleObserver:
         if not late:
             self.ledger.passed("RH-ACK-1", "one $ACK of its own type", ev, self.case)
         observed = [cls for _, cls, _ in p.data] + [a]
+        if p.branched:  # already in the mirror, unanswered: judge the late answer's content only
+            self._late_answer(p, a, observed, ev)
+            return
         v_ack = self.v(t)
         res = self.beliefs.command(p.kind.item, v_ack, self.k * (dt + JITTER_S + self.res), observed)
         p.expected = res.expected
@@ -392,6 +433,11 @@ class VehicleObserver:
         if res.matched:
             self._matched(p, a, res, cands, ev)
         else:
+            if want is not None and want.status == 1 and a.status == 1 and want.err != 26:
+                # refused, as it should be, with the wrong error number: RH-ACK-4 for a refused
+                # precondition, else RH-ACK-3 (each command's own "incorrect values" error)
+                first = "RH-ACK-4" if "RH-ACK-4" in cands else "RH-ACK-3"
+                cands = (first,) + tuple(c for c in cands if c != first)
             what = (f"{_text(p)}: a conforming vehicle in mode {res.before[0]} answers "
                     f"{_brief(res.expected)}; got {_brief(observed)}")
             if res.desync:
@@ -405,6 +451,15 @@ class VehicleObserver:
             self.last_osd = p
             self._osd_data(p, a, ev)
         self.checks.answered(p, a, res, ev)
+
+    def _late_answer(self, p: Sent, a: s.ACK, observed: list, ev: list) -> None:
+        want = next((r for r in p.expected if isinstance(r, s.ACK)), None)
+        if want is None or (want.status, want.err) == (a.status, a.err):
+            return
+        row = self.beliefs.primary.model.row_for(p.kind.item) if not hasattr(p.kind.item, "ack_err") else None
+        self.book("inconclusive", command_clauses(p.kind.item, want, row),
+                  f"{_text(p)} answered late, out of order, {_brief([a])}; a conforming vehicle answers "
+                  f"{_brief([want])} — not judged: the state it met is not known", ev, at=p)
 
     def _matched(self, p: Sent, a: s.ACK, res, cands: tuple[str, ...], ev: list) -> None:
         if res.mission_dependent:
