@@ -15,7 +15,9 @@ slave side once the backseat is there, so the backseat closing the port (or dyin
 a hang-up; on a TCP serial server it is the client's disconnect; on a device, a device that
 disappears. Any of these before the run's end is "disconnected" (the report says when). The
 loop waits in ``select`` at most 50 ms at a time; SIGINT/SIGTERM (or :meth:`Runner.stop`)
-end it early as "interrupted".
+end it early as "interrupted". When helmcheck started the backseat (``child``, a
+:class:`~helmcheck.conformance.launcher.Launcher`), the loop also ends, as "exited", as soon as
+that process has ended (checked every tick).
 """
 
 from __future__ import annotations
@@ -46,7 +48,7 @@ _TICK = 0.05
 class Outcome:
     """How a run ended and what it saw; times are seconds since the certifier started."""
 
-    status: str  #: complete | never-connected | disconnected | interrupted
+    status: str  #: complete | never-connected | disconnected | interrupted | exited
     reason: str
     judge: BackseatJudge
     connected_at: Optional[float] = None
@@ -64,7 +66,7 @@ class Runner:
     def __init__(self, link: Link, profile: Profile, plan: Plan, *, time_scale: float,
                  missions: Optional[MissionCatalog] = None, log: Optional[WireLogWriter] = None,
                  connect_timeout: float = 30.0, clock: Callable[[], float] = time.monotonic,
-                 progress: Any = None, reaction_s: float = 1.0, jitter_s: float = 0.2):
+                 progress: Any = None, reaction_s: float = 1.0, jitter_s: float = 0.2, child: Any = None):
         self.link = link
         self.profile = profile
         self.plan = plan
@@ -73,6 +75,7 @@ class Runner:
         self.connect_timeout = connect_timeout
         self.clock = clock
         self.progress = progress
+        self.child = child  #: the backseat process under test, when helmcheck started it
         self.launch = clock()
         self.core = EmulatorCore(profile.replace(fault_injection="none"), missions, start=self.launch,
                                  time_scale=time_scale, baud=profile.baud, log=log)
@@ -109,6 +112,11 @@ class Runner:
                 now = self.clock()
                 if self._stop is not None:
                     status, reason = "interrupted", f"the run was {self._stop} after {self._elapsed(now):.1f} s"
+                    break
+                if self.child is not None and self.child.ended:
+                    status = "exited"
+                    reason = (f"the backseat under test {self.child.exit_text()} after {self._elapsed(now):.1f} s "
+                              f"of the {self.plan.total:.1f} s run")
                     break
                 if self.connected_at is None and self.rel(now) > self.connect_timeout:
                     status = "never-connected"

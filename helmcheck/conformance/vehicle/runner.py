@@ -9,6 +9,13 @@ the end, every report format (:func:`helmcheck.reports.render.render_all`).
 
 A vanished device stops the run: the clauses not yet judged are INCONCLUSIVE with that reason,
 and the report is still written.
+
+With ``Options.exec_cmd`` (``--exec``) helmcheck starts the vehicle under test itself on the
+port (:mod:`helmcheck.conformance.exec_port`, :mod:`helmcheck.conformance.launcher`), checks it
+is still running before every case, and stops it at the end. If it ends before the run's end,
+that is a finding about the vehicle, not a link fault: the clauses judged before keep their
+verdicts, those whose cases had not run (or had not finished) are NOT-TESTED with the exit as
+the reason, ``results.json`` gets a ``process`` object, and the run verdict is FAIL.
 """
 
 from __future__ import annotations
@@ -54,6 +61,9 @@ class Options:
     command: str = ""
     render: bool = True
     explore_budget_s: Optional[float] = None  #: wall seconds for exploration (default: the hypothesis profile's)
+    exec_cmd: Optional[str] = None  #: start the vehicle under test on ``port`` (module docstring)
+    exec_grace_s: float = 5.0  #: SIGTERM → SIGKILL when stopping it
+    exec_ready_s: float = 30.0  #: how long it may take to open (or listen on) the port
 
 
 @dataclass
@@ -157,6 +167,7 @@ class Run:
         self.session: Optional[Session] = None
         self.log_file = None
         self.stats: dict = {}
+        self.child = None  #: the vehicle under test, when helmcheck started it (a Launcher)
 
     # ------------------------------------------------------------------ results
     def save(self, final: bool = False) -> None:
@@ -167,7 +178,7 @@ class Run:
         for cid in self.ids:
             verdict, reason, cases, ev, n = self.book.verdict(cid, self._default_reason(cid))
             if self.aborted and verdict == "not-tested" and cid not in self._not_applicable:
-                verdict, reason = "inconclusive", f"not judged: {self.aborted}"
+                verdict, reason = self._unjudged()
             R.add_clause(r, cid, verdict, reason, cases=cases, evidence=ev[-16:], offending_count=n)
             r_ids.add(cid)
         for c in vehicle_clauses():
@@ -199,13 +210,13 @@ class Run:
     def open(self) -> None:
         wire_path = self.dir / R.WIRE_LOG_NAME
         self.log_file = open(wire_path, "w", encoding="utf-8")
-        meta = (f"started {time.strftime('%Y-%m-%dT%H:%M:%SZ', time.gmtime())}  port {self.o.port}  "
-                f"baud {self.p.baud}  time_scale {self.k:g}")
         try:
-            raw = open_link(self.o.port, role="client", baud=self.p.baud)
+            raw = self._start_child() if self.o.exec_cmd else open_link(self.o.port, role="client", baud=self.p.baud)
         except (OSError, ValueError) as e:
             self.log_file.write("# helmcheck wire-log 1\n")
             raise LinkLost(f"cannot open {self.o.port}: {getattr(e, 'strerror', None) or e}") from None
+        meta = (f"started {time.strftime('%Y-%m-%dT%H:%M:%SZ', time.gmtime())}  port {raw.name or self.o.port}  "
+                f"baud {self.p.baud}  time_scale {self.k:g}")
         self.link = TesterLink(raw, self.p, log=self.log_file, meta=meta)
         try:
             ser = getattr(raw, "ser", None)
@@ -244,6 +255,7 @@ class Run:
         ses = self.session
         assert ses is not None
         for case in cases:
+            self.check_child()
             ses.case, ses.case_t0 = case.id, ses.now()
             ses.link.note(f"case {case.id} {' '.join(case.clauses)}: {case.title}")
             entry = {"id": case.id, "clauses": list(case.clauses), "title": case.title,
@@ -280,6 +292,15 @@ class Run:
                 for cid in case.clauses:
                     self.book.add(cid, "not-tested", f"{case.id}: {e.reason}", case.id)
             except LinkLost as e:
+                gone = self.child_gone(settle_s=1.0)
+                if gone:  # the vehicle under test died: not a link fault
+                    self.aborted = gone
+                    entry.update(verdict="not-tested", reason=gone)
+                    self.results["cases"].append(entry)
+                    for cid in case.clauses:
+                        self.book.add(cid, "not-tested", f"{case.id}: {gone}, before this case finished", case.id)
+                    self.progress.step(case.id, "not finished (the vehicle under test ended)")
+                    raise
                 self.aborted = f"link fault during {case.id}: {e}"
                 entry.update(verdict="inconclusive", reason=str(e))
                 self.results["cases"].append(entry)
@@ -291,6 +312,57 @@ class Run:
             self.results["cases"].append(entry)
             self.progress.step(f"{case.id} {case.subject}", verdict)
             self.save()
+
+    # ------------------------------------------------------------------ the vehicle under test (--exec)
+    def _start_child(self):
+        """Start the vehicle under test on the port; the link once it has opened it."""
+        from ..exec_port import ChildNotReady, open_for_child
+        from ..launcher import Launcher
+
+        self.child = Launcher(self.o.exec_cmd, subject="vehicle", directory=self.dir, grace_s=self.o.exec_grace_s)
+        try:
+            return open_for_child(self.o.port, self.child, baud=self.p.baud, time_scale=self.k,
+                                  ready_s=self.o.exec_ready_s)
+        except ChildNotReady as e:
+            self.log_file.write("# helmcheck wire-log 1\n")
+            raise LinkLost(str(e)) from None
+
+    def child_gone(self, settle_s: float = 0.0) -> Optional[str]:
+        """Why the run cannot go on when the vehicle under test has ended by itself, else None.
+
+        *settle_s*: after a link fault, how long to give its exit to become visible (the port
+        closes before the process is reaped)."""
+        c = self.child
+        if c is None or c.proc is None:
+            return None
+        if settle_s and c.stopping_at is None and not c.ended:
+            c.wait(settle_s)
+        if not c.ended_by_itself:
+            return None
+        return f"the vehicle under test {c.exit_text()} at {c.ended_at - self.t_start:.1f} s"
+
+    def check_child(self) -> None:
+        """Between cases: :class:`LinkLost` if the vehicle under test has ended."""
+        gone = self.child_gone()
+        if gone:
+            raise LinkLost(gone)
+
+    def _unjudged(self) -> tuple[str, str]:
+        """The verdict of a clause the run never reached."""
+        gone = self.child_gone()
+        if gone:
+            return "not-tested", f"{gone}, before this clause's case ran"
+        return "inconclusive", f"not judged: {self.aborted}"
+
+    def stop_child(self) -> None:
+        """End of the run: stop the vehicle under test and record it (``results.json`` ``process``)."""
+        c = self.child
+        if c is None or c.proc is None:
+            return
+        if self.aborted and not c.ended:
+            c.wait(1.0)  # a link fault may be its exit, not yet reaped
+        c.stop()
+        self.results["process"] = c.record(epoch=self.t_start)
 
     def finish_clauses(self) -> None:
         """Clauses judged by all observations rather than by one case."""
@@ -338,6 +410,7 @@ def certify(opts: Options) -> Outcome:
             run.finish_clauses()
         except Exception:  # noqa: BLE001
             pass
+        run.stop_child()
         if run.link is not None:
             run.link.close()
         elif run.log_file is not None:
