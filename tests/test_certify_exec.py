@@ -190,3 +190,39 @@ def test_bad_exec_arguments_are_usage_errors(argv, message, tmp_path):
     assert proc.returncode == 64, proc.stderr
     assert message in proc.stderr and "Traceback" not in proc.stderr
     assert len(proc.stderr.strip().splitlines()) == 1
+
+
+@pytest.mark.parametrize("role", ["vehicle", "backseat"])
+def test_sigterm_to_helmcheck_stops_the_started_implementation_too(role, tmp_path):
+    """A cancelled CI job: helmcheck gets SIGTERM mid-run, writes a partial report, exits 2, and
+    the implementation it started is gone with it."""
+    import signal
+    import time
+
+    report = tmp_path / "r"
+    if role == "vehicle":
+        argv = ["certify", "vehicle", *VH, "--exec", EMULATE]
+        ready = report / "vehicle.stdout.log"
+    else:
+        argv = ["certify", "backseat", *BS, "--duration", "60", "--exec", BACKSEAT]
+        ready = report / "backseat.stdout.log"
+    proc = subprocess.Popen([sys.executable, "-m", "helmcheck", *argv, "--report-dir", str(report)],
+                            stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        deadline = time.monotonic() + 60
+        while time.monotonic() < deadline and not (ready.exists() and ready.read_text().strip()):
+            time.sleep(0.1)
+        time.sleep(1.0)
+        assert survivors(), "the implementation should be running"
+        proc.send_signal(signal.SIGTERM)
+        out, err = proc.communicate(timeout=60)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+    assert proc.returncode == 2, err
+    r = load_results(report)
+    assert r["partial"] and r["verdict"] == "inconclusive"
+    assert r["process"]["ended_early"] is False
+    assert not survivors()
+    assert "Traceback" not in err

@@ -83,6 +83,18 @@ def _usage(msg: str) -> int:
     return exitcodes.usage_error("helmcheck certify vehicle", msg)
 
 
+def _sigterm_interrupts() -> None:
+    """SIGTERM ends the run like Ctrl-C: a partial report, and the started vehicle stopped."""
+    import signal
+    import threading
+
+    def interrupt(*_):
+        raise KeyboardInterrupt
+
+    if threading.current_thread() is threading.main_thread():
+        signal.signal(signal.SIGTERM, interrupt)
+
+
 def run(args: argparse.Namespace) -> int:
     from ...profile import ProfileError, load_profile
     from ..transport import BAUD_RATES, parse_port_spec
@@ -138,6 +150,8 @@ def run(args: argparse.Namespace) -> int:
                    wire_log=Path(args.wire_log) if args.wire_log else None, hypothesis_profile=hp,
                    explore=args.examples != 0, progress=not args.no_progress, command=command.strip(),
                    exec_cmd=args.exec_cmd, exec_grace_s=args.exec_grace, exec_ready_s=args.exec_ready)
+    if args.exec_cmd is not None:
+        _sigterm_interrupts()  # a cancelled CI job must not leave the vehicle under test running
     out = certify(opts)
     print(f"{out.verdict.upper()}{' (partial)' if out.results.get('partial') else ''}: {out.reason} "
           f"— report: {out.report_dir / 'report.html'}")
