@@ -82,6 +82,9 @@ def pytest_configure(config: pytest.Config) -> None:
         return
     if len(given) > 1:
         raise pytest.UsageError("helmcheck: give one of --helm-vehicle, --helm-vehicle-exec, --helm-backseat-exec")
+    if config.getoption("numprocesses", default=None):
+        raise pytest.UsageError("helmcheck: the certification runs once per session; run it without "
+                                "pytest-xdist's -n (each worker would certify on its own)")
     plan = _Certification(config, given[0])
     config.addinivalue_line("markers", "helmcheck: a clause of a helmcheck certification")
     config.pluginmanager.register(plan, "helmcheck-certification")
