@@ -114,3 +114,21 @@ def test_reports_show_the_process_and_escape_its_output(tmp_path):
     md = (tmp_path / "report.md").read_text()
     assert "Process under test:" in md and "<script>" not in md.replace("`bs <script>alert(1)</script>`", "")
     assert "exited with code 3" in md
+
+
+def test_junit_has_a_process_testcase_that_fails_when_it_ended_early(tmp_path):
+    import xml.etree.ElementTree as ET
+
+    for early in (True, False):
+        d = tmp_path / str(early)
+        write_results_atomic(d, _run(_process(ended_early=early)))
+        render_all(d, formats=("junit",))
+        suite = ET.parse(d / "junit.xml").getroot().find("testsuite")
+        case = [c for c in suite.iter("testcase") if c.get("classname") == "process"]
+        assert len(case) == 1 and case[0].get("name") == "backseat under test"
+        failure = case[0].find("failure")
+        assert (failure is not None) is early
+        assert suite.get("tests") == "4" and suite.get("failures") == ("1" if early else "0")
+        if early:
+            assert failure.get("type") == "process-ended" and "exited with code 3" in failure.get("message")
+            assert failure.text.endswith("Traceback: boom")
