@@ -124,7 +124,6 @@ class _Certification:
         base = Path(config.invocation_params.dir)
         self.report_dir = base / (opt("helm_report_dir") or f"helmcheck-reports/{self.role}")
         self.clause_ids = [c.id for c in (backseat_clauses() if self.role == "backseat" else vehicle_clauses())]
-        self.levels = {c.id: c.level for c in (backseat_clauses() + vehicle_clauses())}
         self.selected: Optional[list[str]] = None
         self.results: Optional[dict] = None
         self.error: Optional[str] = None
