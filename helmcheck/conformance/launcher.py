@@ -19,9 +19,10 @@ Decisions:
   signals the whole group, so grandchildren do not survive: SIGTERM, then SIGKILL to whatever
   is left of the group after the grace period (default 5 s).
 * Standard output and error go, through two reader threads, to ``<subject>.stdout.log`` and
-  ``<subject>.stderr.log`` in the report directory; the last :data:`TAIL_LINES` lines of both,
-  interleaved in arrival order, are kept for the report (each cut to :data:`TAIL_WIDTH`
-  characters, decoded as UTF-8 with replacement).
+  ``<subject>.stderr.log`` in the report directory; the last :data:`TAIL_LINES` lines of both
+  are kept for the report in the order they were read (within a stream exact; between the two
+  streams only as close as two readers can tell), each cut to :data:`TAIL_WIDTH` characters and
+  decoded as UTF-8 with replacement.
 * Times are ``time.monotonic()`` seconds; :meth:`Launcher.record` turns the end time into
   seconds since the run's epoch (the certifier's start), the time axis of its report.
 """
