@@ -20,6 +20,7 @@ SUBCOMMANDS = {
     "replay": ("helmcheck.commands.replay_cmd", "re-drive a saved failing sequence against a vehicle"),
     "check-log": ("helmcheck.commands.checklog_cmd", "check a recorded serial log against the model"),
     "report": ("helmcheck.commands.report_cmd", "render a results directory as HTML, JUnit, Markdown"),
+    "matrix": ("helmcheck.commands.matrix_cmd", "one overview of several runs: clauses x implementations"),
     "docs": ("helmcheck.commands.docs_cmd", "regenerate the generated documentation"),
 }
 
@@ -31,6 +32,7 @@ Typical use:
   helmcheck certify vehicle --port /dev/pts/5      # certify whatever answers on that port
   helmcheck certify backseat --port pty            # play the vehicle, judge a backseat
   helmcheck report reports/demo                    # render results.json to HTML/JUnit/Markdown
+  helmcheck matrix out/a out/b --out out/          # several runs side by side, clause by clause
   helmcheck parse wire.log                         # validate a capture line by line
 
 Exit codes: 0 conformant, 1 non-conformant, 2 inconclusive or tester error, 64 usage error.

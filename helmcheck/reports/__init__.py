@@ -14,6 +14,7 @@ Modules, one concern each:
 * :mod:`~helmcheck.reports.html`, :mod:`~helmcheck.reports.junit`,
   :mod:`~helmcheck.reports.markdown`, :mod:`~helmcheck.reports.compare` — the renderings.
 * :mod:`~helmcheck.reports.render` — :func:`render_all` and the ``helmcheck report`` command.
+* :mod:`~helmcheck.reports.matrix` — several runs side by side (``helmcheck matrix``).
 """
 
 from .digest import Digest, digest_bytes, digest_dir
@@ -25,6 +26,7 @@ from .results import (
     add_clause,
     add_event,
     add_mode,
+    add_process,
     add_replay,
     exit_code,
     finish,
@@ -46,6 +48,7 @@ __all__ = [
     "add_clause",
     "add_event",
     "add_mode",
+    "add_process",
     "add_replay",
     "digest_bytes",
     "digest_dir",

@@ -2,7 +2,8 @@
 
 Contents, top to bottom: a PARTIAL warning when the run was interrupted; the verdict banner;
 the certificate digest; clause counts; the run (command, times, settings); the implementation
-identity as declared and as seen on the wire (first ``$OSI``, RH-OUT-1 field 18); the profile
+identity as declared and as seen on the wire (first ``$OSI``, RH-OUT-1 field 18); the process
+under test when helmcheck started it (``--exec``: how it ended, its last output); the profile
 table; the clause matrix grouped by section of the reference profile (requirement text from
 ``helmcheck.clauses``); one finding per non-pass clause with its replay steps and wire excerpt;
 model coverage; the mode timeline (:mod:`helmcheck.reports.timeline`); an optional comparison;
@@ -23,6 +24,7 @@ from typing import Any, Iterable, Mapping
 from .rundir import Run
 from .text import printable
 from .timeline import MODE_ORDER, timeline_svg
+from .verdicts import describe_process
 from .view import VERDICT_LABEL, clause_rows, counts, non_pass_rows, replay_for, sections
 
 __all__ = ["render_html", "md_inline", "EVIDENCE_LIMIT"]
@@ -219,6 +221,30 @@ def _identity(run: Run) -> str:
     return "\n".join(out)
 
 
+def _process(run: Run) -> str:
+    """The implementation under test that helmcheck started (``--exec``): how it ended, its output."""
+    proc = run.results.get("process")
+    if not isinstance(proc, Mapping):
+        return ""
+    subject = run.results["role"]
+    cls = "v-fail" if proc.get("ended_early") else "v-pass"
+    out = [f'<div class="finding {cls}" id="process-end"><p>{_e(describe_process(proc, subject))}</p>']
+    rows = [("command", proc.get("command")), ("pid", proc.get("pid")), ("exit code", proc.get("exit_code")),
+            ("signal", proc.get("signal")),
+            ("ended at", None if proc.get("ended_at_s") is None else f'{proc["ended_at_s"]:.3f} s'),
+            ("ended before the run's end", "yes" if proc.get("ended_early") else "no")]
+    out.append(_kv_table(rows))
+    tail = [str(line) for line in proc.get("output_tail") or ()]
+    if tail:
+        out.append(f"<h3>Last output ({len(tail)} line(s))</h3><pre>{_e(chr(10).join(tail))}</pre>")
+    logs = [name for name in (f"{subject}.stdout.log", f"{subject}.stderr.log")
+            if (run.directory / name).is_file()]
+    if logs:
+        out.append("<p>Full output: " + ", ".join(f'<a href="{_e(n)}">{_e(n)}</a>' for n in logs) + "</p>")
+    out.append("</div>")
+    return "\n".join(out)
+
+
 def _matrix(run: Run) -> str:
     out = []
     for section, title, rows in sections(run.results):
@@ -368,6 +394,7 @@ def render_html(run: Run, comparison_html: str | None = None) -> str:
         _section("summary", "Summary", _counts(run)),
         _section("run", "Run", _run_facts(run)),
         _section("implementation", "Implementation", _identity(run)),
+        *([_section("process", "Process under test", _process(run))] if run.results.get("process") else []),
         _section("profile", "Profile", _kv_table(_flatten(r["profile"]))),
         _section("matrix", f"Clauses ({n})", _matrix(run)),
         _section("findings", "Findings", _findings(run)),

@@ -9,6 +9,11 @@ Mapping (classname = section of the reference profile, name = clause ID + short 
 * ``non-strict`` → passes with a ``<system-out>`` note, or ``<failure type="non-strict">`` when
   the run is strict (a SHOULD then counts as a MUST).
 
+When helmcheck started the implementation (``process`` in the results, ``--exec``), one more
+testcase (classname ``process``) says how it ended: a ``<failure type="process-ended">`` quoting
+its last output when it ended before the run's end — a dashboard must not show a run whose
+implementation died as a row of skipped clauses — else a plain testcase.
+
 The suite's ``<properties>`` carry the certificate digest, so a CI artefact can be matched to its
 results directory. Built with the standard library; text is stripped of characters XML forbids.
 """
@@ -20,6 +25,7 @@ from typing import Any, Mapping
 
 from .rundir import Run
 from .text import printable, section_name, short_title
+from .verdicts import describe_process
 from .view import VERDICT_LABEL, clause_rows
 
 __all__ = ["render_junit"]
@@ -91,6 +97,14 @@ def render_junit(run: Run, strict: bool | None = None) -> str:
         elif v == "non-strict":
             out = ET.SubElement(case, "system-out")
             out.text = _t(f"{VERDICT_LABEL[v]} (SHOULD not met): {row['reason']}")
+    proc = r.get("process")
+    if isinstance(proc, Mapping):
+        tallies["tests"] += 1
+        case = ET.SubElement(suite, "testcase", classname="process", name=_t(f"{r['role']} under test"), time="0")
+        if proc.get("ended_early"):
+            el = ET.SubElement(case, "failure", message=_t(describe_process(proc, r["role"])), type="process-ended")
+            el.text = _t("\n".join([f"command: {proc.get('command', '')}", *map(str, proc.get("output_tail") or [])]))
+            tallies["failures"] += 1
     for key, value in tallies.items():
         suite.set(key, str(value))
 

@@ -1,6 +1,7 @@
 """A short Markdown summary for pull requests and CI job pages.
 
-A verdict line, a PARTIAL warning if the run was interrupted, a counts table, the clauses that
+A verdict line, a PARTIAL warning if the run was interrupted, how the process under test ended
+(when helmcheck started it, ``--exec``) with its last output, a counts table, the clauses that
 did not pass with their reasons (worst first), and the certificate digest. Strings from the
 results file or the device are escaped for GitHub-flavoured Markdown, including the HTML it
 renders: ``<``, ``>`` and ``&`` become entities and Markdown punctuation is backslash-escaped.
@@ -12,9 +13,10 @@ import re
 
 from .rundir import Run
 from .text import printable
+from .verdicts import describe_process
 from .view import VERDICT_LABEL, counts, non_pass_rows
 
-__all__ = ["render_markdown", "md_escape", "ROW_LIMIT"]
+__all__ = ["render_markdown", "md_escape", "md_code", "ROW_LIMIT"]
 
 ROW_LIMIT = 60  # non-pass rows listed before "… and N more"
 
@@ -27,6 +29,11 @@ def md_escape(value: object) -> str:
     text = " ".join(printable(value).split())
     text = text.replace("&", "&amp;").replace("<", "&lt;").replace(">", "&gt;")
     return _MD_SPECIAL.sub(r"\\\1", text)
+
+
+def md_code(value: object) -> str:
+    """Any value as the inside of an inline code span: one line, no backticks."""
+    return " ".join(printable(value).split()).replace("`", "'")
 
 
 def digest_markdown(run: Run) -> str:
@@ -64,6 +71,10 @@ def render_markdown(run: Run, comparison_md: str | None = None) -> str:
         when += f", {r['duration_s']:.1f} s"
     seed = f", seed {md_escape(r['seed'])}" if r["seed"] is not None else ""
     out += [f"Implementation: {' '.join(facts) or 'not recorded'}; {when}{seed}.", ""]
+    proc = r.get("process")
+    if isinstance(proc, dict):
+        out += [f"Process under test: `{md_code(proc.get('command', ''))}`. "
+                f"{md_escape(describe_process(proc, r['role']))}", ""]
 
     c = counts(r)
     out.append("| " + " | ".join(VERDICT_LABEL[v] for v in c) + " | total |")

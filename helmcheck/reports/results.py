@@ -2,7 +2,7 @@
 
 A results document is a plain ``dict`` (it is JSON on disk and JSON in memory). Certifiers build
 it with :func:`new_results`, :func:`add_clause`, :func:`add_replay`, :func:`add_event`,
-:func:`add_mode` and :func:`finish`, and save it with :func:`write_results_atomic`. Reports read
+:func:`add_mode`, :func:`add_process` and :func:`finish`, and save it with :func:`write_results_atomic`. Reports read
 it back with :func:`load_results`, which validates it (:mod:`helmcheck.reports.schema`) and turns
 every problem into a one-line :class:`ReportError` naming the file. The verdict rules live in
 :mod:`helmcheck.reports.verdicts` and are re-exported here.
@@ -20,7 +20,8 @@ from helmcheck.clauses import SPEC_NAME, catalogue
 
 from .atomic import write_bytes_atomic
 from .schema import DIRECTIONS, EVENT_KINDS, LEVELS, ROLES, SCHEMA, validate
-from .verdicts import CLAUSE_VERDICTS, VERDICTS, describe_verdict, exit_code, overall_verdict, run_verdict
+from .verdicts import (CLAUSE_VERDICTS, VERDICTS, describe_verdict, ended_early, exit_code, overall_verdict,
+                       run_verdict)
 
 __all__ = [
     "SCHEMA",
@@ -38,6 +39,7 @@ __all__ = [
     "add_replay",
     "add_event",
     "add_mode",
+    "add_process",
     "finish",
     "validate",
     "load_results",
@@ -187,11 +189,30 @@ def add_mode(results: dict[str, Any], t: float, mode: str) -> None:
     timeline.append({"t": t, "mode": mode})
 
 
+def add_process(results: dict[str, Any], process: Mapping[str, Any], *,
+                not_run: Iterable[str] = (), reason: str = "") -> None:
+    """Record the implementation under test that helmcheck started (``--exec``).
+
+    *process* has the keys the schema names (``command``, ``pid``, ``exit_code``, ``signal``,
+    ``ended_at_s``, ``ended_early``, ``output_tail``). When it ended early, the clauses in
+    *not_run* — those whose cases or scenarios had not run, or had not finished, when it ended —
+    become NOT-TESTED with *reason*; the clauses judged before keep their verdicts. Call
+    :func:`finish` afterwards: the run verdict is then ``fail`` (:func:`run_verdict`).
+    """
+    results["process"] = dict(process)
+    if process.get("ended_early") is True:
+        todo = set(not_run)
+        for c in results["clauses"]:
+            if c["id"] in todo:
+                c.update(verdict="not-tested", reason=reason, offending_count=0, evidence=[], replay=None)
+
+
 def finish(results: dict[str, Any], *, finished: str | None = None, partial: bool = False,
            strict: bool | None = None, duration_s: float | None = None) -> str:
     """Close the run: set ``finished``, ``duration_s``, ``partial``, ``verdict`` and its reason.
 
-    *strict* defaults to ``settings.strict``. Returns the verdict.
+    *strict* defaults to ``settings.strict``. A ``process`` that ended early (see
+    :func:`add_process`) makes the verdict ``fail``. Returns the verdict.
     """
     if strict is None:
         strict = bool(results.get("settings", {}).get("strict", False))
@@ -206,8 +227,11 @@ def finish(results: dict[str, Any], *, finished: str | None = None, partial: boo
     results["duration_s"] = duration_s
     results["partial"] = bool(partial)
     verdicts = [c["verdict"] for c in results["clauses"]]
-    results["verdict"] = run_verdict(verdicts, strict=strict, partial=partial)
-    results["verdict_reason"] = describe_verdict(results["clauses"], strict=strict, partial=partial)
+    died = ended_early(results)
+    results["verdict"] = run_verdict(verdicts, strict=strict, partial=partial, process_failed=died)
+    results["verdict_reason"] = describe_verdict(results["clauses"], strict=strict, partial=partial,
+                                                 process=results.get("process"),
+                                                 subject=str(results.get("role", "implementation")))
     return results["verdict"]
 
 

@@ -5,6 +5,11 @@ directions, event kinds), that clause IDs are clauses of the reference profile w
 the profile gives them, that replays referenced by clauses exist, that the timeline runs forward,
 that the wire log path stays inside the results directory, and that the run verdict follows from
 the clause verdicts (:func:`helmcheck.reports.verdicts.run_verdict`). Unknown keys are allowed.
+
+The optional ``process`` object describes an implementation under test that helmcheck started
+(``certify … --exec``): ``command``, ``pid``, ``exit_code`` (integer or null), ``signal`` (a
+signal name or null), ``ended_at_s``, ``ended_early`` (a boolean: it ended before the run's
+end, which makes the run ``fail``) and ``output_tail`` (its last lines of output).
 """
 
 from __future__ import annotations
@@ -17,7 +22,7 @@ from typing import Any
 
 from helmcheck.clauses import SPEC_NAME, catalogue
 
-from .verdicts import CLAUSE_VERDICTS, VERDICTS, run_verdict
+from .verdicts import CLAUSE_VERDICTS, VERDICTS, ended_early, run_verdict
 
 __all__ = ["SCHEMA", "ROLES", "LEVELS", "DIRECTIONS", "EVENT_KINDS", "validate"]
 
@@ -201,15 +206,39 @@ def validate(results: Any) -> list[str]:
         _check_events(ck, r("events"))
     if "wire_log" in results and ck.string("wire_log", r("wire_log")):
         _check_relative(ck, "wire_log", r("wire_log"))
+    if "process" in results:
+        _check_process(ck, r("process"))
 
     if not ck.errors:
         strict = bool(r("settings").get("strict", False))
-        expected = run_verdict([c["verdict"] for c in r("clauses")], strict=strict, partial=r("partial"))
+        died = ended_early(results)
+        expected = run_verdict([c["verdict"] for c in r("clauses")], strict=strict, partial=r("partial"),
+                               process_failed=died)
         if r("verdict") != expected:
             ck.err("verdict", f"{r('verdict')!r} does not follow from the clause verdicts "
                               f"(they give {expected!r}{', strict' if strict else ''}"
-                              f"{', partial run' if r('partial') else ''})")
+                              f"{', partial run' if r('partial') else ''}"
+                              f"{', the implementation under test ended early' if died else ''})")
     return ck.errors
+
+
+def _check_process(ck: _Checker, process: Any) -> None:
+    if not ck.obj("process", process):
+        return
+    ck.string("process.command", process.get("command"))
+    if "pid" in process:
+        ck.typed("process.pid", process["pid"], (int,), "an integer", optional=True)
+    for key in ("exit_code", "signal", "ended_at_s"):
+        if key not in process:
+            ck.err(f"process.{key}", "missing (use null when unknown)")
+    ck.typed("process.exit_code", process.get("exit_code"), (int,), "an integer", optional=True)
+    if ck.string("process.signal", process.get("signal"), optional=True) \
+            and not re.match(r"^SIG[A-Z0-9+-]+$", process["signal"]):
+        ck.err("process.signal", f"{_short(process['signal'])} is not a signal name like SIGKILL")
+    ck.number("process.ended_at_s", process.get("ended_at_s"), optional=True, minimum=None)
+    ck.typed("process.ended_early", process.get("ended_early"), (bool,), "a boolean")
+    if "output_tail" in process:
+        ck.str_list("process.output_tail", process["output_tail"])
 
 
 def _check_relative(ck: _Checker, path: str, value: str) -> None:

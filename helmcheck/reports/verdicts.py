@@ -8,6 +8,11 @@ Reference profile, preamble: a MUST not met gives FAIL, a SHOULD not met gives N
 * :func:`run_verdict` — the verdict written into ``results.json``: :func:`overall_verdict`,
   except that a run that was interrupted (``partial``) or that judged no clause at all cannot
   certify ``pass``/``non-strict`` and is ``inconclusive`` instead. An observed ``fail`` stays.
+  A run whose implementation under test was started by helmcheck (``--exec``) and ended before
+  the run's end (``process_failed``: exited with any code, or killed by a signal) is ``fail``
+  whatever its clauses say: an implementation that dies during certification cannot be
+  certified, and the death is a finding about it, not a link fault.
+* :func:`describe_process` — one sentence quoting such an exit and its last output.
 * :func:`exit_code` — pass → 0, non-strict → 0 (1 when strict), fail → 1, inconclusive → 2.
 """
 
@@ -15,7 +20,8 @@ from __future__ import annotations
 
 from typing import Any, Iterable, Mapping
 
-__all__ = ["VERDICTS", "CLAUSE_VERDICTS", "overall_verdict", "run_verdict", "exit_code", "describe_verdict"]
+__all__ = ["VERDICTS", "CLAUSE_VERDICTS", "overall_verdict", "run_verdict", "exit_code", "describe_verdict",
+           "describe_process", "ended_early"]
 
 VERDICTS = ("pass", "non-strict", "fail", "inconclusive")
 CLAUSE_VERDICTS = VERDICTS + ("not-tested",)
@@ -42,10 +48,17 @@ def overall_verdict(clause_verdicts: Iterable[str], strict: bool = False) -> str
     return worst
 
 
-def run_verdict(clause_verdicts: Iterable[str], *, strict: bool = False, partial: bool = False) -> str:
+def run_verdict(clause_verdicts: Iterable[str], *, strict: bool = False, partial: bool = False,
+                process_failed: bool = False) -> str:
     """The verdict a run records: :func:`overall_verdict`, made ``inconclusive`` when the run was
-    interrupted or judged nothing and would otherwise claim ``pass`` or ``non-strict``."""
+    interrupted or judged nothing and would otherwise claim ``pass`` or ``non-strict``; ``fail``
+    when the implementation under test ended early (*process_failed*, see the module docstring)."""
     verdicts = list(clause_verdicts)
+    if process_failed:
+        for v in verdicts:  # still refuse unknown words
+            if v not in CLAUSE_VERDICTS:
+                raise ValueError(f"unknown clause verdict {v!r}; expected one of {CLAUSE_VERDICTS}")
+        return "fail"
     verdict = overall_verdict(verdicts, strict)
     judged = any(v != "not-tested" for v in verdicts)
     if verdict in ("pass", "non-strict") and (partial or not judged):
@@ -72,8 +85,53 @@ def _id_list(ids: list[str], limit: int = 5) -> str:
     return shown if len(ids) <= limit else f"{shown} and {len(ids) - limit} more"
 
 
-def describe_verdict(clauses: list[Mapping[str, Any]], *, strict: bool = False, partial: bool = False) -> str:
-    """One sentence explaining :func:`run_verdict` for these clause entries."""
+def ended_early(results: Mapping[str, Any]) -> bool:
+    """Did the implementation under test of this results document end before the run's end?"""
+    process = results.get("process")
+    return isinstance(process, Mapping) and process.get("ended_early") is True
+
+
+_OUTPUT_QUOTE = 200  #: characters of the last output line quoted in a verdict reason
+
+
+def describe_process(process: Mapping[str, Any], subject: str = "implementation") -> str:
+    """One sentence on how a started implementation ended: code or signal, when, its last output.
+
+    ``subject`` names it (``backseat``, ``vehicle``). Used for the verdict reason of a run whose
+    implementation ended early, and by the reports.
+    """
+    if process.get("signal"):
+        how = f"was killed by {process['signal']}"
+    elif process.get("exit_code") is not None:
+        how = f"exited with code {process['exit_code']}"
+    else:
+        how = "ended"
+    at = process.get("ended_at_s")
+    when = f" at {at:.1f} s" if isinstance(at, (int, float)) and not isinstance(at, bool) else ""
+    text = f"The {subject} under test {how}{when}"
+    text += ", before the run's end" if process.get("ended_early") else ", when helmcheck stopped it"
+    tail = [line.strip() for line in process.get("output_tail") or () if isinstance(line, str) and line.strip()]
+    if tail:
+        last = tail[-1]
+        if len(last) > _OUTPUT_QUOTE:
+            last = last[: _OUTPUT_QUOTE - 1] + "…"
+        text += f"; its last output: “{last}”"
+    else:
+        text += "; it wrote no output"
+    return text + "."
+
+
+def describe_verdict(clauses: list[Mapping[str, Any]], *, strict: bool = False, partial: bool = False,
+                     process: Mapping[str, Any] | None = None, subject: str = "implementation") -> str:
+    """One sentence explaining :func:`run_verdict` for these clause entries (and *process*, the
+    implementation under test when helmcheck started it)."""
+    if process is not None and process.get("ended_early") is True:
+        judged = [c for c in clauses if c["verdict"] != "not-tested"]
+        failed = [c["id"] for c in clauses if c["verdict"] == "fail"]
+        text = (f"{describe_process(process, subject)} An implementation that dies during certification "
+                f"cannot be certified ({len(judged)} clause(s) judged before it ended")
+        text += f", {len(failed)} of them failed: {_id_list(failed)})." if failed else ")."
+        return text
     text = _describe(clauses, strict=strict, partial=partial)
     if partial and "interrupted" not in text:
         text += " The run was interrupted before it finished."

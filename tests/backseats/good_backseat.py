@@ -16,7 +16,8 @@ faulty variants in ``faulty_backseat.py``:
 * when the mission ends (``$OSI`` reports ``S``) it stops driving, and starts again after 1 s.
 
 Usage: ``good_backseat.py PORT [--time-scale K] [--mission NAME] [--baud N]
-[--crash-after S]``. It runs until the port goes away. Times it keeps are wall time; the vehicle's
+[--crash-after S]``. It runs until the port goes away; ``--crash-after`` makes it say so on
+standard error and exit with code 3 at once. Times it keeps are wall time; the vehicle's
 durations (servo timeout, lockout) are divided by the time scale it is told (RH-TIM-2).
 """
 
@@ -193,10 +194,12 @@ class Backseat:
 
     # ------------------------------------------------------------------ main loop
     def run(self) -> int:
+        print(f"good_backseat: driving {self.ser.port} at time scale {self.k:g}", flush=True)
         try:
             while True:
                 now = time.monotonic()
                 if self.crash_after is not None and now - self.t0 >= self.crash_after:
+                    print(f"good_backseat: crashing on purpose after {self.crash_after:g} s", file=sys.stderr)
                     os._exit(3)  # a crash: no goodbye, no flush
                 self.step(now)
                 self.read()

@@ -9,12 +9,16 @@ At the end (also after Ctrl-C, a backseat that never connected or one that went 
 ``results.json``, ``wire.log`` and every report format into ``--report-dir``, prints one verdict
 line on standard output and exits 0 (pass; non-strict without ``--strict``), 1 (fail), 2
 (inconclusive) or 64 (usage). Progress goes to standard error.
+
+With ``--exec CMD`` helmcheck starts the backseat itself once the port is open and stops it at
+the end (:mod:`.process`); a backseat that exits or dies before the end fails the run.
 """
 
 from __future__ import annotations
 
 import argparse
 import math
+import shlex
 import shutil
 import signal
 import sys
@@ -47,6 +51,16 @@ examples:
   helmcheck certify backseat --duration 30 --time-scale 10 --report-dir out/
   helmcheck certify backseat --port socket://127.0.0.1:4001 --scenario lockout
   helmcheck certify backseat --port /dev/ttyUSB0 --profile site.toml --strict
+  helmcheck certify backseat --time-scale 10 --exec 'python3 my_backseat.py --port {port} --k {time_scale}'
+
+--exec CMD starts the backseat under test on the port once it is open: CMD is split like a
+shell line and run without a shell; {port} becomes the pty path (or socket://HOST:PORT; {host}
+and {tcp_port} its halves), {time_scale} the time scale; without {port} the port is appended.
+Environment: yours, plus HELMCHECK_PORT and HELMCHECK_TIME_SCALE. Its output goes to
+DIR/backseat.stdout.log and DIR/backseat.stderr.log. At the end it gets SIGTERM (its whole
+process group), then SIGKILL after --exec-grace seconds. A backseat that exits or is killed
+before the end fails the run: results.json "process" has its exit and last output, the clauses
+whose scenarios had not finished are NOT-TESTED.
 
 exit status: 0 conformant, 1 non-conformant, 2 inconclusive, 64 usage.
 """
@@ -69,6 +83,10 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--connect-timeout", type=float, default=30.0, metavar="S",
                    help="seconds to wait for the backseat's first byte (default 30)")
     p.add_argument("--baud", type=int, metavar="N", help="line rate (default: the profile's)")
+    p.add_argument("--exec", dest="exec_cmd", metavar="CMD",
+                   help="start the backseat under test on the port ({port} is replaced, or the port appended)")
+    p.add_argument("--exec-grace", type=float, default=5.0, metavar="S",
+                   help="seconds between SIGTERM and SIGKILL when stopping it (default 5)")
 
 
 def _usage(msg: str) -> int:
@@ -132,6 +150,14 @@ def run(args: argparse.Namespace, *, on_port: Optional[Callable[[str], None]] = 
         return _usage(f"--duration must be a positive number of seconds (got {args.duration})")
     if not _positive(args.connect_timeout):
         return _usage(f"--connect-timeout must be a positive number of seconds (got {args.connect_timeout})")
+    exec_cmd = getattr(args, "exec_cmd", None)
+    if exec_cmd is not None:
+        from ..launcher import check_command
+        why = check_command(exec_cmd)
+        if why:
+            return _usage(f"--exec: {why}")
+        if not _positive(args.exec_grace):
+            return _usage(f"--exec-grace must be a positive number of seconds (got {args.exec_grace})")
     baud = args.baud if args.baud is not None else profile.baud
     if baud not in BAUD_RATES:
         return _usage(f"--baud must be one of {', '.join(map(str, BAUD_RATES))} (got {baud})")
@@ -155,8 +181,8 @@ def run(args: argparse.Namespace, *, on_port: Optional[Callable[[str], None]] = 
                                 "scenarios": list(dict.fromkeys(names)), "baud": baud,
                                 "connect_timeout_s": float(args.connect_timeout),
                                 "reaction_s": float(profile.reaction_s), "jitter_s": JITTER_S}
-    command = "helmcheck certify backseat " + " ".join(sys.argv[3:] if sys.argv[1:3] == ["certify", "backseat"]
-                                                       else [f"--port {args.port}"])
+    command = "helmcheck certify backseat " + shlex.join(sys.argv[3:] if sys.argv[1:3] == ["certify", "backseat"]
+                                                         else ["--port", args.port])
     started = started_dt.isoformat(timespec="seconds").replace("+00:00", "Z")
     return _certify(args, profile, spec, plan, report_dir, log_file, settings, command, started, started_dt,
                     on_port)
@@ -172,6 +198,7 @@ def _certify(args, profile, spec, plan, report_dir: Path, log_file, settings, co
     outcome = None
     reason = ""
     progress = None
+    child = process = None  # --exec: the backseat under test (.process)
     try:
         try:
             link = HangupPty(profile.baud) if spec.kind == "pty" else open_link(spec, role="server", baud=profile.baud)
@@ -200,6 +227,13 @@ def _certify(args, profile, spec, plan, report_dir: Path, log_file, settings, co
             runner = Runner(link, profile, plan, time_scale=profile.time_scale,
                             missions=DirectoryCatalog([builtin_dir()]), log=log_file, meta=meta,
                             connect_timeout=args.connect_timeout, progress=progress)
+            if getattr(args, "exec_cmd", None):
+                from .process import start_backseat
+                try:
+                    runner.child = child = start_backseat(args.exec_cmd, link.name, report_dir,
+                                                          time_scale=profile.time_scale, grace_s=args.exec_grace)
+                except OSError as e:
+                    runner.stop(f"stopped: the backseat under test could not be started ({e.strerror or e})")
             old = {}
             if threading.current_thread() is threading.main_thread():
                 for sig in (signal.SIGINT, signal.SIGTERM):
@@ -210,7 +244,13 @@ def _certify(args, profile, spec, plan, report_dir: Path, log_file, settings, co
                 for sig, h in old.items():
                     signal.signal(sig, h)
                 progress.stop()
+                if child is not None:
+                    from .process import end_backseat
+                    process = end_backseat(child, epoch=runner.launch,
+                                           link_lost=outcome is None or outcome.status in ("disconnected", "exited"))
     finally:
+        if child is not None and process is None:
+            child.stop()  # the run never started (or broke): leave nothing behind
         if link is not None:
             link.close()
         try:
@@ -224,6 +264,9 @@ def _certify(args, profile, spec, plan, report_dir: Path, log_file, settings, co
     results = build_results(outcome, profile=profile, settings=settings, command=command,
                             port=link.name if link is not None else args.port, started=started,
                             reason=reason)
+    if process is not None and outcome is not None:
+        from .process import record_backseat
+        record_backseat(results, process, plan=plan, connected_at=outcome.connected_at, ended_at=outcome.ended_at)
     try:
         write_reports(report_dir, results)
         if args.wire_log:

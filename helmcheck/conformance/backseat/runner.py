@@ -24,7 +24,9 @@ slave side once the backseat is there, so the backseat closing the port (or dyin
 a hang-up; on a TCP serial server it is the client's disconnect; on a device, a device that
 disappears. Any of these before the run's end is "disconnected" (the report says when). The
 loop waits in ``select`` at most 50 ms at a time; SIGINT/SIGTERM (or :meth:`Runner.stop`)
-end it early as "interrupted".
+end it early as "interrupted". When helmcheck started the backseat (``child``, a
+:class:`~helmcheck.conformance.launcher.Launcher`), the loop also ends, as "exited", as soon as
+that process has ended (checked every tick).
 """
 
 from __future__ import annotations
@@ -76,7 +78,7 @@ class _CoreNotes:
 class Outcome:
     """How a run ended and what it saw; times are seconds since the certifier started."""
 
-    status: str  #: complete | never-connected | disconnected | interrupted
+    status: str  #: complete | never-connected | disconnected | interrupted | exited
     reason: str
     observer: BackseatObserver
     connected_at: Optional[float] = None
@@ -94,7 +96,7 @@ class Runner:
     def __init__(self, link: Link, profile: Profile, plan: Plan, *, time_scale: float,
                  missions: Optional[MissionCatalog] = None, log: Optional[IO[str]] = None,
                  meta: Iterable[str] = (), connect_timeout: float = 30.0,
-                 clock: Callable[[], float] = time.monotonic, progress: Any = None):
+                 clock: Callable[[], float] = time.monotonic, progress: Any = None, child: Any = None):
         self.link = link
         self.profile = profile
         self.plan = plan
@@ -102,6 +104,7 @@ class Runner:
         self.connect_timeout = connect_timeout
         self.clock = clock
         self.progress = progress
+        self.child = child  #: the backseat process under test, when helmcheck started it
         self.launch = clock()
         self.ledger = Ledger(BS_CLAUSES)
         self.observer = BackseatObserver(profile, self.ledger, time_scale=time_scale, baud=profile.baud)
@@ -139,6 +142,11 @@ class Runner:
                 now = self.clock()
                 if self._stop is not None:
                     status, reason = "interrupted", f"the run was {self._stop} after {self._elapsed(now):.1f} s"
+                    break
+                if self.child is not None and self.child.ended:
+                    status = "exited"
+                    reason = (f"the backseat under test {self.child.exit_text()} after {self._elapsed(now):.1f} s "
+                              f"of the {self.plan.total:.1f} s run")
                     break
                 if self.connected_at is None and self.rel(now) > self.connect_timeout:
                     status = "never-connected"

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import argparse
 import math
+import shlex
 import sys
 from pathlib import Path
 
@@ -36,6 +37,14 @@ examples:
   helmcheck certify vehicle --port /dev/pts/N --time-scale 20 --profile emu.toml
   helmcheck certify vehicle --port /dev/ttyUSB0 --profile iver3.toml --hypothesis-profile patient
   helmcheck certify vehicle --port socket://10.0.0.5:4001 --select 'RH-SRV-*' --select RH-ACK-2
+  helmcheck certify vehicle --exec './uvc-sim --serial {port}' --time-scale 20   # start the vehicle too
+
+--exec CMD starts the vehicle under test (a simulator, a firmware build on the host) on a new
+pty ({port} is its path; without {port} the path is appended), or with --port socket://HOST:0
+on a free TCP port ({port} is socket://HOST:N, {host} and {tcp_port} its halves); {time_scale}
+is K. Its output goes to DIR/vehicle.stdout.log and DIR/vehicle.stderr.log; at the end it gets
+SIGTERM, then SIGKILL after --exec-grace. A vehicle that exits or dies before the end fails the
+run (results.json "process", its last output quoted).
 
 results: DIR/results.json (schema 1), DIR/wire.log, DIR/report.html, DIR/junit.xml, DIR/report.md.
 exit status: 0 pass (or non-strict without --strict), 1 fail, 2 inconclusive, 64 usage.
@@ -43,8 +52,9 @@ exit status: 0 pass (or non-strict without --strict), 1 fail, 2 inconclusive, 64
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--port", required=True, metavar="URL",
-                   help="what pyserial opens: /dev/ttyUSB0, /dev/pts/N, socket://HOST:PORT, rfc2217://…")
+    p.add_argument("--port", metavar="URL",
+                   help="what pyserial opens: /dev/ttyUSB0, /dev/pts/N, socket://HOST:PORT, rfc2217://… "
+                        "(required unless --exec; with --exec: pty, the default, or socket://HOST:0)")
     p.add_argument("--profile", metavar="FILE", help="TOML profile (the ICS; default: rh5)")
     p.add_argument("--time-scale", type=float, metavar="K",
                    help="the vehicle's clock runs K times faster than wall time (RH-TIM-2; default: the profile's)")
@@ -60,10 +70,29 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--hypothesis-profile", choices=("fast", "patient"), default=None,
                    help="fast for emulators (default when K > 1), patient for hardware")
     p.add_argument("--no-progress", action="store_true", help="no progress display")
+    p.add_argument("--exec", dest="exec_cmd", metavar="CMD",
+                   help="start the vehicle under test on the port: CMD is split like a shell line, run "
+                        "without a shell; {port} is replaced by the port (appended if absent)")
+    p.add_argument("--exec-grace", type=float, default=5.0, metavar="S",
+                   help="seconds between SIGTERM and SIGKILL when stopping it (default 5)")
+    p.add_argument("--exec-ready", type=float, default=30.0, metavar="S",
+                   help="seconds it may take to open (or listen on) the port (default 30)")
 
 
 def _usage(msg: str) -> int:
     return exitcodes.usage_error("helmcheck certify vehicle", msg)
+
+
+def _sigterm_interrupts() -> None:
+    """SIGTERM ends the run like Ctrl-C: a partial report, and the started vehicle stopped."""
+    import signal
+    import threading
+
+    def interrupt(*_):
+        raise KeyboardInterrupt
+
+    if threading.current_thread() is threading.main_thread():
+        signal.signal(signal.SIGTERM, interrupt)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -83,12 +112,26 @@ def run(args: argparse.Namespace) -> int:
             return _usage(f"--baud must be one of {', '.join(map(str, BAUD_RATES))}")
         profile = profile.replace(baud=args.baud)
     profile = profile.replace(time_scale=float(k))
+    if args.exec_cmd is not None:
+        from ..launcher import check_command
+        why = check_command(args.exec_cmd)
+        if why:
+            return _usage(f"--exec: {why}")
+        for name in ("exec_grace", "exec_ready"):
+            value = getattr(args, name)
+            if not math.isfinite(value) or value <= 0:
+                return _usage(f"--{name.replace('_', '-')} must be a positive number of seconds (got {value})")
+        if args.port is None:
+            args.port = "pty"
+    elif args.port is None:
+        return _usage("--port is required (or --exec CMD to start the vehicle under test)")
     try:
         spec = parse_port_spec(args.port)
     except ValueError as e:
         return _usage(f"--port: {e}")
-    if spec.kind == "pty":
-        return _usage("--port pty creates a new pseudo-terminal; give the vehicle's port (e.g. /dev/pts/N)")
+    if spec.kind == "pty" and args.exec_cmd is None:
+        return _usage("--port pty creates a new pseudo-terminal; give the vehicle's port (e.g. /dev/pts/N) "
+                      "or --exec CMD to start the vehicle on it")
     select = None
     if args.select:
         select = [x.strip() for item in args.select for x in item.split(",") if x.strip()]
@@ -101,11 +144,14 @@ def run(args: argparse.Namespace) -> int:
     if args.examples is not None and args.examples < 0:
         return _usage("--examples must be 0 or more")
     hp = args.hypothesis_profile or ("fast" if k > 1 else "patient")
-    command = "helmcheck certify vehicle " + " ".join(sys.argv[3:] if len(sys.argv) > 3 else [])
+    command = "helmcheck certify vehicle " + shlex.join(sys.argv[3:] if len(sys.argv) > 3 else [])
     opts = Options(port=args.port, profile=profile, time_scale=float(k), report_dir=Path(args.report_dir),
                    select=select, examples=args.examples, seed=args.seed, strict=args.strict,
                    wire_log=Path(args.wire_log) if args.wire_log else None, hypothesis_profile=hp,
-                   explore=args.examples != 0, progress=not args.no_progress, command=command.strip())
+                   explore=args.examples != 0, progress=not args.no_progress, command=command.strip(),
+                   exec_cmd=args.exec_cmd, exec_grace_s=args.exec_grace, exec_ready_s=args.exec_ready)
+    if args.exec_cmd is not None:
+        _sigterm_interrupts()  # a cancelled CI job must not leave the vehicle under test running
     out = certify(opts)
     print(f"{out.verdict.upper()}{' (partial)' if out.results.get('partial') else ''}: {out.reason} "
           f"— report: {out.report_dir / 'report.html'}")

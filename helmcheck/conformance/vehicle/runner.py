@@ -14,6 +14,13 @@ offline ``check-log`` of ``wire.log`` feeds the same observer the same events.
 
 A vanished device stops the run: a ``run aborted`` note makes the clauses not yet judged
 INCONCLUSIVE with that reason, and the report is still written.
+
+With ``Options.exec_cmd`` (``--exec``) helmcheck starts the vehicle under test itself on the
+port (:mod:`helmcheck.conformance.exec_port`, :mod:`helmcheck.conformance.launcher`), checks it
+is still running before every case, and stops it at the end. If it ends before the run's end,
+that is a finding about the vehicle, not a link fault: the clauses judged before keep their
+verdicts, those not judged yet are NOT-TESTED with the exit as the reason (a ``not tested``
+note), ``results.json`` gets a ``process`` object, and the run verdict is FAIL.
 """
 
 from __future__ import annotations
@@ -29,6 +36,7 @@ from ... import __version__
 from ...clauses import vehicle_clauses
 from ...judge import Ledger
 from ...judge.vehicle import VehicleObserver
+from ...judge.wire import tester_note
 from ...profile import Profile
 from ...reports import results as R
 from ..recorder import Recorder
@@ -61,6 +69,9 @@ class Options:
     render: bool = True
     explore_budget_s: Optional[float] = None  #: wall seconds for exploration (default: the hypothesis profile's)
     max_wait: Optional[float] = None  #: wall seconds any one wait may last (None: what the protocol needs)
+    exec_cmd: Optional[str] = None  #: start the vehicle under test on ``port`` (module docstring)
+    exec_grace_s: float = 5.0  #: SIGTERM → SIGKILL when stopping it
+    exec_ready_s: float = 30.0  #: how long it may take to open (or listen on) the port
 
 
 @dataclass
@@ -115,6 +126,7 @@ class Run:
         self.link: Optional[TesterLink] = None
         self.session: Optional[Session] = None
         self.stats: dict = {}
+        self.child = None  #: the vehicle under test, when helmcheck started it (a Launcher)
 
     # ------------------------------------------------------------------ results
     def save(self, final: bool = False) -> None:
@@ -162,14 +174,19 @@ class Run:
     # ------------------------------------------------------------------ main
     def open(self) -> None:
         wire = open(self.dir / R.WIRE_LOG_NAME, "w", encoding="utf-8")
-        meta = [f"started {time.strftime('%Y-%m-%dT%H:%M:%SZ', time.gmtime())}  port {self.o.port}  "
-                f"baud {self.p.baud}  time_scale {self.k:g}",
+        try:
+            raw = (self._start_child() if self.o.exec_cmd
+                   else open_link(self.o.port, role="client", baud=self.p.baud))
+        except (OSError, ValueError) as e:
+            self.recorder = Recorder(wire, [], [self.observer])
+            raise LinkLost(f"cannot open {self.o.port}: {getattr(e, 'strerror', None) or e}") from None
+        except LinkLost:
+            self.recorder = Recorder(wire, [], [self.observer])
+            raise
+        meta = [f"started {time.strftime('%Y-%m-%dT%H:%M:%SZ', time.gmtime())}  port "
+                f"{getattr(raw, 'name', None) or self.o.port}  baud {self.p.baud}  time_scale {self.k:g}",
                 f"helmcheck {__version__} certify vehicle; profile {self.p.name}"]
         self.recorder = Recorder(wire, meta, [self.observer])
-        try:
-            raw = open_link(self.o.port, role="client", baud=self.p.baud)
-        except (OSError, ValueError) as e:
-            raise LinkLost(f"cannot open {self.o.port}: {getattr(e, 'strerror', None) or e}") from None
         self.link = TesterLink(raw, self.p, self.recorder)
         try:
             ser = getattr(raw, "ser", None)
@@ -207,6 +224,7 @@ class Run:
         ses = self.session
         assert ses is not None
         for case in cases:
+            self.check_child()
             entry = {"id": case.id, "clauses": list(case.clauses), "title": case.title,
                      "expectation": case.expectation, "start": case.start, "steps": case.describe()["steps"]}
             if all(self.ledger.has_failed(cid) for cid in case.clauses):
@@ -218,6 +236,13 @@ class Run:
             try:
                 outcome, reason = run_case(ses, case)
             except LinkLost as e:
+                gone = self.child_gone(settle_s=1.0)
+                if gone:  # the vehicle under test died: not a link fault
+                    self.aborted = gone
+                    entry.update(verdict="not-tested", reason=gone, wall_s=round(time.monotonic() - t0, 3))
+                    self.results["cases"].append(entry)
+                    self.progress.step(case.id, "not finished (the vehicle under test ended)")
+                    raise
                 entry.update(verdict="inconclusive", reason=str(e), wall_s=round(time.monotonic() - t0, 3))
                 self.results["cases"].append(entry)
                 self.progress.step(case.id, "inconclusive (link)")
@@ -229,11 +254,62 @@ class Run:
                                if case.subject in self.ledger else outcome)
             self.save()
 
+    # ------------------------------------------------------------------ the vehicle under test (--exec)
+    def _start_child(self):
+        """Start the vehicle under test on the port; the link once it has opened it."""
+        from ..exec_port import ChildNotReady, open_for_child
+        from ..launcher import Launcher
+
+        self.child = Launcher(self.o.exec_cmd, subject="vehicle", directory=self.dir, grace_s=self.o.exec_grace_s)
+        try:
+            return open_for_child(self.o.port, self.child, baud=self.p.baud, time_scale=self.k,
+                                  ready_s=self.o.exec_ready_s)
+        except ChildNotReady as e:
+            raise LinkLost(str(e)) from None
+
+    def child_gone(self, settle_s: float = 0.0) -> Optional[str]:
+        """Why the run cannot go on when the vehicle under test has ended by itself, else None.
+
+        *settle_s*: after a link fault, how long to give its exit to become visible (the port
+        closes before the process is reaped)."""
+        c = self.child
+        if c is None or c.proc is None:
+            return None
+        if settle_s and c.stopping_at is None and not c.ended:
+            c.wait(settle_s)
+        if not c.ended_by_itself:
+            return None
+        return f"the vehicle under test {c.exit_text()} at {c.ended_at - self.t_start:.1f} s"
+
+    def check_child(self) -> None:
+        """Between cases: :class:`LinkLost` if the vehicle under test has ended."""
+        gone = self.child_gone()
+        if gone:
+            raise LinkLost(gone)
+
+    def stop_child(self) -> None:
+        """End of the run: stop the vehicle under test and record it (``results.json`` ``process``)."""
+        c = self.child
+        if c is None or c.proc is None:
+            return
+        if self.aborted and not c.ended:
+            c.wait(1.0)  # a link fault may be its exit, not yet reaped
+        c.stop()
+        self.results["process"] = c.record(epoch=self.t_start)
+
     def end(self, reason: Optional[str]) -> None:
-        """Close the record: a ``run aborted`` note when it ended early, then the observer."""
+        """Close the record: a ``run aborted`` note when it ended early (a ``not tested`` note for
+        what a dead vehicle under test never reached), then the observer."""
         if self.recorder is not None:
             t = self.link.now() if self.link is not None else self.recorder.last_t
-            self.recorder.note(t, f"run aborted: {reason}" if reason else "run ends")
+            gone = self.child_gone()
+            if gone:
+                left = [c for c in self.ids if not self.ledger.judged(c)]
+                if left:
+                    self.recorder.note(t, tester_note("not-tested", left, f"{gone}, before this clause's case ran"))
+                self.recorder.note(t, "run ends")
+            else:
+                self.recorder.note(t, f"run aborted: {reason}" if reason else "run ends")
         self.observer.close()
 
 
@@ -262,6 +338,7 @@ def certify(opts: Options) -> Outcome:
         run.progress.stop()
         try:
             run.end(run.aborted)
+            run.stop_child()
         finally:
             if run.link is not None:
                 run.link.close()
