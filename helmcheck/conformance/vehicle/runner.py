@@ -24,6 +24,7 @@ from ...clauses import vehicle_clauses
 from ...model.transitions import REMOTE_MODES
 from ...profile import Profile
 from ...reports import results as R
+from ...reports.certificate import RunDeclaration, finish_run
 from ..transport import open_link
 from .cases import Case, run_case, select_cases
 from .judge import Book, CaseFail, CaseInconclusive, CaseNotTested
@@ -54,6 +55,7 @@ class Options:
     command: str = ""
     render: bool = True
     explore_budget_s: Optional[float] = None  #: wall seconds for exploration (default: the hypothesis profile's)
+    certificate: Optional[RunDeclaration] = None  #: identity and signing key (helmcheck.reports.certificate)
 
 
 @dataclass
@@ -75,9 +77,9 @@ class Recorder:
         self.pairs: set = set()
         self.last_mode: Optional[str] = None
 
-    def _event(self, t: float, kind: str, label: str) -> None:
+    def _event(self, t: float, kind: str, label: str, negative_test: bool = False) -> None:
         if len(self.r["events"]) < _MAX_EVENTS:
-            R.add_event(self.r, round(t, 6), kind, label[:120])
+            R.add_event(self.r, round(t, 6), kind, label[:120], negative_test=negative_test)
 
     def event(self, t: float, kind: str, label: str) -> None:
         self._event(t, kind, label)
@@ -91,7 +93,10 @@ class Recorder:
         item = ex.item
         cid = getattr(item, "ID", None) or getattr(item, "sentence_id", None) or "?"
         if a is not None and a.status != 0:
-            self._event(ex.t_ack, "ack-error", f"$ACK,{a.type},{a.status},{a.err} for ${cid}")
+            # A refusal the reference model predicted is one the tester provoked: a negative test.
+            want = next((r for r in (getattr(ex, "expected", None) or ()) if getattr(r, "ID", None) == "ACK"), None)
+            self._event(ex.t_ack, "ack-error", f"$ACK,{a.type},{a.status},{a.err} for ${cid}",
+                        negative_test=want is not None and (want.status, want.err) == (a.status, a.err))
             if a.err == 26:
                 self._event(ex.t_ack, "lockout", f"${cid} refused: lockout (26)")
         elif a is not None:
@@ -343,6 +348,11 @@ def certify(opts: Options) -> Outcome:
         elif run.log_file is not None:
             run.log_file.close()
         run.save(final=True)
+        # The certificate: profile.toml, digests, identity, scope and signature.
+        try:
+            finish_run(run.results, run.dir, opts.profile, opts.certificate)
+        except (OSError, R.ReportError) as e:
+            run.progress.note(f"certificate not recorded: {e}")
         if opts.wire_log is not None:
             try:
                 shutil.copyfile(run.dir / R.WIRE_LOG_NAME, opts.wire_log)
