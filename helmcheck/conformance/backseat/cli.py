@@ -46,6 +46,10 @@ examples:
   helmcheck certify backseat --duration 30 --time-scale 10 --report-dir out/
   helmcheck certify backseat --port socket://127.0.0.1:4001 --scenario lockout
   helmcheck certify backseat --port /dev/ttyUSB0 --profile site.toml --strict
+  helmcheck certify backseat --implementation moos-ivp-helm@2.1.0 --sign-key lab.key --operator "J. Doe"
+
+certificate: --implementation names the backseat in every report; --sign-key signs the run
+  (helmcheck keygen); helmcheck verify DIR --public-key lab.pub checks it against its evidence.
 
 exit status: 0 conformant, 1 non-conformant, 2 inconclusive, 64 usage.
 """
