@@ -293,3 +293,34 @@ def test_compare_counts_lost_coverage_and_fail_on_regression_exits_1(tmp_path, c
     assert "lost coverage since" in capsys.readouterr().err
     assert cli_main(["report", str(old), "--compare", str(old), "--fail-on-regression"]) == 0
     assert cli_main(["report", str(new), "--fail-on-regression"]) == 64
+
+
+# --------------------------------------------------------------------------- certify options
+
+def test_a_bad_signing_key_is_a_usage_error_before_anything_runs(tmp_path, capsys):
+    missing = tmp_path / "missing.key"
+    code = cli_main(["certify", "vehicle", "--port", str(tmp_path / "no-such-port"), "--sign-key", str(missing),
+                     "--report-dir", str(tmp_path / "out")])
+    err = capsys.readouterr().err
+    assert code == 64 and f"--sign-key: {missing}: cannot read the private key" in err
+    assert not (tmp_path / "out").exists() and "Traceback" not in err
+
+
+@pytest.mark.parametrize("argv,needle", [
+    (["--implementation", "@1.0"], "--implementation '@1.0': give NAME or NAME@VERSION"),
+    (["--implementation", "goby@"], "nothing after '@'"),
+    (["--operator", "a\x07b"], "--operator must be printable text"),
+])
+def test_bad_backseat_declarations_are_usage_errors(tmp_path, capsys, argv, needle):
+    code = cli_main(["certify", "backseat", "--report-dir", str(tmp_path / "out"), *argv])
+    err = capsys.readouterr().err
+    assert code == 64 and needle in err, err
+    assert not (tmp_path / "out").exists()
+
+
+def test_the_certificate_options_are_offered_to_both_roles(capsys):
+    for role, extra in (("vehicle", ""), ("backseat", "--implementation")):
+        with pytest.raises(SystemExit):
+            cli_main(["certify", role, "--help"])
+        out = capsys.readouterr().out
+        assert "--sign-key" in out and "--operator" in out and "--site" in out and extra in out
