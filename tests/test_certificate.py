@@ -210,7 +210,7 @@ def test_every_rendering_leads_with_the_scope_of_a_partial_pass(tmp_path):
     html, md, junit = _render(d)
     line = "PASS — partial: 4 of 60 claimed clauses judged; not a certificate"
     banner = html.split('id="verdict"', 1)[1].split("</div>", 3)
-    assert 'class="banner v-pass scope-partial"' in html and 'data-certificate="false"' in html
+    assert 'class="banner v-pass not-certificate scope-partial"' in html and 'data-certificate="false"' in html
     assert "partial: 4 of 60 claimed clauses judged; not a certificate" in "".join(banner)
     assert "not tested: not selected (--select)" in html.split('id="identity"')[0]
     assert md.splitlines()[0] == f"## helmcheck vehicle report: **{line}**"
@@ -324,3 +324,13 @@ def test_the_certificate_options_are_offered_to_both_roles(capsys):
             cli_main(["certify", role, "--help"])
         out = capsys.readouterr().out
         assert "--sign-key" in out and "--operator" in out and "--site" in out and extra in out
+
+
+def test_a_vehicle_name_on_the_wire_that_differs_from_the_profile_is_flagged(tmp_path):
+    d = copy_run(tmp_path, "fail_run")  # its $OSI carries a hostile vehicle name
+    finish_run(load_results(d), d, DEFAULT)
+    html, md, _ = _render(d)
+    cell = html.split('id="identity"', 1)[1].split("</table>", 1)[0]
+    assert "(differs from the profile&#x27;s vehicle_name)</td>" in cell and 'class="missing"' in cell
+    assert "<img" not in cell
+    assert "differs from the profile's vehicle\\_name)**" in md

@@ -95,7 +95,7 @@ svg .ev-lockout-line{stroke:#bc4c00;stroke-dasharray:4 3}svg .ev-note{fill:#5760
 footer{margin-top:32px;border-top:1px solid var(--line);padding-top:8px}
 .banner.scope-partial{color:#3d444d;border-color:#8c959f;
 background:repeating-linear-gradient(135deg,#f6f8fa,#f6f8fa 14px,#eaeef2 14px,#eaeef2 28px)}
-.banner .word .vw{border-radius:4px}.banner.scope-partial .word{font-size:22px}
+.banner .word .vw{border-radius:4px}.banner.not-certificate .word{font-size:22px}
 .banner ul.gaps{margin:6px 0 0;padding-left:20px;font-size:13.5px}.banner ul.gaps li{margin:1px 0}
 .cert{display:grid;grid-template-columns:minmax(0,1.15fr) minmax(0,1fr);gap:14px;align-items:start;margin:10px 0}
 .cert h2{font-size:15px;margin:0 0 4px;border:0;padding:0}
@@ -195,7 +195,8 @@ def _banner(run: Run) -> str:
     scope = scope_of(r)
     word = VERDICT_LABEL.get(r["verdict"], r["verdict"])
     partial_scope = not scope.certificate and r["verdict"] in ("pass", "non-strict")
-    cls = f'banner v-{_e(r["verdict"])}' + (" scope-partial" if partial_scope else "")
+    cls = (f'banner v-{_e(r["verdict"])}' + ("" if scope.certificate else " not-certificate")
+           + (" scope-partial" if partial_scope else ""))
     gaps = "".join(f"<li>{_e(line)}</li>" for line in scope.why())
     out.append(f'<div class="{cls}" id="verdict" data-certificate="{str(scope.certificate).lower()}">'
                f'<div class="word" id="scope"><span class="vw v-{_e(r["verdict"])}">{_e(word)}</span> — '

@@ -146,7 +146,11 @@ def identity_rows(results: Mapping[str, Any], wire_name: Optional[str] = None) -
         row("vehicle", impl.get("name"))
         row("serial number", impl.get("serial"))
         row("UVC / firmware version", impl.get("version"))
-        row("name on the wire ($OSI 18)", impl.get("name_on_wire"))
+        seen, declared = impl.get("name_on_wire"), impl.get("name")
+        if seen and declared and seen != declared:
+            rows.append(("name on the wire ($OSI 18)", f"{seen} (differs from the profile's vehicle_name)", True))
+        else:
+            row("name on the wire ($OSI 18)", seen)
     row("operator", ident.get("operator"), required=False)
     row("site", ident.get("site"), required=False)
     port = (results.get("implementation") or {}).get("port")

@@ -16,7 +16,7 @@ itself and the tool, and only a signature makes the whole set trustworthy.
 from __future__ import annotations
 
 import hashlib
-from pathlib import Path
+from pathlib import Path, PurePosixPath
 from typing import Any, Mapping
 
 __all__ = ["MANIFEST_FORMAT", "PROFILE_NAME", "RESULTS_NAME", "sha256_file", "sha256_bytes", "evidence_files",
@@ -62,12 +62,19 @@ def build_manifest(directory: Path | str, results: Mapping[str, Any]) -> dict[st
     }
 
 
+def _inside(name: object) -> bool:
+    if not isinstance(name, str) or not name or "\\" in name or ":" in name:
+        return False
+    p = PurePosixPath(name)
+    return not p.is_absolute() and ".." not in p.parts and name not in (".",)
+
+
 def differing_files(directory: Path | str, recorded: Mapping[str, Any]) -> list[tuple[str, str | None, str | None]]:
     """``(name, recorded digest, digest now)`` for every file whose bytes are not the recorded ones."""
     directory = Path(directory)
     out = []
     for name, want in recorded.items():
-        if not isinstance(name, str) or "/" in name or "\\" in name or name in ("", ".", ".."):
+        if not _inside(name):  # never read outside the results directory
             out.append((str(name), want if isinstance(want, str) else None, None))
             continue
         got = sha256_file(directory / name)
