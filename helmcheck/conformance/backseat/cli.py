@@ -245,8 +245,7 @@ def _certify(args, profile, spec, plan, report_dir: Path, log_file, settings, co
         print(f"helmcheck certify backseat: report not written: {e}", file=sys.stderr)
         return exitcodes.INCONCLUSIVE
     verdict = results["verdict"]
-    partial = " (PARTIAL)" if results["partial"] else ""
-    print(f"{headline(results)}{partial}. {results['verdict_reason']}")
+    print(f"{headline(results)}. {results['verdict_reason']}")  # the headline says when the run was cut short
     print(f"helmcheck certify backseat: report in {report_dir}", file=sys.stderr)
     sys.stdout.flush()
     return exit_code(verdict, strict)
