@@ -21,6 +21,8 @@ SUBCOMMANDS = {
     "check-log": ("helmcheck.commands.checklog_cmd", "check a recorded serial log against the model"),
     "report": ("helmcheck.commands.report_cmd", "render a results directory as HTML, JUnit, Markdown"),
     "matrix": ("helmcheck.commands.matrix_cmd", "one overview of several runs: clauses x implementations"),
+    "verify": ("helmcheck.commands.verify_cmd", "check a results directory against its evidence and signature"),
+    "keygen": ("helmcheck.commands.keygen_cmd", "make an Ed25519 key pair for signing results"),
     "docs": ("helmcheck.commands.docs_cmd", "regenerate the generated documentation"),
 }
 
@@ -33,6 +35,7 @@ Typical use:
   helmcheck certify backseat --port pty            # play the vehicle, judge a backseat
   helmcheck report reports/demo                    # render results.json to HTML/JUnit/Markdown
   helmcheck matrix out/a out/b --out out/          # several runs side by side, clause by clause
+  helmcheck verify reports/demo                    # re-judge the wire log; check the signature
   helmcheck parse wire.log                         # validate a capture line by line
 
 Exit codes: 0 conformant, 1 non-conformant, 2 inconclusive or tester error, 64 usage error.

@@ -241,6 +241,6 @@ def test_command_prints_port_first_and_writes_a_partial_report_on_ctrl_c(tmp_pat
     r = load_results(out_dir)
     assert r["partial"] and r["verdict"] == "inconclusive"
     assert "interrupted" in r["verdict_reason"]
-    assert out.decode().strip().startswith("INCONCLUSIVE (PARTIAL)")
+    assert out.decode().strip().startswith("INCONCLUSIVE — partial: the run was interrupted; ")
     assert wire.read_text().startswith("# helmcheck wire-log 1")
     assert "Traceback" not in err.decode()

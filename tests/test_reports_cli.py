@@ -27,7 +27,7 @@ def test_writes_all_three_reports_and_nothing_else(run_dir, capsys):
     assert main([str(run_dir)]) == 0
     assert sorted(os.listdir(run_dir)) == ["junit.xml", "report.html", "report.md", "results.json", "wire.log"]
     out = capsys.readouterr().out
-    assert out.startswith("FAIL: ") and "digest " in out and str(run_dir / "report.html") in out
+    assert out.startswith("FAIL — partial: 57 of 60 claimed clauses judged; not a certificate. ") and "digest " in out and str(run_dir / "report.html") in out
 
 
 def test_format_selects_outputs(run_dir):

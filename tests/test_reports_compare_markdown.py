@@ -41,11 +41,14 @@ def test_markdown_summary_lists_non_pass_clauses_and_digest(tmp_path):
     render_all(d, formats=("md",))
     md = (d / "report.md").read_text(encoding="utf-8")
     doc = load_results(d)
-    assert md.splitlines()[0] == "## helmcheck vehicle report: **FAIL**"
+    assert md.splitlines()[0] == ("## helmcheck vehicle report: "
+                                  "**FAIL — partial: 57 of 60 claimed clauses judged; not a certificate**")
+    assert "- RH-FRM-9 not tested: " in md  # why the run is not a certificate, right under the headline
     assert "| 69 | 0 | 3 | 1 | 3 | 76 |" in md
+    not_passed, passed = md.split("### Passed, with evidence", 1)
     for c in doc["clauses"]:
-        listed = f"| {c['id']} |" in md
-        assert listed == (c["verdict"] != "pass"), c["id"]
+        assert (f"| {c['id']} |" in not_passed) == (c["verdict"] != "pass"), c["id"]
+        assert (f"| {c['id']} |" in passed) == (c["verdict"] == "pass"), c["id"]
     assert digest_dir(d).combined in md
     assert "<script>" not in md and "<img" not in md and "<b>" not in md
 
@@ -79,14 +82,16 @@ def test_compare_finds_regressions_fixes_and_other_changes(tmp_path):
         "RH-OUT-1": ("fail", "$OSI had 20 fields"),         # pass -> fail: regressed
         "RH-TIM-1": ("fail", "release 0.9 s late"),         # inconclusive -> fail: regressed
         "RH-ACK-2": ("inconclusive", "jitter too large"),   # fail -> inconclusive: fixed (improved)
-        "RH-FRM-9": ("pass", "checked on real serial"),     # not-tested -> pass: changed
+        "RH-FRM-9": ("pass", "checked on real serial"),     # not-tested -> pass: gained coverage
+        "RH-OSD-1": ("not-tested", "not selected"),         # pass -> not-tested: lost coverage
     })
     cmp = compare(load_results(old), load_results(new))
     assert [i["id"] for i in cmp["regressed"]] == ["RH-OUT-1", "RH-TIM-1"]
     assert sorted(i["id"] for i in cmp["fixed"]) == ["RH-ACK-2", "RH-SRV-4"]
-    assert [i["id"] for i in cmp["changed"]] == ["RH-FRM-9"]
-    assert cmp["added"] == cmp["removed"] == []
-    assert cmp["unchanged"] == 76 - 5
+    assert [i["id"] for i in cmp["gained"]] == ["RH-FRM-9"]
+    assert [i["id"] for i in cmp["lost"]] == ["RH-OSD-1"]
+    assert cmp["added"] == cmp["removed"] == cmp["changed"] == []
+    assert cmp["unchanged"] == 76 - 6
     assert cmp["verdict"] == ("fail", "fail")
     srv = next(i for i in cmp["fixed"] if i["id"] == "RH-SRV-4")
     assert (srv["old"], srv["new"], srv["reason"]) == ("fail", "pass", "released on time")
@@ -100,11 +105,14 @@ def test_compare_finds_regressions_fixes_and_other_changes(tmp_path):
 
 
 def test_compare_added_and_removed_clauses():
-    old = {"verdict": "pass", "clauses": [{"id": "RH-SRV-3", "verdict": "pass", "reason": "a"}]}
+    """A clause judged before and gone now is lost coverage; one never judged is just removed."""
+    old = {"verdict": "pass", "clauses": [{"id": "RH-SRV-3", "verdict": "pass", "reason": "a"},
+                                          {"id": "RH-SRV-2", "verdict": "not-tested", "reason": "c"}]}
     new = {"verdict": "pass", "clauses": [{"id": "RH-SRV-4", "verdict": "pass", "reason": "b"}]}
     cmp = compare(old, new)
     assert [i["id"] for i in cmp["added"]] == ["RH-SRV-4"]
-    assert [i["id"] for i in cmp["removed"]] == ["RH-SRV-3"]
+    assert [i["id"] for i in cmp["lost"]] == ["RH-SRV-3"]
+    assert [i["id"] for i in cmp["removed"]] == ["RH-SRV-2"]
     assert cmp["regressed"] == cmp["fixed"] == []
 
 

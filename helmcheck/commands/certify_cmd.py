@@ -9,6 +9,8 @@ from __future__ import annotations
 import argparse
 import importlib
 
+from . import certificate_opts
+
 ROLES = {
     "vehicle": ("helmcheck.conformance.vehicle.cli",
                 "certify a vehicle: helmcheck plays the backseat and judges every reply"),
@@ -34,6 +36,7 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
                               formatter_class=argparse.RawDescriptionHelpFormatter,
                               epilog=getattr(mod, "EPILOG", None))
         mod.add_arguments(rp)
+        certificate_opts.add_arguments(rp, role)  # --sign-key, --operator, --site, --implementation
         rp.set_defaults(func=mod.run)
     p.set_defaults(func=lambda args: (p.print_help(), 64)[1])
     return p

@@ -15,6 +15,15 @@ Modules, one concern each:
   :mod:`~helmcheck.reports.markdown`, :mod:`~helmcheck.reports.compare` — the renderings.
 * :mod:`~helmcheck.reports.render` — :func:`render_all` and the ``helmcheck report`` command.
 * :mod:`~helmcheck.reports.matrix` — several runs side by side (``helmcheck matrix``).
+
+Certificates (issue: certificates anyone can verify):
+
+* :mod:`~helmcheck.reports.scope` — claimed clauses, ``certificate`` and the headline;
+* :mod:`~helmcheck.reports.identity` — what was tested, by whom, with which tester;
+* :mod:`~helmcheck.reports.manifest` — file digests and the signed manifest;
+* :mod:`~helmcheck.reports.signing` — Ed25519 keys and signatures;
+* :mod:`~helmcheck.reports.certificate` — :func:`finish_run`, the end of every certification;
+* :mod:`~helmcheck.reports.verify` — re-judging a results directory (``helmcheck verify``).
 """
 
 from .digest import Digest, digest_bytes, digest_dir

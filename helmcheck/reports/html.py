@@ -1,13 +1,19 @@
 """The HTML compliance report: one self-contained file, inline CSS and SVG, no script, no network.
 
-Contents, top to bottom: a PARTIAL warning when the run was interrupted; the verdict banner;
-the certificate digest; clause counts; the run (command, times, settings); the implementation
-identity as declared and as seen on the wire (first ``$OSI``, RH-OUT-1 field 18); the process
-under test when helmcheck started it (``--exec``: how it ended, its last output); the profile
-table; the clause matrix grouped by section of the reference profile (requirement text from
-``helmcheck.clauses``); one finding per non-pass clause with its replay steps and wire excerpt;
-model coverage; the mode timeline (:mod:`helmcheck.reports.timeline`); an optional comparison;
-the digest again.
+Contents, top to bottom. The first screen (and, printed, the first page) is the certificate: a
+PARTIAL warning when the run was interrupted; the verdict banner, which leads with the scope
+(:func:`helmcheck.reports.scope.headline`, "PASS — partial: 4 of 60 claimed clauses judged; not
+a certificate") and lists why clauses were not judged; what was tested
+(:func:`helmcheck.reports.identity.identity_rows`: implementation, serial, version, name on the
+wire, operator, site, profile SHA-256, tester version and revision); the digest and the
+signature; clause counts. Then the clause matrix grouped by section of the reference profile
+(requirement text from ``helmcheck.clauses``); one finding per non-pass clause with its replay
+steps and wire excerpt; the evidence of every passing clause; the implementation as declared and
+as seen on the wire (first ``$OSI``, RH-OUT-1 field 18); the run (command, times, settings); the
+profile table; model coverage; the mode timeline (:mod:`helmcheck.reports.timeline`), where the
+tester's deliberate negative tests are drawn apart from real ACK errors; an optional comparison;
+the digest again. A print stylesheet puts the certificate alone on the first page. When helmcheck started the implementation (``--exec``) a
+"Process under test" section says how it ended, with its last output.
 
 Everything that comes from the results file or the device is escaped with ``html.escape`` after
 control characters are made visible; a Content-Security-Policy forbids scripts and fetches in
@@ -21,11 +27,13 @@ import re
 from html import escape
 from typing import Any, Iterable, Mapping
 
+from .identity import identity_rows
 from .rundir import Run
+from .scope import headline, scope_of
 from .text import printable
-from .timeline import MODE_ORDER, timeline_svg
+from .timeline import MODE_ORDER, event_counts, timeline_svg
 from .verdicts import describe_process
-from .view import VERDICT_LABEL, clause_rows, counts, non_pass_rows, replay_for, sections
+from .view import VERDICT_LABEL, clause_rows, counts, non_pass_rows, pass_rows, replay_for, sections
 
 __all__ = ["render_html", "md_inline", "EVIDENCE_LIMIT"]
 
@@ -87,8 +95,35 @@ svg .step{fill:none;stroke:#0969da;stroke-width:2}svg .seg{fill:#0969da;fill-opa
 svg .ev-command{fill:#0969da}svg .ev-ack-error{fill:#cf222e}svg .ev-lockout{fill:#bc4c00}
 svg .ev-lockout-line{stroke:#bc4c00;stroke-dasharray:4 3}svg .ev-note{fill:#57606a}
 footer{margin-top:32px;border-top:1px solid var(--line);padding-top:8px}
-@media print{.banner,.partial,.v-pass,.v-fail,.v-non-strict,.v-inconclusive,.v-not-tested{
--webkit-print-color-adjust:exact;print-color-adjust:exact}}
+.banner.scope-partial{color:#3d444d;border-color:#8c959f;
+background:repeating-linear-gradient(135deg,#f6f8fa,#f6f8fa 14px,#eaeef2 14px,#eaeef2 28px)}
+.banner .word .vw{border-radius:4px}.banner.not-certificate .word{font-size:22px}
+.banner ul.gaps{margin:6px 0 0;padding-left:20px;font-size:13.5px}.banner ul.gaps li{margin:1px 0}
+.cert{display:grid;grid-template-columns:minmax(0,1.15fr) minmax(0,1fr);gap:14px;align-items:start;margin:10px 0}
+.cert h2{font-size:15px;margin:0 0 4px;border:0;padding:0}
+table.ident{width:100%;min-width:0;margin:0;table-layout:fixed}table.ident th{width:12.5em;font-weight:600}
+table.ident td,table.ident th{padding:2px 8px}table.ident td{overflow-wrap:anywhere}
+td.missing{color:var(--fail);font-style:italic}
+.seal,.who{border:1px solid var(--line);border-radius:6px;padding:8px 12px;font-size:13px}
+.seal .digest{margin:4px 0;padding:4px 8px;font-size:11.5px}
+.sig-ok{color:var(--pass);font-weight:700}.sig-none{color:var(--ns);font-weight:700}
+.pass-evidence{border-left:4px solid var(--pass);padding:0 12px;margin:8px 0}
+.pass-evidence h3{margin:10px 0 2px;font-size:14px}.pass-evidence p{margin:2px 0}
+svg .ev-negative{fill:#8c959f}
+@page{size:A4;margin:14mm 12mm}
+@media print{
+.banner,.partial,.v-pass,.v-fail,.v-non-strict,.v-inconclusive,.v-not-tested,.scope-partial,td.hit,.chip{
+-webkit-print-color-adjust:exact;print-color-adjust:exact}
+body{max-width:none;padding:0;font-size:10pt;color:#000}
+#certificate-page{break-after:page;page-break-after:always}
+.cert{grid-template-columns:1fr;gap:8px}
+h2{break-after:avoid;page-break-after:avoid}h3{break-after:avoid;page-break-after:avoid}
+tr,.finding,.pass-evidence,pre,svg.timeline,.seal{break-inside:avoid;page-break-inside:avoid}
+a{color:inherit;text-decoration:none}
+details>summary{list-style:none}
+pre{white-space:pre-wrap}
+footer{break-before:avoid}
+}
 """
 
 
@@ -159,10 +194,58 @@ def _banner(run: Run) -> str:
         out.append(f'<div class="partial" id="no-wire-log">The wire log {_e(r["wire_log"])} is missing '
                    "from the results directory: the evidence below cannot be checked against it.</div>")
     strict = ' <span class="muted">(strict: SHOULD clauses count as MUST)</span>' if run.strict else ""
-    out.append(f'<div class="banner v-{_e(r["verdict"])}" id="verdict">'
-               f'<div class="word">{_e(VERDICT_LABEL.get(r["verdict"], r["verdict"]))}{strict}</div>'
-               f'<div class="why">{_e(r["verdict_reason"])}</div></div>')
+    scope = scope_of(r)
+    word = VERDICT_LABEL.get(r["verdict"], r["verdict"])
+    partial_scope = not scope.certificate and r["verdict"] in ("pass", "non-strict")
+    cls = (f'banner v-{_e(r["verdict"])}' + ("" if scope.certificate else " not-certificate")
+           + (" scope-partial" if partial_scope else ""))
+    gaps = "".join(f"<li>{_e(line)}</li>" for line in scope.why())
+    out.append(f'<div class="{cls}" id="verdict" data-certificate="{str(scope.certificate).lower()}">'
+               f'<div class="word" id="scope"><span class="vw v-{_e(r["verdict"])}">{_e(word)}</span> — '
+               f'{_e(scope.statement)}{strict}</div>'
+               f'<div class="why">{_e(r["verdict_reason"])}</div>'
+               + (f'<ul class="gaps" id="scope-gaps">{gaps}</ul>' if gaps else "") + "</div>")
     return "\n".join(out)
+
+
+def _identity_table(run: Run) -> str:
+    rows = []
+    for label, value, missing in identity_rows(run.results, run.wire["osi_vehicle_name"]):
+        cls = ' class="missing"' if missing else ""
+        rows.append(f"<tr><th>{_e(label)}</th><td{cls}>{_e(value)}</td></tr>")
+    return (f'<div class="who"><h2>What was tested</h2><table class="kv ident" id="identity"><tbody>'
+            f'{"".join(rows)}</tbody></table></div>')
+
+
+def _seal(run: Run) -> str:
+    sig = run.results.get("signature")
+    if isinstance(sig, Mapping):
+        signed = (f'<p id="signature"><span class="sig-ok">Signed</span> ({_e(sig.get("algorithm"))}, '
+                  f'<span class="mono">{_e(sig.get("file"))}</span>) by key '
+                  f'<span class="mono">{_e(sig.get("key_id"))}</span>. Check it with '
+                  f'<span class="mono">helmcheck verify DIR --public-key KEY.pub</span>.</p>')
+    else:
+        signed = ('<p id="signature"><span class="sig-none">Not signed.</span> The digest below can be '
+                  "recomputed by anyone, so on its own it proves nothing; "
+                  '<span class="mono">helmcheck verify DIR</span> re-judges the wire log.</p>')
+    return f'<div class="seal"><h2>Digest and signature</h2>{signed}{_digest(run, "digest")}</div>'
+
+
+def _certificate_page(run: Run) -> str:
+    """Everything that belongs on the first page: verdict, scope, identity, digest, signature."""
+    r = run.results
+    name = next((v for label, v, missing in identity_rows(r, run.wire["osi_vehicle_name"])
+                 if label in ("vehicle", "backseat") and not missing), None)
+    kind = "certificate" if scope_of(r).certificate else "report"
+    heading = f'helmcheck {r["role"]} {kind}' + (f" — {name}" if name else "")
+    return "\n".join([
+        '<div id="certificate-page">',
+        f"<h1>{_e(heading)}</h1>",
+        _banner(run),
+        f'<div class="cert" id="certificate">{_identity_table(run)}{_seal(run)}</div>',
+        _section("summary", "Summary", _counts(run)),
+        "</div>",
+    ])
 
 
 def _digest(run: Run, anchor: str) -> str:
@@ -260,7 +343,12 @@ def _matrix(run: Run) -> str:
             v = row["verdict"]
             text = md_inline(row["text"]) if row["text"] else '<span class="warn">not in the reference profile</span>'
             cid = _e(row["id"])
-            link = f'<a href="#finding-{cid}">{cid}</a>' if _has_finding(run, row) else cid
+            if _has_finding(run, row):
+                link = f'<a href="#finding-{cid}">{cid}</a>'
+            elif v == "pass":
+                link = f'<a href="#evidence-{cid}">{cid}</a>'
+            else:
+                link = cid
             out.append(f'<tr class="clause" id="clause-{cid}" data-verdict="{_e(v)}">'
                        f'<td class="id">{link}</td><td class="req">{text}</td>'
                        f'<td class="level">{_e(row["level"])}</td>{_verdict_cell(v)}'
@@ -326,6 +414,23 @@ def _findings(run: Run) -> str:
     return "\n".join(out) if out else '<p>Every judged clause passes; nothing to show.</p>'
 
 
+def _pass_evidence(run: Run) -> str:
+    """The wire evidence of every passing clause (its first deciding exchange)."""
+    out = []
+    for row in pass_rows(run.results):
+        cid = _e(row["id"])
+        out.append(f'<section class="pass-evidence" id="evidence-{cid}">')
+        out.append(f'<h3><a href="#clause-{cid}">{cid}</a> — <span class="v-pass">PASS</span> '
+                   f'<span class="muted">({_e(row["level"])})</span></h3>')
+        out.append(f"<p>{_e(row['reason'])}</p>")
+        if row["evidence"]:
+            out.append(_wire_excerpt(row["evidence"]))
+        else:
+            out.append('<p class="muted">No wire evidence recorded for this clause.</p>')
+        out.append("</section>")
+    return "\n".join(out) if out else '<p class="muted">No clause passed.</p>'
+
+
 def _coverage(run: Run) -> str:
     cov = run.results["coverage"]
     reached = set(cov["modes"])
@@ -361,11 +466,23 @@ def _events_table(run: Run) -> str:
     events = sorted(run.results["events"], key=lambda ev: ev["t"])
     if not events:
         return ""
-    rows = "".join(f'<tr><td class="mono">{ev["t"]:.3f}</td><td>{_e(ev["kind"])}</td>'
+    rows = "".join(f'<tr><td class="mono">{ev["t"]:.3f}</td><td>{_e(_kind(ev))}</td>'
                    f'<td class="mono">{_e(ev["label"])}</td></tr>' for ev in events[:2000])
     more = f'<p class="muted">… {len(events) - 2000} more events in results.json</p>' if len(events) > 2000 else ""
     return (f"<details><summary>Events ({len(events)})</summary><table><thead><tr><th>t (s)</th>"
             f"<th>kind</th><th>label</th></tr></thead><tbody>{rows}</tbody></table>{more}</details>")
+
+
+def _kind(ev: Mapping[str, Any]) -> str:
+    if ev.get("negative_test"):
+        return "expected refusal (negative test)"
+    return str(ev["kind"])
+
+
+def _event_summary(run: Run) -> str:
+    c = event_counts(run.results)
+    return (f'<p id="event-counts">{c["ack-error"]} ACK error(s); {c["negative-test"]} expected refusal(s) '
+            f'— negative tests the tester provoked on purpose, drawn in grey; {c["lockout"]} lockout event(s).</p>')
 
 
 # --------------------------------------------------------------------------- document
@@ -377,7 +494,7 @@ def _section(anchor: str, title: str, body: str) -> str:
 def render_html(run: Run, comparison_html: str | None = None) -> str:
     """The complete HTML report for *run* (optionally with a comparison section)."""
     r = run.results
-    title = f'helmcheck {r["role"]} report — {VERDICT_LABEL.get(r["verdict"], r["verdict"])}'
+    title = f'helmcheck {r["role"]} report — {headline(r)}'
     if r["partial"]:
         title += " (PARTIAL)"
     n = len(clause_rows(r))
@@ -388,18 +505,17 @@ def render_html(run: Run, comparison_html: str | None = None) -> str:
         '<meta name="viewport" content="width=device-width, initial-scale=1">',
         f'<meta name="helmcheck-digest" content="{run.digest.combined}">',
         f"<title>{_e(title)}</title><style>{_CSS}</style></head><body>",
-        f"<h1>{_e(title)}</h1>",
-        _banner(run),
-        _digest(run, "digest"),
-        _section("summary", "Summary", _counts(run)),
-        _section("run", "Run", _run_facts(run)),
-        _section("implementation", "Implementation", _identity(run)),
+        _certificate_page(run),
         *([_section("process", "Process under test", _process(run))] if run.results.get("process") else []),
-        _section("profile", "Profile", _kv_table(_flatten(r["profile"]))),
         _section("matrix", f"Clauses ({n})", _matrix(run)),
         _section("findings", "Findings", _findings(run)),
+        _section("evidence", "Evidence for passing clauses", _pass_evidence(run)),
+        _section("implementation", "Implementation", _identity(run)),
+        _section("run", "Run", _run_facts(run)),
+        _section("profile", "Profile", _kv_table(_flatten(r["profile"]))),
         _section("coverage", "Model coverage", _coverage(run)),
-        _section("timeline", "Mode timeline", timeline_svg(r) + "\n" + _events_table(run)),
+        _section("timeline", "Mode timeline",
+                 _event_summary(run) + "\n" + timeline_svg(r) + "\n" + _events_table(run)),
     ]
     if comparison_html:
         parts.append(_section("comparison", "Comparison with an earlier run", comparison_html))

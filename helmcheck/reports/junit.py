@@ -9,13 +9,16 @@ Mapping (classname = section of the reference profile, name = clause ID + short 
 * ``non-strict`` → passes with a ``<system-out>`` note, or ``<failure type="non-strict">`` when
   the run is strict (a SHOULD then counts as a MUST).
 
+The suite's ``<properties>`` lead with the headline and scope ("PASS — partial: 4 of 60 claimed
+clauses judged; not a certificate", ``helmcheck.certificate``), then what was tested
+(``identity.*``), the certificate digest and the signing key, so a CI artefact can be matched to
+its results directory. A passing testcase carries its wire evidence in ``<system-out>``. Built
+with the standard library; text is stripped of characters XML forbids.
+
 When helmcheck started the implementation (``process`` in the results, ``--exec``), one more
 testcase (classname ``process``) says how it ended: a ``<failure type="process-ended">`` quoting
 its last output when it ended before the run's end — a dashboard must not show a run whose
 implementation died as a row of skipped clauses — else a plain testcase.
-
-The suite's ``<properties>`` carry the certificate digest, so a CI artefact can be matched to its
-results directory. Built with the standard library; text is stripped of characters XML forbids.
 """
 
 from __future__ import annotations
@@ -23,7 +26,9 @@ from __future__ import annotations
 import xml.etree.ElementTree as ET
 from typing import Any, Mapping
 
+from .identity import identity_rows
 from .rundir import Run
+from .scope import headline, scope_of
 from .text import printable, section_name, short_title
 from .verdicts import describe_process
 from .view import VERDICT_LABEL, clause_rows
@@ -60,7 +65,15 @@ def render_junit(run: Run, strict: bool | None = None) -> str:
     suite = ET.Element("testsuite", name=suite_name, timestamp=_t(r["started"]),
                        time=f'{r["duration_s"] or 0:.3f}', hostname=_t(r["implementation"].get("port") or ""))
     props = ET.SubElement(suite, "properties")
+    scope = scope_of(r)
+    sig = r.get("signature") if isinstance(r.get("signature"), dict) else {}
     meta = [
+        ("helmcheck.headline", headline(r)),
+        ("helmcheck.certificate", "true" if scope.certificate else "false"),
+        ("helmcheck.scope", scope.statement),
+        ("helmcheck.scope_gaps", "; ".join(scope.why())),
+    ] + [(f"identity.{label}", value) for label, value, _ in identity_rows(r, run.wire["osi_vehicle_name"])] + [
+        ("helmcheck.signature_key_id", sig.get("key_id") or "not signed"),
         ("helmcheck.digest", run.digest.combined),
         ("helmcheck.results_sha256", run.digest.results),
         ("helmcheck.wire_sha256", run.digest.wire or "absent"),
@@ -97,6 +110,9 @@ def render_junit(run: Run, strict: bool | None = None) -> str:
         elif v == "non-strict":
             out = ET.SubElement(case, "system-out")
             out.text = _t(f"{VERDICT_LABEL[v]} (SHOULD not met): {row['reason']}")
+        elif v == "pass":
+            out = ET.SubElement(case, "system-out")
+            out.text = _evidence_text(row) if row["evidence"] else _t(f"{row['reason']}\n(no wire evidence recorded)")
     proc = r.get("process")
     if isinstance(proc, Mapping):
         tallies["tests"] += 1

@@ -1,24 +1,31 @@
 """A short Markdown summary for pull requests and CI job pages.
 
-A verdict line, a PARTIAL warning if the run was interrupted, how the process under test ended
-(when helmcheck started it, ``--exec``) with its last output, a counts table, the clauses that
-did not pass with their reasons (worst first), and the certificate digest. Strings from the
-results file or the device are escaped for GitHub-flavoured Markdown, including the HTML it
-renders: ``<``, ``>`` and ``&`` become entities and Markdown punctuation is backslash-escaped.
+A headline that leads with the scope ("PASS — partial: 4 of 60 claimed clauses judged; not a
+certificate", :func:`helmcheck.reports.scope.headline`) and why clauses were not judged, a
+PARTIAL warning if the run was interrupted, what was tested (identity), a counts table, the
+clauses that did not pass with their reasons (worst first), every passing clause with its first
+evidence line, real ACK errors counted apart from the tester's negative tests, and the digest and
+signature. Strings from the results file or the device are escaped for GitHub-flavoured Markdown,
+including the HTML it renders: ``<``, ``>`` and ``&`` become entities and Markdown punctuation is
+backslash-escaped.
 """
 
 from __future__ import annotations
 
 import re
 
+from .identity import identity_rows
 from .rundir import Run
+from .scope import headline, scope_of
 from .text import printable
+from .timeline import event_counts
 from .verdicts import describe_process
-from .view import VERDICT_LABEL, counts, non_pass_rows
+from .view import VERDICT_LABEL, counts, non_pass_rows, pass_rows
 
 __all__ = ["render_markdown", "md_escape", "md_code", "ROW_LIMIT"]
 
 ROW_LIMIT = 60  # non-pass rows listed before "… and N more"
+PASS_ROW_LIMIT = 200  # passing rows (each with its first evidence line)
 
 # Markdown punctuation that can start markup inline; ``$`` because GitHub renders $…$ as math.
 _MD_SPECIAL = re.compile(r"([\\`*_\[\]|~$])")
@@ -38,8 +45,16 @@ def md_code(value: object) -> str:
 
 def digest_markdown(run: Run) -> str:
     d = run.digest
+    sig = run.results.get("signature")
+    signed = (f"Signed ({md_escape(sig.get('algorithm'))}) by key `{md_escape(sig.get('key_id'))}`; check with "
+              f"`helmcheck verify DIR --public-key KEY.pub`." if isinstance(sig, dict)
+              else "Not signed: `helmcheck verify DIR` re-judges the wire log.")
     return (f"Certificate digest (SHA-256): `{d.combined}`  \n"
-            f"results.json `{d.results}` · wire log `{d.wire or 'absent'}`")
+            f"results.json `{d.results}` · wire log `{d.wire or 'absent'}`  \n{signed}")
+
+
+def _evidence_line(ev: dict) -> str:
+    return md_escape(f'{ev["t"]:.6f} {ev["dir"]} {ev["line"]}')
 
 
 def render_markdown(run: Run, comparison_md: str | None = None) -> str:
@@ -47,7 +62,11 @@ def render_markdown(run: Run, comparison_md: str | None = None) -> str:
     r = run.results
     word = VERDICT_LABEL.get(r["verdict"], r["verdict"])
     impl = r["implementation"]
-    out = [f"## helmcheck {md_escape(r['role'])} report: **{word}**", ""]
+    scope = scope_of(r)
+    out = [f"## helmcheck {md_escape(r['role'])} report: **{md_escape(headline(r))}**", ""]
+    out += [f"- {md_escape(line)}" for line in scope.why()]
+    if scope.gaps:
+        out.append("")
     if r["partial"]:
         out += ["> **PARTIAL RUN**: the run was interrupted before it finished; "
                 "this is not a complete certificate.", ""]
@@ -71,6 +90,10 @@ def render_markdown(run: Run, comparison_md: str | None = None) -> str:
         when += f", {r['duration_s']:.1f} s"
     seed = f", seed {md_escape(r['seed'])}" if r["seed"] is not None else ""
     out += [f"Implementation: {' '.join(facts) or 'not recorded'}; {when}{seed}.", ""]
+    out += ["| What was tested | |", "|---|---|"]
+    out += [f"| {md_escape(label)} | {'**' + md_escape(value) + '**' if missing else md_escape(value)} |"
+            for label, value, missing in identity_rows(r, run.wire["osi_vehicle_name"])]
+    out.append("")
     proc = r.get("process")
     if isinstance(proc, dict):
         out += [f"Process under test: `{md_code(proc.get('command', ''))}`. "
@@ -93,6 +116,21 @@ def render_markdown(run: Run, comparison_md: str | None = None) -> str:
         out.append("")
     else:
         out += ["Every clause passes.", ""]
+
+    passed = pass_rows(r)
+    if passed:
+        out += [f"### Passed, with evidence ({len(passed)})", "", "| Clause | Reason | First evidence line |",
+                "|---|---|---|"]
+        for row in passed[:PASS_ROW_LIMIT]:
+            first = _evidence_line(row["evidence"][0]) if row["evidence"] else "no wire evidence recorded"
+            more = f" (+{len(row['evidence']) - 1} more)" if len(row["evidence"]) > 1 else ""
+            out.append(f"| {md_escape(row['id'])} | {md_escape(row['reason'])} | {first}{more} |")
+        if len(passed) > PASS_ROW_LIMIT:
+            out.append(f"\n… and {len(passed) - PASS_ROW_LIMIT} more; see report.html.")
+        out.append("")
+    ev = event_counts(r)
+    out += [f"Events: {ev['ack-error']} ACK error(s); {ev['negative-test']} expected refusal(s) (negative tests "
+            f"the tester provoked on purpose); {ev['lockout']} lockout event(s).", ""]
 
     if comparison_md:
         out += [comparison_md.rstrip(), ""]

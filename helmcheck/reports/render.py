@@ -1,10 +1,11 @@
 """Writing the reports of a results directory, and the ``helmcheck report`` command.
 
-``helmcheck report DIR [--format html,junit,md] [--compare OLD_DIR]`` reads ``DIR/results.json``
-and ``DIR/wire.log`` (nothing is re-run) and writes, each atomically, ``DIR/report.html``,
-``DIR/junit.xml`` and ``DIR/report.md``. Exit status: 0 written; 2 a results directory could
-not be read or a report could not be written (one line on stderr naming the file); 64 a usage
-error (EX_USAGE).
+``helmcheck report DIR [--format html,junit,md] [--compare OLD_DIR [--fail-on-regression]]``
+reads ``DIR/results.json`` and ``DIR/wire.log`` (nothing is re-run) and writes, each atomically,
+``DIR/report.html``, ``DIR/junit.xml`` and ``DIR/report.md``. Exit status: 0 written; 1 with
+``--fail-on-regression``, when a clause regressed or lost coverage since OLD_DIR; 2 a results
+directory could not be read or a report could not be written (one line on stderr naming the
+file); 64 a usage error (EX_USAGE).
 """
 
 from __future__ import annotations
@@ -15,20 +16,20 @@ from pathlib import Path
 from typing import Any, Mapping, Sequence
 
 from .atomic import write_text_atomic
-from .compare import compare_html, compare_markdown, compare_runs, compare_text
+from .compare import compare_html, compare_markdown, compare_runs, compare_text, worsened
 from .html import render_html
 from .junit import render_junit
 from .markdown import render_markdown
 from .results import ReportError
 from .rundir import Run, load_run
-from .view import VERDICT_LABEL
+from .scope import headline
 
 __all__ = ["FORMATS", "OUTPUT_NAMES", "render_all", "render_run", "main", "build_parser", "add_arguments", "run",
-           "EXIT_OK", "EXIT_UNREADABLE", "EXIT_USAGE"]
+           "EXIT_OK", "EXIT_WORSENED", "EXIT_UNREADABLE", "EXIT_USAGE"]
 
 FORMATS = ("html", "junit", "md")
 OUTPUT_NAMES = {"html": "report.html", "junit": "junit.xml", "md": "report.md"}
-EXIT_OK, EXIT_UNREADABLE, EXIT_USAGE = 0, 2, 64
+EXIT_OK, EXIT_WORSENED, EXIT_UNREADABLE, EXIT_USAGE = 0, 1, 2, 64
 
 
 def render_all(directory: Path | str, formats: Sequence[str] = FORMATS,
@@ -99,6 +100,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         metavar="LIST", help="comma-separated formats to write: html,junit,md (default: all)")
     parser.add_argument("--compare", dest="compare_dir", type=Path, metavar="OLD_DIR",
                         help="an earlier results directory to compare with")
+    parser.add_argument("--fail-on-regression", action="store_true",
+                        help="with --compare: exit 1 when a clause regressed or lost coverage (judged "
+                             "before, not judged now)")
 
 
 def build_parser(prog: str = "helmcheck report") -> argparse.ArgumentParser:
@@ -112,6 +116,9 @@ def run(args: argparse.Namespace, out=None, err=None) -> int:
     """Carry out a parsed ``report`` command; returns the exit status."""
     out = out or sys.stdout
     err = err or sys.stderr
+    if getattr(args, "fail_on_regression", False) and args.compare_dir is None:
+        print("helmcheck report: error: --fail-on-regression needs --compare OLD_DIR", file=err)
+        return EXIT_USAGE
     try:
         run_ = load_run(args.directory)
         cmp = compare_runs(load_run(args.compare_dir), run_) if args.compare_dir is not None else None
@@ -120,13 +127,16 @@ def run(args: argparse.Namespace, out=None, err=None) -> int:
         print(f"helmcheck report: error: {exc}", file=err)
         return EXIT_UNREADABLE
     r = run_.results
-    partial = " (PARTIAL)" if r["partial"] else ""
-    print(f"{VERDICT_LABEL[r['verdict']]}{partial}: {r['verdict_reason']}", file=out)
+    print(f"{headline(r)}. {r['verdict_reason']}", file=out)  # the headline says when the run was cut short
     print(f"digest {run_.digest.combined}", file=out)
     for path in paths:
         print(f"wrote {path}", file=out)
     if cmp:
         print(compare_text(cmp), end="", file=out)
+        if getattr(args, "fail_on_regression", False) and worsened(cmp):
+            print(f"helmcheck report: {len(cmp['regressed'])} clause(s) regressed and {len(cmp['lost'])} lost "
+                  f"coverage since {args.compare_dir}", file=err)
+            return EXIT_WORSENED
     return EXIT_OK
 
 

@@ -174,11 +174,21 @@ def add_replay(results: dict[str, Any], cid: str, steps: Iterable[Mapping[str, A
     return entry
 
 
-def add_event(results: dict[str, Any], t: float, kind: str, label: str) -> None:
-    """Mark a command, an ACK error, a lockout or a note on the run's time axis."""
+def add_event(results: dict[str, Any], t: float, kind: str, label: str, *, negative_test: bool = False) -> None:
+    """Mark a command, an ACK error, a lockout or a note on the run's time axis.
+
+    *negative_test* marks an ``ack-error`` the tester provoked on purpose (an expected refusal):
+    the event then carries ``"negative_test": true`` and the reports count it apart from real
+    ACK errors.
+    """
     if kind not in EVENT_KINDS:
         raise ValueError(f"event kind must be one of {EVENT_KINDS}, not {kind!r}")
-    results["events"].append({"t": t, "kind": kind, "label": label})
+    if negative_test and kind != "ack-error":
+        raise ValueError("only an ack-error event can be a negative test")
+    event = {"t": t, "kind": kind, "label": label}
+    if negative_test:
+        event["negative_test"] = True
+    results["events"].append(event)
 
 
 def add_mode(results: dict[str, Any], t: float, mode: str) -> None:

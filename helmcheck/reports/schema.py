@@ -10,6 +10,12 @@ The optional ``process`` object describes an implementation under test that helm
 (``certify … --exec``): ``command``, ``pid``, ``exit_code`` (integer or null), ``signal`` (a
 signal name or null), ``ended_at_s``, ``ended_early`` (a boolean: it ended before the run's
 end, which makes the run ``fail``) and ``output_tail`` (its last lines of output).
+
+The certificate keys (:mod:`helmcheck.reports.certificate`) are optional, so documents written
+before them stay valid; when present they are checked: ``certificate`` must follow from the
+clause verdicts by the scope rule (:func:`helmcheck.reports.scope.scope_of`), ``digests`` map file
+names inside the directory to SHA-256 hex (or null for a missing file), ``identity`` and
+``signature`` have their documented shapes, and ``negative_test`` marks only ``ack-error`` events.
 """
 
 from __future__ import annotations
@@ -22,6 +28,7 @@ from typing import Any
 
 from helmcheck.clauses import SPEC_NAME, catalogue
 
+from .scope import scope_of
 from .verdicts import CLAUSE_VERDICTS, VERDICTS, ended_early, run_verdict
 
 __all__ = ["SCHEMA", "ROLES", "LEVELS", "DIRECTIONS", "EVENT_KINDS", "validate"]
@@ -33,6 +40,7 @@ DIRECTIONS = (">", "<", ">~", "<~", "!")  # docs/contracts.md, wire-log format 1
 EVENT_KINDS = ("command", "ack-error", "lockout", "note")
 
 _CLAUSE_ID = re.compile(r"^RH-[A-Z]+-\d+$")
+_SHA256 = re.compile(r"^[0-9a-f]{64}$")
 _STEP_ACTIONS = ("send", "wait", "expect")
 
 
@@ -208,6 +216,7 @@ def validate(results: Any) -> list[str]:
         _check_relative(ck, "wire_log", r("wire_log"))
     if "process" in results:
         _check_process(ck, r("process"))
+    _check_certificate_keys(ck, results)
 
     if not ck.errors:
         strict = bool(r("settings").get("strict", False))
@@ -219,6 +228,11 @@ def validate(results: Any) -> list[str]:
                               f"(they give {expected!r}{', strict' if strict else ''}"
                               f"{', partial run' if r('partial') else ''}"
                               f"{', the implementation under test ended early' if died else ''})")
+        if "certificate" in results:
+            scope = scope_of(results)
+            if r("certificate") != scope.certificate:
+                ck.err("certificate", f"{r('certificate')!r} does not follow from the clause verdicts "
+                                      f"(scope: {scope.statement})")
     return ck.errors
 
 
@@ -239,6 +253,57 @@ def _check_process(ck: _Checker, process: Any) -> None:
     ck.typed("process.ended_early", process.get("ended_early"), (bool,), "a boolean")
     if "output_tail" in process:
         ck.str_list("process.output_tail", process["output_tail"])
+
+
+def _check_sha(ck: _Checker, path: str, value: Any, *, optional: bool = False) -> None:
+    if ck.string(path, value, optional=optional) and not _SHA256.match(value):
+        ck.err(path, f"{_short(value)} is not a SHA-256 in lower-case hex")
+
+
+def _check_certificate_keys(ck: _Checker, results: dict[str, Any]) -> None:
+    """``certificate``, ``scope``, ``digests``, ``identity``, ``signature`` (all optional)."""
+    if "certificate" in results:
+        ck.typed("certificate", results["certificate"], (bool,), "a boolean")
+    if "scope" in results and ck.obj("scope", results["scope"]):
+        sc = results["scope"]
+        for key in ("claimed", "judged"):
+            if ck.typed(f"scope.{key}", sc.get(key), (int,), "an integer") and sc[key] < 0:
+                ck.err(f"scope.{key}", "must be ≥ 0")
+        ck.string("scope.statement", sc.get("statement"))
+        if ck.arr("scope.gaps", sc.get("gaps")):
+            for i, gap in enumerate(sc["gaps"]):
+                if ck.obj(f"scope.gaps[{i}]", gap):
+                    ck.str_list(f"scope.gaps[{i}].clauses", gap.get("clauses"))
+                    ck.one_of(f"scope.gaps[{i}].verdict", gap.get("verdict"), ("not-tested", "inconclusive", "missing"))
+                    ck.string(f"scope.gaps[{i}].reason", gap.get("reason"))
+    if "digests" in results and ck.obj("digests", results["digests"]):
+        for name, value in results["digests"].items():
+            _check_relative(ck, f"digests[{name!r}]", name)
+            _check_sha(ck, f"digests[{name!r}]", value, optional=True)
+    if "identity" in results and ck.obj("identity", results["identity"]):
+        ident = results["identity"]
+        if ck.obj("identity.implementation", ident.get("implementation")):
+            impl = ident["implementation"]
+            ck.one_of("identity.implementation.role", impl.get("role"), ROLES)
+            for key in ("name", "serial", "version", "name_on_wire"):
+                if key in impl:
+                    ck.string(f"identity.implementation.{key}", impl[key], optional=True)
+        for key in ("operator", "site"):
+            ck.string(f"identity.{key}", ident.get(key), optional=True)
+        _check_sha(ck, "identity.profile_sha256", ident.get("profile_sha256"))
+        pf = ident.get("profile_file")
+        if pf is not None and ck.obj("identity.profile_file", pf):
+            ck.string("identity.profile_file.path", pf.get("path"))
+            _check_sha(ck, "identity.profile_file.sha256", pf.get("sha256"), optional=True)
+        if ck.obj("identity.tester", ident.get("tester")):
+            for key in ("name", "version", "revision"):
+                ck.string(f"identity.tester.{key}", ident["tester"].get(key))
+    if results.get("signature") is not None and ck.obj("signature", results["signature"]):
+        sig = results["signature"]
+        if ck.string("signature.file", sig.get("file")):
+            _check_relative(ck, "signature.file", sig["file"])
+        ck.one_of("signature.algorithm", sig.get("algorithm"), ("Ed25519",))
+        _check_sha(ck, "signature.key_id", sig.get("key_id"))
 
 
 def _check_relative(ck: _Checker, path: str, value: str) -> None:
@@ -363,3 +428,6 @@ def _check_events(ck: _Checker, events: Any) -> None:
             ck.number(f"{p}.t", ev.get("t"))
             ck.one_of(f"{p}.kind", ev.get("kind"), EVENT_KINDS)
             ck.string(f"{p}.label", ev.get("label"))
+            if "negative_test" in ev and ck.typed(f"{p}.negative_test", ev["negative_test"], (bool,), "a boolean") \
+                    and ev["negative_test"] and ev.get("kind") != "ack-error":
+                ck.err(f"{p}.negative_test", "only an ack-error event can be a negative test")

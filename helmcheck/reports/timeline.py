@@ -1,10 +1,12 @@
 """The mode timeline as inline SVG: mode over run time, one lane per mode, events marked.
 
 The step line follows ``results["timeline"]`` (RH-OUT-4: the mode the vehicle reported, over
-run time in seconds). Below the lanes, one row each marks ``command`` events, ``ack-error``
-events, ``lockout`` events (RH-SAF-1, also drawn as a line across the lanes) and notes. Every
-mark has a ``<title>`` so a browser shows its label on hover, without any script. All text is
-HTML-escaped: the SVG is embedded in the HTML report.
+run time in seconds). Below the lanes, one row each marks ``command`` events, real ``ack-error``
+events (red), the tester's deliberate negative tests — ``ack-error`` events with
+``"negative_test": true``, refusals the tester provoked on purpose — in a row of their own
+(grey, "expected refusals"), ``lockout`` events (RH-SAF-1, also drawn as a line across the
+lanes) and notes. Every mark has a ``<title>`` so a browser shows its label on hover, without any
+script. All text is HTML-escaped: the SVG is embedded in the HTML report.
 """
 
 from __future__ import annotations
@@ -15,15 +17,15 @@ from typing import Any, Mapping
 
 from .text import printable
 
-__all__ = ["timeline_svg", "MODE_ORDER"]
+__all__ = ["timeline_svg", "MODE_ORDER", "event_row", "event_counts"]
 
 #: Lane order: stopped, mission modes, then the remote-helm modes (§3).
 MODE_ORDER = ("S", "N", "P", "mP", "A", "M", "W")
-_EVENT_ROWS = (("command", "commands"), ("ack-error", "ACK errors"), ("lockout", "lockouts"),
-               ("note", "notes"))
+_EVENT_ROWS = (("command", "commands"), ("ack-error", "ACK errors"), ("negative-test", "expected refusals"),
+               ("lockout", "lockouts"), ("note", "notes"))
 _MAX_MARKS = 4000  # per event kind; a longer run is thinned evenly and says so
 
-_LEFT, _RIGHT, _TOP = 92, 16, 12
+_LEFT, _RIGHT, _TOP = 124, 16, 12
 _WIDTH = 960
 _LANE = 24
 _ROW = 18
@@ -47,6 +49,22 @@ def _thin(items: list[Any]) -> tuple[list[Any], int]:
         return items, 0
     stride = len(items) / _MAX_MARKS
     return [items[int(i * stride)] for i in range(_MAX_MARKS)], len(items) - _MAX_MARKS
+
+
+def event_row(event: Mapping[str, Any]) -> str:
+    """The row an event is drawn in: its kind, or ``negative-test`` for a deliberate refusal."""
+    if event.get("kind") == "ack-error" and event.get("negative_test") is True:
+        return "negative-test"
+    return str(event.get("kind"))
+
+
+def event_counts(results: Mapping[str, Any]) -> dict[str, int]:
+    """Events per row (:func:`event_row`): real ACK errors and negative tests counted apart."""
+    out = {kind: 0 for kind, _ in _EVENT_ROWS}
+    for ev in results.get("events") or []:
+        row = event_row(ev)
+        out[row] = out.get(row, 0) + 1
+    return out
 
 
 def timeline_svg(results: Mapping[str, Any]) -> str:
@@ -75,7 +93,7 @@ def timeline_svg(results: Mapping[str, Any]) -> str:
 
     out = [f'<svg xmlns="http://www.w3.org/2000/svg" class="timeline" role="img" '
            f'viewBox="0 0 {_WIDTH} {height}" width="100%" '
-           f'aria-label="Mode over run time, with commands, ACK errors and lockouts">']
+           f'aria-label="Mode over run time, with commands, ACK errors, expected refusals and lockouts">']
     out.append("<title>Mode timeline</title>")
     for i, mode in enumerate(modes):
         y = _TOP + i * _LANE
@@ -119,7 +137,7 @@ def timeline_svg(results: Mapping[str, Any]) -> str:
     notes: list[str] = []
     for i, (kind, label) in enumerate(_EVENT_ROWS):
         cy = rows_top + i * _ROW + _ROW / 2
-        marks, dropped = _thin([ev for ev in events if ev["kind"] == kind])
+        marks, dropped = _thin([ev for ev in events if event_row(ev) == kind])
         if dropped:
             notes.append(f"{dropped} {label} not drawn")
         for ev in marks:
@@ -129,6 +147,9 @@ def timeline_svg(results: Mapping[str, Any]) -> str:
                 out.append(f'<rect class="ev-command" x="{ex - 1}" y="{cy - 6}" width="2" height="12">{tip}</rect>')
             elif kind == "ack-error":
                 out.append(f'<circle class="ev-ack-error" cx="{ex}" cy="{cy}" r="4">{tip}</circle>')
+            elif kind == "negative-test":
+                tip = f'<title>{ev["t"]:.3f} s expected refusal (negative test): {_e(ev["label"])}</title>'
+                out.append(f'<circle class="ev-negative" cx="{ex}" cy="{cy}" r="3.5">{tip}</circle>')
             elif kind == "lockout":
                 out.append(f'<line class="ev-lockout-line" x1="{ex}" x2="{ex}" y1="{_TOP}" y2="{cy}"/>')
                 out.append(f'<path class="ev-lockout" d="M{ex},{cy - 6} L{ex + 6},{cy + 5} '

@@ -13,7 +13,8 @@ from helmcheck.clauses import catalogue
 
 from .verdicts import CLAUSE_VERDICTS
 
-__all__ = ["VERDICT_LABEL", "NON_PASS", "counts", "clause_rows", "sections", "replay_for", "non_pass_rows"]
+__all__ = ["VERDICT_LABEL", "NON_PASS", "counts", "clause_rows", "sections", "replay_for", "non_pass_rows",
+           "pass_rows"]
 
 VERDICT_LABEL = {
     "pass": "PASS",
@@ -69,6 +70,11 @@ def non_pass_rows(results: Mapping[str, Any]) -> list[dict[str, Any]]:
     rank = {v: i for i, v in enumerate(NON_PASS)}
     rows = [r for r in clause_rows(results) if r["verdict"] != "pass"]
     return sorted(rows, key=lambda r: rank[r["verdict"]])  # stable: profile order within a verdict
+
+
+def pass_rows(results: Mapping[str, Any]) -> list[dict[str, Any]]:
+    """Rows whose verdict is ``pass``, in profile order: each carries its deciding evidence."""
+    return [r for r in clause_rows(results) if r["verdict"] == "pass"]
 
 
 def replay_for(results: Mapping[str, Any], entry: Mapping[str, Any]) -> dict[str, Any] | None:

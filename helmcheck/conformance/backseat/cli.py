@@ -62,6 +62,11 @@ process group), then SIGKILL after --exec-grace seconds. A backseat that exits o
 before the end fails the run: results.json "process" has its exit and last output, the clauses
 whose scenarios had not finished are NOT-TESTED.
 
+  helmcheck certify backseat --implementation moos-ivp-helm@2.1.0 --sign-key lab.key --operator "J. Doe"
+
+certificate: --implementation names the backseat in every report; --sign-key signs the run
+  (helmcheck keygen); helmcheck verify DIR --public-key lab.pub checks it against its evidence.
+
 exit status: 0 conformant, 1 non-conformant, 2 inconclusive, 64 usage.
 """
 
@@ -166,6 +171,11 @@ def run(args: argparse.Namespace, *, on_port: Optional[Callable[[str], None]] = 
     except ValueError as e:
         return _usage(f"--port: {e}")
     profile = profile.replace(time_scale=float(scale), baud=baud)
+    from ...commands.certificate_opts import DeclarationError, declaration
+    try:
+        cert = declaration(args, "backseat")
+    except DeclarationError as e:
+        return _usage(str(e))
     names = args.scenario or list(SCENARIOS)
     plan = make_plan(names, args.duration, time_scale=scale, lockout_s=profile.lockout_s)
     started_dt = datetime.now(timezone.utc)
@@ -185,11 +195,11 @@ def run(args: argparse.Namespace, *, on_port: Optional[Callable[[str], None]] = 
                                                          else ["--port", args.port])
     started = started_dt.isoformat(timespec="seconds").replace("+00:00", "Z")
     return _certify(args, profile, spec, plan, report_dir, log_file, settings, command, started, started_dt,
-                    on_port)
+                    on_port, cert)
 
 
 def _certify(args, profile, spec, plan, report_dir: Path, log_file, settings, command: str,
-             started: str, started_dt: datetime, on_port=None) -> int:
+             started: str, started_dt: datetime, on_port=None, cert=None) -> int:
     from ..transport import open_link
     from .link import HangupPty
 
@@ -257,9 +267,11 @@ def _certify(args, profile, spec, plan, report_dir: Path, log_file, settings, co
             log_file.close()
         except OSError:
             pass
+    from ...reports.certificate import finish_run
+    from ...reports.render import render_all
     from ...reports.results import ReportError, exit_code
-    from ...reports.view import VERDICT_LABEL
-    from .report import build_results, write_reports
+    from ...reports.scope import headline
+    from .report import build_results
 
     results = build_results(outcome, profile=profile, settings=settings, command=command,
                             port=link.name if link is not None else args.port, started=started,
@@ -268,15 +280,16 @@ def _certify(args, profile, spec, plan, report_dir: Path, log_file, settings, co
         from .process import record_backseat
         record_backseat(results, process, plan=plan, connected_at=outcome.connected_at, ended_at=outcome.ended_at)
     try:
-        write_reports(report_dir, results)
+        # results.json with the certificate (profile.toml, digests, identity, scope, signature), then the reports
+        finish_run(results, report_dir, profile, cert)
+        render_all(report_dir)
         if args.wire_log:
             shutil.copyfile(report_dir / "wire.log", args.wire_log)
     except (ReportError, OSError) as e:
         print(f"helmcheck certify backseat: report not written: {e}", file=sys.stderr)
         return exitcodes.INCONCLUSIVE
     verdict = results["verdict"]
-    partial = " (PARTIAL)" if results["partial"] else ""
-    print(f"{VERDICT_LABEL[verdict]}{partial}: {results['verdict_reason']}")
+    print(f"{headline(results)}. {results['verdict_reason']}")  # the headline says when the run was cut short
     print(f"helmcheck certify backseat: report in {report_dir}", file=sys.stderr)
     sys.stdout.flush()
     return exit_code(verdict, strict)

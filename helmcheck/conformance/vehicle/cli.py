@@ -46,7 +46,12 @@ is K. Its output goes to DIR/vehicle.stdout.log and DIR/vehicle.stderr.log; at t
 SIGTERM, then SIGKILL after --exec-grace. A vehicle that exits or dies before the end fails the
 run (results.json "process", its last output quoted).
 
-results: DIR/results.json (schema 1), DIR/wire.log, DIR/report.html, DIR/junit.xml, DIR/report.md.
+certificate: a run that judges every vehicle clause is a certificate; --select runs and runs with a
+  NOT-TESTED or INCONCLUSIVE clause say "partial: N of 60 claimed clauses judged; not a certificate".
+  --sign-key KEY signs the run (helmcheck keygen); helmcheck verify DIR checks it.
+
+results: DIR/results.json (schema 1), DIR/wire.log, DIR/profile.toml, DIR/signature.json (signed runs),
+  DIR/report.html, DIR/junit.xml, DIR/report.md.
 exit status: 0 pass (or non-strict without --strict), 1 fail, 2 inconclusive, 64 usage.
 """
 
@@ -143,16 +148,22 @@ def run(args: argparse.Namespace) -> int:
             return _usage(f"--select: {', '.join(bad)} match no vehicle clause (e.g. RH-SRV-*, RH-ACK-2)")
     if args.examples is not None and args.examples < 0:
         return _usage("--examples must be 0 or more")
+    from ...commands.certificate_opts import DeclarationError, declaration
+    try:
+        cert = declaration(args, "vehicle")
+    except DeclarationError as e:
+        return _usage(str(e))
     hp = args.hypothesis_profile or ("fast" if k > 1 else "patient")
     command = "helmcheck certify vehicle " + shlex.join(sys.argv[3:] if len(sys.argv) > 3 else [])
     opts = Options(port=args.port, profile=profile, time_scale=float(k), report_dir=Path(args.report_dir),
                    select=select, examples=args.examples, seed=args.seed, strict=args.strict,
                    wire_log=Path(args.wire_log) if args.wire_log else None, hypothesis_profile=hp,
                    explore=args.examples != 0, progress=not args.no_progress, command=command.strip(),
-                   exec_cmd=args.exec_cmd, exec_grace_s=args.exec_grace, exec_ready_s=args.exec_ready)
+                   exec_cmd=args.exec_cmd, exec_grace_s=args.exec_grace, exec_ready_s=args.exec_ready,
+                   certificate=cert)
     if args.exec_cmd is not None:
         _sigterm_interrupts()  # a cancelled CI job must not leave the vehicle under test running
     out = certify(opts)
-    print(f"{out.verdict.upper()}{' (partial)' if out.results.get('partial') else ''}: {out.reason} "
-          f"— report: {out.report_dir / 'report.html'}")
+    from ...reports.scope import headline
+    print(f"{headline(out.results)}. {out.reason} — report: {out.report_dir / 'report.html'}")
     return out.exit_code

@@ -40,6 +40,7 @@ from ...judge.wire import tester_note
 from ...profile import Profile
 from ...reports import results as R
 from ..recorder import Recorder
+from ...reports.certificate import RunDeclaration, finish_run
 from ..transport import open_link
 from .catalogue import select_cases
 from .flow import LinkLost, LinkSilent
@@ -72,6 +73,7 @@ class Options:
     exec_cmd: Optional[str] = None  #: start the vehicle under test on ``port`` (module docstring)
     exec_grace_s: float = 5.0  #: SIGTERM → SIGKILL when stopping it
     exec_ready_s: float = 30.0  #: how long it may take to open (or listen on) the port
+    certificate: Optional[RunDeclaration] = None  #: identity and signing key (helmcheck.reports.certificate)
 
 
 @dataclass
@@ -345,6 +347,11 @@ def certify(opts: Options) -> Outcome:
             if run.recorder is not None:
                 run.recorder.close()
             run.save(final=True)
+        # The certificate: profile.toml, digests, identity, scope and signature.
+        try:
+            finish_run(run.results, run.dir, opts.profile, opts.certificate)
+        except (OSError, R.ReportError) as e:
+            run.progress.note(f"certificate not recorded: {e}")
         if opts.wire_log is not None:
             try:
                 shutil.copyfile(run.dir / R.WIRE_LOG_NAME, opts.wire_log)

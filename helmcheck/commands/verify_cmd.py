@@ -1,0 +1,81 @@
+"""``helmcheck verify DIR [--public-key PUB]``: does a results directory follow from its evidence?
+
+The command owns the command line; the checks are :mod:`helmcheck.reports.verify`. It re-judges
+the wire log under the recorded profile and compares every clause verdict, the run verdict and
+the certificate flag with ``results.json``, checks the recorded digests, and checks the
+signature when the run is signed (against ``--public-key`` when given).
+
+Exit status: 0 verified; 1 something differs (one line per difference on standard output, each
+naming the clause or file); 64 usage (no such results directory, unreadable public key).
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+from .. import exitcodes
+
+EPILOG = """\
+what is checked:
+  results.json    a valid results document whose digests match wire.log and profile.toml
+  profile.toml    the profile the run recorded, key by key
+  clause verdicts re-judged from wire.log under profile.toml (same observer as check-log);
+                  every clause verdict, the run verdict and the certificate flag must agree
+  signature.json  if present: the Ed25519 signature over results.json, wire.log, profile.toml
+                  and the tool version; with --public-key it must be that key's signature
+
+examples:
+  helmcheck verify reports/vehicle
+  helmcheck verify reports/vehicle --public-key lab.pub
+
+exit status: 0 verified, 1 mismatch (each difference named), 64 usage.
+"""
+
+
+def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
+    p = sub.add_parser("verify", help="check a results directory against its wire log, profile and signature",
+                       description="Re-judge a results directory's wire log under its recorded profile and "
+                                   "check that results.json follows from it; check the signature if signed. "
+                                   "Exit 0 verified, 1 mismatch, 64 usage.",
+                       epilog=EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("directory", metavar="DIR", help="results directory (results.json, wire.log, profile.toml)")
+    p.add_argument("--public-key", metavar="PUB",
+                   help="the trusted public key (PREFIX.pub from 'helmcheck keygen'); the run must be signed by it")
+    p.set_defaults(func=run)
+    return p
+
+
+def run(args: argparse.Namespace) -> int:
+    from ..reports.signing import KeyFileError, load_public_key
+    from ..reports.verify import VerifyUsageError, verify_run
+
+    prog = "helmcheck verify"
+    public = None
+    if args.public_key is not None:
+        try:
+            public = load_public_key(args.public_key)
+        except KeyFileError as e:
+            return exitcodes.usage_error(prog, str(e))
+    try:
+        result = verify_run(args.directory, public, public_key_name=str(args.public_key))
+    except VerifyUsageError as e:
+        return exitcodes.usage_error(prog, str(e))
+    for note in result.notes:
+        print(f"note: {note}")
+    if not result.ok:
+        for finding in result.findings:
+            print(f"MISMATCH {finding}")
+        print(f"NOT VERIFIED: {len(result.findings)} difference(s) in {args.directory}")
+        sys.stdout.flush()
+        return exitcodes.NONCONFORMANT
+    if result.signed and result.trusted_key:
+        signed = f"; signed by the given key {result.key_id}"
+    elif result.signed:
+        signed = (f"; signature valid, made by key {result.key_id} "
+                  f"(give --public-key to check it is a key you trust)")
+    else:
+        signed = "; not signed"
+    print(f"VERIFIED: {result.clauses_compared} clause verdict(s), the run verdict and the certificate flag "
+          f"follow from the wire log under the recorded profile{signed}")
+    return exitcodes.OK

@@ -1,0 +1,158 @@
+"""Scope: whether a run is a certificate, and the one line every rendering leads with.
+
+A verdict says how the judged clauses went; the scope says how much was judged. The rule:
+
+* **Claimed clauses.** A vehicle run claims every vehicle clause of the reference profile (§1–8,
+  :func:`helmcheck.clauses.vehicle_clauses`); a backseat run every §9 clause
+  (:func:`helmcheck.clauses.backseat_clauses`); a log check the clauses it lists. A MUST is a
+  MUST: no profile setting removes a clause from the claim. A profile that gives the tester no
+  way to exercise a clause — no violation trigger for §7 (``fault_injection = "none"`` and
+  ``violation_trigger`` none, RH-SAF-5), no ``end_mission``, a command left out of ``commands``,
+  an OSD letter left out of ``osd_letters`` — leaves that clause NOT-TESTED, with the reason.
+* **Judged** means a verdict of ``pass``, ``non-strict`` or ``fail``. ``not-tested``,
+  ``inconclusive`` and a clause missing from the results are not judged.
+* A run is a **certificate** when it finished (not ``partial``) and judged every claimed clause,
+  MUST and SHOULD alike. ``--select`` runs, runs with a NOT-TESTED or INCONCLUSIVE clause and
+  interrupted runs are not; their verdict and exit status are unchanged, but every rendering
+  leads with ``PASS — partial: 4 of 60 claimed clauses judged; not a certificate`` and says why
+  (``RH-SAF-1..5 not tested: …``). A run that judged everything and failed is a certificate
+  too: a certificate of non-conformance.
+
+Nothing here reads files: the scope is a pure function of the results document (its role, its
+clause verdicts, ``partial``), so ``helmcheck verify`` can recompute it from re-judged verdicts
+and the schema validator can check a recorded ``certificate`` flag.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+from typing import Any, Iterable, Mapping
+
+from helmcheck.clauses import backseat_clauses, catalogue, vehicle_clauses
+
+from .view import VERDICT_LABEL
+
+__all__ = ["JUDGED", "Gap", "Scope", "claimed_clauses", "scope_of", "headline", "id_ranges"]
+
+JUDGED = ("pass", "non-strict", "fail")
+_GAPS_SHOWN = 4
+
+
+@dataclass(frozen=True)
+class Gap:
+    """Claimed clauses not judged for one reason."""
+
+    clauses: tuple[str, ...]
+    verdict: str  #: ``not-tested``, ``inconclusive`` or ``missing``
+    reason: str
+
+    def text(self) -> str:
+        what = {"not-tested": "not tested", "inconclusive": "inconclusive",
+                "missing": "missing from the results"}.get(self.verdict, self.verdict)
+        return f"{id_ranges(self.clauses)} {what}" + (f": {self.reason}" if self.reason else "")
+
+
+@dataclass(frozen=True)
+class Scope:
+    """The scope of one run (module docstring)."""
+
+    certificate: bool
+    claimed: tuple[str, ...]
+    judged: tuple[str, ...]
+    gaps: tuple[Gap, ...]
+    interrupted: bool
+
+    @property
+    def statement(self) -> str:
+        """``certificate: all 60 claimed clauses judged`` or ``partial: 4 of 60 claimed clauses
+        judged; not a certificate`` (with ``the run was interrupted`` first when it was)."""
+        n, k = len(self.claimed), len(self.judged)
+        if self.certificate:
+            return f"certificate: all {n} claimed clauses judged"
+        stopped = "the run was interrupted; " if self.interrupted else ""
+        return f"partial: {stopped}{k} of {n} claimed clauses judged; not a certificate"
+
+    def why(self, limit: int = _GAPS_SHOWN) -> list[str]:
+        """One line per reason a claimed clause was not judged, the first *limit* of them."""
+        lines = [g.text() for g in self.gaps[:limit]]
+        rest = self.gaps[limit:]
+        if rest:
+            lines.append(f"and {sum(len(g.clauses) for g in rest)} more clause(s) for {len(rest)} other reason(s)")
+        return lines
+
+    def as_dict(self) -> dict[str, Any]:
+        return {"claimed": len(self.claimed), "judged": len(self.judged), "statement": self.statement,
+                "gaps": [{"clauses": list(g.clauses), "verdict": g.verdict, "reason": g.reason} for g in self.gaps]}
+
+
+def claimed_clauses(results: Mapping[str, Any]) -> list[str]:
+    """The clause IDs a run claims, in profile order (module docstring)."""
+    role = results.get("role")
+    if role == "vehicle":
+        return [c.id for c in vehicle_clauses()]
+    if role == "backseat":
+        return [c.id for c in backseat_clauses()]
+    order = {cid: i for i, cid in enumerate(catalogue())}
+    ids = [c.get("id") for c in results.get("clauses") or [] if isinstance(c, Mapping)]
+    return sorted(dict.fromkeys(i for i in ids if isinstance(i, str)), key=lambda i: order.get(i, len(order)))
+
+
+def scope_of(results: Mapping[str, Any], verdicts: Mapping[str, str] | None = None) -> Scope:
+    """The scope of *results*; *verdicts* (clause ID → verdict) replaces the recorded ones."""
+    entries = {c["id"]: c for c in results.get("clauses") or [] if isinstance(c, Mapping) and "id" in c}
+    if verdicts is None:
+        verdicts = {cid: c.get("verdict") for cid, c in entries.items()}
+    claimed = claimed_clauses(results)
+    judged = tuple(cid for cid in claimed if verdicts.get(cid) in JUDGED)
+    groups: dict[tuple[str, str], list[str]] = {}
+    for cid in claimed:
+        v = verdicts.get(cid)
+        if v in JUDGED:
+            continue
+        verdict = v if v in ("not-tested", "inconclusive") else "missing"
+        reason = str(entries.get(cid, {}).get("reason") or "") if verdict != "missing" else ""
+        groups.setdefault((verdict, _plain_reason(reason)), []).append(cid)
+    gaps = tuple(Gap(tuple(ids), v, r) for (v, r), ids in groups.items())
+    interrupted = bool(results.get("partial"))
+    certificate = not interrupted and not gaps and bool(claimed)
+    return Scope(certificate, tuple(claimed), judged, gaps, interrupted)
+
+
+def _plain_reason(reason: str) -> str:
+    """A clause reason without the case prefix (``V-55: …``), so one cause groups its clauses."""
+    return re.sub(r"^[A-Z]+-\d+[a-z]?: ", "", reason.strip())
+
+
+def headline(results: Mapping[str, Any]) -> str:
+    """``PASS — partial: 4 of 60 claimed clauses judged; not a certificate`` (the verdict word and
+    :attr:`Scope.statement`): the first line of every rendering."""
+    verdict = results.get("verdict")
+    return f"{VERDICT_LABEL.get(verdict, str(verdict).upper())} — {scope_of(results).statement}"
+
+
+def id_ranges(ids: Iterable[str]) -> str:
+    """``RH-SAF-1, RH-SAF-2, RH-SAF-3, RH-FRM-9`` → ``RH-SAF-1..3, RH-FRM-9`` (order kept)."""
+    out: list[str] = []
+    run: list[tuple[str, int]] = []
+
+    def flush() -> None:
+        if not run:
+            return
+        fam, first = run[0]
+        last = run[-1][1]
+        out.append(f"{fam}-{first}" if first == last else f"{fam}-{first}..{last}")
+        run.clear()
+
+    for cid in ids:
+        fam, _, num = cid.rpartition("-")
+        if not num.isdigit():
+            flush()
+            out.append(cid)
+            continue
+        n = int(num)
+        if run and (run[-1][0] != fam or run[-1][1] + 1 != n):
+            flush()
+        run.append((fam, n))
+    flush()
+    return ", ".join(out)
