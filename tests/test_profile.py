@@ -67,7 +67,7 @@ def test_end_and_srp_missions_are_string_keys(tmp_path):
 
 
 def test_empty_end_or_srp_mission_makes_its_case_not_tested():
-    from helmcheck.conformance.vehicle.cases import CASES, unmet_need
+    from helmcheck.conformance.vehicle.catalogue import CASES, unmet_need
     end = next(c for c in CASES if c.subject == "RH-MSN-4")
     srp = next(c for c in CASES if c.subject == "RH-SAF-4" and "srp_mission" in c.needs)
     emu = DEFAULT.replace(fault_injection="oxflt")

@@ -93,7 +93,8 @@ class Beliefs:
         self.catalog = catalog
         self.k = k
         self.cands: list[Candidate] = [Candidate(VehicleModel(profile, catalog))]
-        self.desync = ""
+        #: why the vehicle's state is not known (findings are INCONCLUSIVE until it is again)
+        self.desync = "the record begins with the vehicle's state unknown"
         #: vehicle seconds: the longest command round trip since the state was last known — a
         #: timer armed by a command started somewhere in that round trip (RH-RD-15)
         self.arm_v = 0.0
@@ -238,6 +239,8 @@ class Beliefs:
             if c.code_unknown and osi.error_state != "N" and c.model.phase != "none":
                 c.model.error_state = osi.error_state
                 c.code_unknown = False
+        if self.desync and self._adopt(osi, v_sent):
+            self.desync = ""
         explained = [c for c in self.cands if not c.check(osi, v, slack)]
         result = OsiResult(desync=self.desync)
         if not explained:
@@ -279,6 +282,36 @@ class Beliefs:
         if osi.mode == "S" and osi.error_state == "N" and self.primary.model.mode == "S":
             self.desync = ""
         return result
+
+    def _adopt(self, osi: s.OSI, v: float) -> bool:
+        """While the state is unknown: take it from an ``$OSI`` that shows it whole — ``S``, or a
+        mission running (``N``, ``P``) with no remote control and no safety episode. What a
+        report does not show (set-points, timers of remote control, settings) is not needed in
+        those states; the mission is looked up by field 12's name (unknown names: known by name
+        from now on). Returns whether a state was adopted."""
+        if osi.error_state != "N" or osi.mode not in ("S", "N", "P"):
+            return False
+        old = self.primary.model
+        m = VehicleModel(self.profile, self.catalog)
+        m.settings, m.log_labels, m.loaded = old.settings, old.log_labels, old.loaded
+        m.now = v
+        if osi.mode in ("N", "P"):
+            name = osi.mission_name or self.profile.mission
+            found = self.catalog.lookup(name)
+            if not hasattr(found, "waypoints"):
+                self.catalog.learn_present(name)
+                found = self.catalog.lookup(name)
+            if not hasattr(found, "waypoints") or osi.next_waypoint >= len(found.waypoints):
+                return False
+            m.mission = m.loaded = found
+            m.mission_wp = osi.next_waypoint
+            m.mission_mode = m.mode = osi.mode
+            if osi.mode == "P":
+                m.timers.arm("park", v, float(osi.park_time))
+        self.cands = [Candidate(m)]
+        if osi.mode == "P":
+            self.cands[0].adopted("the mission park's time as the first report shows it", v - 1.0, v)
+        return True
 
     def _confirm(self, c: Candidate, osi: s.OSI, v_sent: float, v_recv: float, slack_v: float,
                  passes: Optional[list], own: set) -> set:

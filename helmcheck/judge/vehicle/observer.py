@@ -151,6 +151,8 @@ class VehicleObserver:
         """Book a finding on :func:`~.blame.targets` of ``candidates``, in the case context of
         ``at`` (the line it is about) or the present one."""
         case, clauses = (at.case, at.case_clauses) if at is not None else (self.case, self.case_clauses)
+        if case and verdict != "pass":
+            reason = f"{case}: {reason}"
         for cid in targets(candidates, clauses):
             if verdict == "fail":
                 self.ledger.failed(cid, reason, evidence, case)
