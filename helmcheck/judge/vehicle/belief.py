@@ -145,9 +145,10 @@ class Beliefs:
         nominal = options[0]
         match = [o for o in options if same_replies(o[1], observed)]
         if match:
+            base = len(self.cands[0].story)
             self._keep([o[0] for o in match])
             chosen = match[0]
-            result = CommandResult(chosen[1], True, chosen[2], chosen[3], chosen[0].story, False, desync)
+            result = CommandResult(chosen[1], True, chosen[2], chosen[3], chosen[0].story[base:], False, desync)
         else:
             found = None
             for c in self.cands:
@@ -157,8 +158,10 @@ class Beliefs:
                     break
             if found is not None:
                 cand, replies, mission_dep = found
+                base = len(self.cands[0].story)
                 self._keep([cand])
-                result = CommandResult(replies, True, nominal[2], nominal[3], cand.story, mission_dep, desync)
+                result = CommandResult(replies, True, nominal[2], nominal[3], cand.story[base:], mission_dep,
+                                       desync)
             else:
                 result = CommandResult(nominal[1], False, nominal[2], nominal[3], (), False, desync)
                 want = nominal[1][-1] if nominal[1] and isinstance(nominal[1][-1], s.ACK) else None
@@ -250,7 +253,7 @@ class Beliefs:
                 got = explain_osi(c, osi, v, slack, tp, self.catalog, fix, self.profile.depth_unit)
                 if got is not None:
                     explained.append(got)
-                    result.adopted = got.story
+                    result.adopted = got.story[len(c.story):]
                     break
         if not explained:
             p = self.primary
@@ -269,6 +272,8 @@ class Beliefs:
                 causes.insert(0, "RH-OMW-5")
             if p.refused_locked and p.model.phase != "lockout":
                 causes.insert(0, "RH-SAF-2")
+            if osi.mode == p.model.mode:  # the mode is right: a countdown is what differs
+                causes += {"mP": ["RH-PK-2"], "W": ["RH-OMW-4"]}.get(osi.mode, [])
             result.causes = tuple(dict.fromkeys(c for c in causes if c != "RH-OUT-4"))
             self._confirm(p, osi, v_sent, v_recv, slack_v, passes=None, own=set())
             return result

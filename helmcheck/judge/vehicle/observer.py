@@ -54,6 +54,8 @@ _PLANT = {"WaypointReached": P.WaypointReached, "OnStation": P.OnStation,
           "QueueWaypointReached": P.QueueWaypointReached, "AtSurface": P.AtSurface,
           "Submerged": P.Submerged, "SafetyViolation": P.SafetyViolation}
 _UNSOLICITED = (13, 14)
+#: Wall seconds after which an unanswered command's ACK is taken never to come (RH-ACK-1).
+GIVE_UP_S = 15.0
 _OWN_REASON = {"RH-INT-3": "after the control that interrupted an $OPK park ended, the mission resumed, "
                            "not the park",
                "RH-OMW-5": "after the control that interrupted the $OMW queue ended, the mission resumed, "
@@ -85,6 +87,8 @@ class Sent:
     overtaken: bool = False  #: the ACK of a later command came first
     waited: float = 0.0  #: how long the observer waited before calling its ACK missing
     branched: bool = False  #: a later command was answered first: taken into the mirror unanswered
+    late_booked: bool = False  #: RH-ACK-2 booked: no ACK by the give-up deadline
+    missing_booked: bool = False  #: RH-ACK-1 booked: no ACK at all
 
     @property
     def done(self) -> bool:
@@ -112,7 +116,7 @@ class VehicleObserver:
                         FROM_VEHICLE: Framer(max(4096, 4 * profile.max_line_bytes))}
         self.pending: deque[Sent] = deque()
         self.silent: deque[Sent] = deque()
-        self.gave_up: deque[Sent] = deque(maxlen=16)
+        self.gave_up: deque[Sent] = deque(maxlen=64)
         self.dead: list[Sent] = []  #: missing while the vehicle said nothing at all (yet)
         self.quiet: list[Sent] = []  #: discarded lines waiting for proof the vehicle listens
         self.last_osd: Optional[Sent] = None
@@ -399,7 +403,9 @@ class VehicleObserver:
         replies = self.vbytes - p.vbytes0
         allowance = ack_allowance(self.profile.ack_window_s, len(p.raw), replies, self.baud, self.res)
         dt = t - p.t
-        if late or dt > ack_fail_after(allowance):
+        if late and p.late_booked:
+            pass  # RH-ACK-2 was booked when the give-up deadline passed
+        elif late or dt > ack_fail_after(allowance):
             self.book("fail", ("RH-ACK-2",), f"$ACK,{a.type} came {dt:.2f} s after {_text(p)}; the window with "
                                              f"transmit time is {allowance - ACK_GRACE_S:.2f} s", ev, at=p)
         elif dt > allowance:
@@ -558,6 +564,8 @@ class VehicleObserver:
             if t - p.t > ack_fail_after(allowance):
                 self.pending.remove(p)
                 self._missing(p, allowance)
+        if self.gave_up:
+            self._give_up(t)
 
     def _silent_over(self, q: Sent, t: float) -> bool:
         allowance = ack_allowance(self.profile.ack_window_s, len(q.raw), 0, self.baud, self.res)
@@ -575,22 +583,42 @@ class VehicleObserver:
             self.quiet.append(q)
 
     def _missing(self, p: Sent, allowance: float) -> None:
+        """Past the give-up deadline unanswered. RH-ACK-2 is certain now (whatever comes later is
+        too late); RH-ACK-1 only once its ACK can no longer come: :data:`GIVE_UP_S` after it was
+        sent, or at the record's end — an ACK that comes before that belongs to it (RH-ACK-2),
+        never to a later command."""
         p.state = "missing"
         p.waited = ack_fail_after(allowance)
         self.gave_up.append(p)
         if self.alive_t is not None and self.alive_t > p.t:
-            self._book_missing(p)
+            self._book_late(p)
         else:
             self.dead.append(p)
 
-    def _book_missing(self, p: Sent) -> None:
-        cands = ((p.kind.variant,) if p.kind.variant else ()) + ("RH-ACK-1",)
+    def _book_late(self, p: Sent) -> None:
+        cands = ((p.kind.variant,) if p.kind.variant else ()) + ("RH-ACK-2",)
         self.book("fail", cands, f"{_text(p)}: no $ACK,{p.kind.ack_type} within {p.waited:.1f} s, though "
-                                 f"the vehicle still answers", [p.ev], at=p)
+                                 f"the vehicle still answers (the window is {self.profile.ack_window_s:g} s)",
+                  [p.ev], at=p)
+        p.late_booked = True
+
+    def _book_missing(self, p: Sent) -> None:
+        if not p.late_booked:
+            self._book_late(p)
+        cands = ((p.kind.variant,) if p.kind.variant else ()) + ("RH-ACK-1",)
+        self.book("fail", cands, f"{_text(p)}: no $ACK,{p.kind.ack_type} at all, though the vehicle still "
+                                 f"answers", [p.ev], at=p)
+
+    def _give_up(self, t: float) -> None:
+        """RH-ACK-1 for what is unanswered :data:`GIVE_UP_S` after it was sent."""
+        for p in list(self.gave_up):
+            if p.ack is None and not p.missing_booked and t - p.t > GIVE_UP_S and p.late_booked:
+                p.missing_booked = True
+                self._book_missing(p)
 
     def _revive(self, t: float) -> None:
         for p in self.dead:
-            self._book_missing(p)
+            self._book_late(p)
         self.dead.clear()
         for q in self.quiet:
             self._silence_kept(q)
@@ -614,6 +642,10 @@ class VehicleObserver:
         for p in self.dead:
             self.ledger.inconclusive("RH-ACK-1", f"{_text(p)}: no $ACK, and the vehicle said nothing at all "
                                                  f"afterwards (a link fault?)", [p.ev], p.case)
+        for p in self.gave_up:
+            if p.ack is None and p.late_booked and not p.missing_booked:
+                p.missing_booked = True
+                self._book_missing(p)
         self.checks.close()
         if self.aborted:
             for cid in self.ledger.order:

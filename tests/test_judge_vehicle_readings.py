@@ -1,0 +1,182 @@
+"""The vehicle observer on hand-made sessions: how it reads what the wire shows.
+
+Each test is a short wire log written by hand — the exact bytes a vehicle and a backseat could
+exchange — checked offline with ``check_log`` (the observer ``certify vehicle`` uses too). The
+cases are the readings an observer gets wrong easily: motion it cannot see, happening between
+two polls; a violation the vehicle raises by itself; an answer that comes after the tester gave
+up; a line that must be discarded but is answered; an ``$OSD`` letter outside the alphabet.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from helmcheck.conformance.checklog.checker import check_log
+from helmcheck.grammar import checksum_hex
+from helmcheck.profile import DEFAULT
+
+PROFILE = DEFAULT  # no $OXFLT: a violation can only come from the vehicle itself
+LAT, LON = 41.520000, -71.320000
+
+
+def osi(mode: str, wp: int = 0, park: int = 0, err: str = "N", lat: float = LAT, lon: float = LON,
+        dist: float = 0.0, depth: float = 0.0, act: str = "8080808080", speed: float = 0.0,
+        mission: str = "conformance.mis") -> str:
+    return (f"OSI,{act},{mode},{wp},{lat:.8f},{lon:.8f},{speed:.2f},{dist:.2f},{err},38.00,P{park},-14.5000,"
+            f"{mission},4.5,75.5,{depth:.2f},94.3,False,IVER3-EMU,0.0,False,False")
+
+
+def write(tmp_path: Path, records: list[tuple], scale: float = 1.0) -> Path:
+    """A wire log from (t, dir, body) records; '>'/'<' bodies are framed with their checksum."""
+    lines = ["# helmcheck wire-log 1", f"# hand-made  baud 19200  time_scale {scale:g}"]
+    for t, d, body in records:
+        text = body if d in ("!",) or body.startswith("$") else f"${body}*{checksum_hex(body)}"
+        lines.append(f"{t:.6f} {d} {text}")
+    p = tmp_path / "made.log"
+    p.write_text("\n".join(lines) + "\n")
+    return p
+
+
+def poll(t: float, **fields) -> list[tuple]:
+    """``$OSD,S`` at ``t`` answered 10 ms later with the ``$OSI`` and 20 ms later with its ACK."""
+    return [(t, ">", "OSD,S"), (t + 0.01, "<", osi(**fields)), (t + 0.02, "<", "ACK,8,0,0")]
+
+
+def start(t: float = 0.0) -> list[tuple]:
+    return (poll(t, mode="S") + [(t + 0.1, ">", "OMSTART,0,0,0,0,conformance.mis,"), (t + 0.11, "<", "ACK,3,0,0")]
+            + poll(t + 0.2, mode="N", dist=150.0, speed=2.0))
+
+
+def judge(tmp_path, records, **kw) -> dict:
+    out = check_log(write(tmp_path, records), profile=kw.pop("profile", PROFILE), role="vehicle", **kw)
+    return {c["id"]: c for c in out.clauses}
+
+
+def verdict(v: dict, cid: str) -> str:
+    return v[cid]["verdict"]
+
+
+def no_fail(v: dict) -> list:
+    return [(c, e["reason"]) for c, e in v.items() if e["verdict"] in ("fail", "non-strict")]
+
+
+# ------------------------------------------------------------------------- unseen motion
+
+def test_RH_PK_2_a_countdown_that_began_between_two_polls_is_accepted(tmp_path):
+    """On station happened somewhere between two polls 30 s apart: the park time shown is what a
+    vehicle that arrived in that window shows — not a FAIL (the event is placed in its window)."""
+    rec = start() + [(1.0, ">", f"OPK,{LAT:.6f},{LON + 0.002:.6f},2,1"), (1.01, "<", "ACK,11,0,0")]
+    rec += poll(1.5, mode="mP", park=120, dist=160.0, speed=1.0)
+    rec += poll(31.5, mode="mP", park=100, dist=1.0, lon=LON + 0.002)
+    v = judge(tmp_path, rec)
+    assert no_fail(v) == []
+    assert verdict(v, "RH-OUT-4") == "pass"
+    assert verdict(v, "RH-PK-2") == "pass"
+
+
+def test_RH_PK_2_a_countdown_far_from_the_park_position_fails(tmp_path):
+    rec = start() + [(1.0, ">", f"OPK,{LAT:.6f},{LON + 0.002:.6f},2,1"), (1.01, "<", "ACK,11,0,0")]
+    rec += poll(1.5, mode="mP", park=120, dist=160.0, speed=1.0)
+    rec += poll(31.5, mode="mP", park=100, dist=150.0, speed=1.0)
+    v = judge(tmp_path, rec)
+    assert verdict(v, "RH-PK-2") == "fail"
+    assert "not on station" in v["RH-PK-2"]["reason"]
+
+
+def test_RH_PK_2_on_station_without_counting_fails(tmp_path):
+    rec = start() + [(1.0, ">", f"OPK,{LAT:.6f},{LON:.6f},2,1"), (1.01, "<", "ACK,11,0,0")]
+    for t in (1.5, 3.0, 4.5, 6.0):
+        rec += poll(t, mode="mP", park=120, dist=0.5)
+    v = judge(tmp_path, rec)
+    assert verdict(v, "RH-PK-2") == "fail"  # the park time a vehicle on station shows is counting
+
+
+def test_RH_MSN_4_at_the_last_waypoint_without_ending_fails(tmp_path):
+    """The profile's test mission has 4 waypoints; the vehicle reports itself 1 m from the last
+    one, in N, for 10 s: a conforming vehicle has reached it and ended the mission."""
+    rec = start() + [(1.0, ">", "OJW,3"), (1.01, "<", "ACK,7,0,0")]
+    for t in (2.0, 4.0, 6.0, 8.0, 10.0, 12.0):
+        rec += poll(t, mode="N", wp=3, dist=1.0, speed=2.0)
+    v = judge(tmp_path, rec)
+    assert verdict(v, "RH-MSN-4") == "fail"
+
+
+def test_RH_SAF_1_a_violation_the_vehicle_raises_by_itself_is_adopted_not_failed(tmp_path):
+    """No $OXFLT anywhere: a bench vehicle trips "no forward progress" on its own. The report
+    showing the code is explained by that unseen event; the lockout is judged (RH-SAF-1)."""
+    rec = start() + poll(5.0, mode="N", err="Sfp", dist=150.0)
+    rec += [(5.5, ">", "OMS,90,2,20,0.5,10"), (5.51, "<", "ACK,9,1,26")]
+    rec += [(6.0, ">", "ORWSET,Sle,R"), (6.01, "<", "ACK,12,1,26")]
+    v = judge(tmp_path, rec)
+    assert no_fail(v) == []
+    assert verdict(v, "RH-OUT-4") == "pass"
+    assert verdict(v, "RH-SAF-1") == "pass"
+
+
+def test_RH_OUT_4_a_waypoint_jump_nothing_explains_is_caught(tmp_path):
+    rec = start() + [(1.0, ">", "OMS,90,2,20,0.5,10"), (1.01, "<", "ACK,9,0,0")]
+    rec += poll(1.5, mode="A", wp=3)
+    v = judge(tmp_path, rec)
+    assert verdict(v, "RH-OUT-4") == "fail"
+
+
+def test_RH_INT_1_a_waypoint_reached_just_before_a_takeover_is_accepted(tmp_path):
+    """The vehicle reached waypoint 0 unseen just before the $OMS: A with the frozen waypoint 1."""
+    rec = start() + [(1.0, ">", "OMS,90,2,20,0.5,10"), (1.01, "<", "ACK,9,0,0")]
+    rec += poll(1.5, mode="A", wp=1)
+    v = judge(tmp_path, rec)
+    assert no_fail(v) == []
+
+
+# ------------------------------------------------------------------------- blame
+
+def test_RH_ACK_2_an_answer_after_the_tester_gave_up_belongs_to_its_command(tmp_path):
+    """The $OMS gets its ACK 4.5 s late, after a later $OSD was answered: RH-ACK-2 for the $OMS;
+    not RH-ACK-6 for anybody, and not RH-ACK-1 (an ACK came)."""
+    rec = start() + [(1.0, ">", "OMS,90,2,20,0.5,10")]
+    rec += poll(5.0, mode="A")
+    rec += [(5.5, "<", "ACK,9,0,0")] + poll(6.0, mode="A")
+    v = judge(tmp_path, rec)
+    assert verdict(v, "RH-ACK-2") == "fail" and v["RH-ACK-2"]["lines"][0] == 11
+    assert verdict(v, "RH-ACK-6") != "fail"
+    assert verdict(v, "RH-ACK-1") != "fail"
+
+
+@pytest.mark.parametrize("line,clause", [
+    ("$OMSTOP,0*07", "RH-FRM-2"),  # wrong checksum
+    ("$OMSTOP,0", "RH-FRM-4"),  # no checksum
+    ("$omstop,0*06", "RH-FRM-5"),  # lower-case ID
+])
+def test_any_answer_to_a_line_that_must_be_discarded_fails_its_discard_clause(tmp_path, line, clause):
+    """Even an error ACK (status 1) is an answer: the discard clause fails, whatever else."""
+    rec = start() + [(1.0, ">", line), (1.01, "<", "ACK,1,1,28")] + poll(2.0, mode="N", dist=150.0)
+    v = judge(tmp_path, rec)
+    assert verdict(v, clause) == "fail"
+
+
+def test_RH_OSD_2_a_letter_outside_the_alphabet_is_judged_under_its_own_clause(tmp_path):
+    rec = start() + [(1.0, ">", "OSD,Q"), (1.01, "<", "ACK,8,1,27")]
+    v = judge(tmp_path, rec)
+    assert verdict(v, "RH-OSD-2") == "pass"
+    rec = start() + [(1.0, ">", "OSD,Q"), (1.005, "<", osi(mode="N", dist=150.0)), (1.01, "<", "ACK,8,1,27")]
+    v = judge(tmp_path, rec)
+    assert verdict(v, "RH-OSD-2") == "fail"
+
+
+def test_RH_ACK_3_a_wrong_error_number_for_a_bad_field_blames_the_error_number(tmp_path):
+    rec = start() + [(1.0, ">", "OMS,400,2,20,0.5,10"), (1.01, "<", "ACK,9,1,21")]
+    v = judge(tmp_path, rec)
+    assert verdict(v, "RH-ACK-3") == "fail"
+    assert verdict(v, "RH-SRV-2") != "fail"
+
+
+def test_the_first_report_of_a_record_gives_the_state_it_starts_in(tmp_path):
+    """A capture that starts mid-mission: nothing before it is known, and nothing is failed for it."""
+    rec = poll(0.0, mode="N", wp=2, dist=300.0, speed=2.0) + [(1.0, ">", "OMS,90,2,20,0.5,10"),
+                                                             (1.01, "<", "ACK,9,0,0")]
+    rec += poll(1.5, mode="A", wp=2)
+    v = judge(tmp_path, rec)
+    assert no_fail(v) == []
+    assert verdict(v, "RH-OUT-4") == "pass"
