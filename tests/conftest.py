@@ -33,3 +33,41 @@ def no_process_left_behind():
     if left:
         kill(left)
         pytest.fail(f"processes started by helmcheck survived the test session: {left}", pytrace=False)
+
+
+def pytest_configure(config):
+    config.addinivalue_line("markers", "unverifiable: the test's results directories are tampered with on "
+                                       "purpose; the agreement check skips them")
+
+
+@pytest.fixture(autouse=True)
+def every_run_verifies(request):
+    """One judge per role: every results directory a test writes under its ``tmp_path`` is
+    re-judged from its ``wire.log`` by the offline observer (``helmcheck verify``), and every
+    clause verdict, the run verdict and the certificate flag must follow — live and offline agree."""
+    yield
+    tmp = request.node.funcargs.get("tmp_path") if hasattr(request.node, "funcargs") else None
+    if tmp is None or request.node.get_closest_marker("unverifiable"):
+        return
+    if hasattr(request.node, "rep_call") and request.node.rep_call.failed:
+        return
+    from helmcheck.reports.verify import verify_run
+
+    problems = []
+    for res in sorted(Path(tmp).rglob("results.json")):
+        d = res.parent
+        if not (d / "profile.toml").is_file():
+            continue  # not a certification (a report fixture, a check-log directory)
+        got = verify_run(d)
+        if not got.ok:
+            problems.append(f"{d}: " + "; ".join(map(str, got.findings[:6])))
+    if problems:
+        pytest.fail("live and offline judging disagree:\n" + "\n".join(problems), pytrace=False)
+
+
+@pytest.hookimpl(hookwrapper=True)
+def pytest_runtest_makereport(item, call):
+    outcome = yield
+    rep = outcome.get_result()
+    if rep.when == "call":
+        item.rep_call = rep

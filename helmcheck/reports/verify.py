@@ -12,7 +12,7 @@
    recorded, the recorded time scale), and every clause verdict, the run verdict and the
    ``certificate`` flag of ``results.json`` must be the ones the re-judged verdicts give. Only
    verdict words are compared, not reasons or evidence. Clauses a ``--select`` run did not select
-   must be NOT-TESTED and are not re-judged;
+   must be NOT-TESTED — or a FAIL the run observed anyway, which is re-judged like the others;
 5. if the run is signed (``signature.json``, :mod:`.certificate`), the Ed25519 signature must
    hold over the manifest and the manifest must name the files as they are now; with a trusted
    public key (``--public-key``) the signature must be that key's, and an unsigned run fails.
@@ -204,7 +204,8 @@ def _rejudge(out: Verification, directory: Path, results: Mapping[str, Any], pro
     verdicts: dict[str, str] = {}
     for cid, entry in recorded.items():
         said = entry["verdict"]
-        if not _selected(results, cid):
+        if not _selected(results, cid) and said not in ("fail", "non-strict"):
+            # outside the selection only what was observed to fail is reported; it is re-judged
             verdicts[cid] = said
             if said != "not-tested":
                 out.add(f"clause {cid}", f"results.json says {_word(said)}, but the run did not select it "

@@ -169,7 +169,7 @@ class _Vehicle:
             self.observer.feed(WireEvent(c.t, c.direction, c.data, "", c.lineno))
 
     def entries(self, to_vehicle: bool, from_vehicle: bool) -> list:
-        if not from_vehicle:
+        if not from_vehicle and not self.observer.aborted:
             led = Ledger(VEHICLE_CLAUSES)
             for c in VEHICLE_CLAUSES:
                 led.not_tested(c, "One-direction log: it has no vehicle→backseat traffic, so the vehicle's "
