@@ -35,5 +35,11 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
                               epilog=getattr(mod, "EPILOG", None))
         mod.add_arguments(rp)
         rp.set_defaults(func=mod.run)
-    p.set_defaults(func=lambda args: (p.print_help(), 64)[1])
+    p.set_defaults(func=_no_role)
     return p
+
+
+def _no_role(args: argparse.Namespace) -> int:
+    from ..failures import UsageError
+
+    raise UsageError(f"choose a role: {' or '.join(ROLES)} (see 'helmcheck certify --help')")
