@@ -97,7 +97,7 @@ def prog_of(args: Optional[argparse.Namespace]) -> str:
     words = ["helmcheck"]
     if args is not None and getattr(args, "command", None):
         words.append(args.command)
-        if getattr(args, "role", None):
+        if args.command == "certify" and getattr(args, "role", None):
             words.append(args.role)
     return " ".join(words)
 
