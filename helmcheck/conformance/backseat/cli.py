@@ -14,16 +14,14 @@ from __future__ import annotations
 
 import argparse
 import math
-import shutil
-import signal
 import sys
-import threading
 import time
 from datetime import datetime, timezone
 from pathlib import Path
 from typing import Any, Callable, Optional
 
 from ... import exitcodes
+from ...failures import describe_interrupt
 from .scenarios import SCENARIOS
 
 __all__ = ["add_arguments", "run", "EPILOG"]
@@ -68,6 +66,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--connect-timeout", type=float, default=30.0, metavar="S",
                    help="seconds to wait for the backseat's first byte (default 30)")
     p.add_argument("--baud", type=int, metavar="N", help="line rate (default: the profile's)")
+    p.add_argument("--overwrite", action="store_true",
+                   help="replace an earlier run in --report-dir (its results, wire log and reports are "
+                        "removed first); without it such a directory is refused")
 
 
 def _usage(msg: str) -> int:
@@ -143,11 +144,9 @@ def run(args: argparse.Namespace, *, on_port: Optional[Callable[[str], None]] = 
     started_dt = datetime.now(timezone.utc)
     stamp = started_dt.strftime("%Y%m%dT%H%M%SZ")
     report_dir = Path(args.report_dir) if args.report_dir else Path("reports") / f"backseat-{stamp}"
-    try:
-        report_dir.mkdir(parents=True, exist_ok=True)
-        log_file = open(report_dir / "wire.log", "w", encoding="utf-8")
-    except OSError as e:
-        return _usage(f"cannot write to {report_dir}: {e.strerror or e}")
+    # Command-line hooks (helmcheck.outputs, helmcheck.commands.ports): every path and the port
+    # checked before anything is written; the port opened once, here (exit 64 if it cannot be).
+    link, log_file = _open_outputs_and_port(args, spec, profile, report_dir)
     settings: dict[str, Any] = {"time_scale": float(scale), "strict": bool(args.strict),
                                 "duration_s": float(args.duration), "planned_s": round(plan.total, 3),
                                 "scenarios": list(dict.fromkeys(names)), "baud": baud,
@@ -157,25 +156,36 @@ def run(args: argparse.Namespace, *, on_port: Optional[Callable[[str], None]] = 
                                                        else [f"--port {args.port}"])
     started = started_dt.isoformat(timespec="seconds").replace("+00:00", "Z")
     return _certify(args, profile, spec, plan, report_dir, log_file, settings, command, started, started_dt,
-                    on_port)
+                    on_port, link)
+
+
+def _open_outputs_and_port(args, spec, profile, report_dir: Path):
+    """(link, wire-log stream): paths checked, port opened, report directory prepared."""
+    from ...commands.ports import open_port
+    from ...outputs import check_writable, open_output_stream, prepare_report_dir
+    from .link import HangupPty
+
+    if args.wire_log:
+        check_writable(args.wire_log, "--wire-log")
+    prepare_report_dir(report_dir, args.overwrite, clear=False)
+    link = open_port(spec, role="server", baud=profile.baud,
+                     opener=(lambda: HangupPty(profile.baud)) if spec.kind == "pty" else None)
+    try:
+        prepare_report_dir(report_dir, args.overwrite)
+        args.report_dir = str(report_dir)  # where a tester error's traceback goes
+        return link, open_output_stream(report_dir / "wire.log", "--report-dir", stop=False, what="wire log")
+    except BaseException:
+        link.close()
+        raise
 
 
 def _certify(args, profile, spec, plan, report_dir: Path, log_file, settings, command: str,
-             started: str, started_dt: datetime, on_port=None) -> int:
-    from ..transport import open_link
-    from .link import HangupPty
-
+             started: str, started_dt: datetime, on_port=None, link=None) -> int:
     strict = bool(args.strict)
-    link = None
     outcome = None
     reason = ""
     progress = None
     try:
-        try:
-            link = HangupPty(profile.baud) if spec.kind == "pty" else open_link(spec, role="server", baud=profile.baud)
-        except (OSError, ValueError) as e:
-            reason = f"cannot open {args.port}: {getattr(e, 'strerror', None) or e}"
-            print(f"helmcheck certify backseat: {reason}", file=sys.stderr)
         if link is not None:
             try:
                 sys.stdout.write(f"port: {link.name}\n")
@@ -200,15 +210,13 @@ def _certify(args, profile, spec, plan, report_dir: Path, log_file, settings, co
             runner = Runner(link, profile, plan, time_scale=profile.time_scale,
                             missions=DirectoryCatalog([builtin_dir()]), log=log,
                             connect_timeout=args.connect_timeout, progress=progress)
-            old = {}
-            if threading.current_thread() is threading.main_thread():
-                for sig in (signal.SIGINT, signal.SIGTERM):
-                    old[sig] = signal.signal(sig, lambda *_: runner.stop("interrupted"))
             try:
                 outcome = runner.run()
+            except KeyboardInterrupt as e:  # Ctrl-C, SIGTERM, SIGHUP (helmcheck.signals)
+                outcome = runner.outcome
+                outcome.status = "interrupted"
+                outcome.reason = f"the run was {describe_interrupt(e)} after {outcome.ended_at - (outcome.connected_at or 0.0):.1f} s"
             finally:
-                for sig, h in old.items():
-                    signal.signal(sig, h)
                 progress.stop()
     finally:
         if link is not None:
@@ -217,6 +225,8 @@ def _certify(args, profile, spec, plan, report_dir: Path, log_file, settings, co
             log_file.close()
         except OSError:
             pass
+    from ...failures import OutputLost
+    from ...outputs import copy_output
     from ...reports.results import ReportError, exit_code
     from ...reports.view import VERDICT_LABEL
     from .report import build_results, write_reports
@@ -226,14 +236,15 @@ def _certify(args, profile, spec, plan, report_dir: Path, log_file, settings, co
                             reason=reason)
     try:
         write_reports(report_dir, results)
-        if args.wire_log:
-            shutil.copyfile(report_dir / "wire.log", args.wire_log)
     except (ReportError, OSError) as e:
-        print(f"helmcheck certify backseat: report not written: {e}", file=sys.stderr)
-        return exitcodes.INCONCLUSIVE
+        raise OutputLost(f"report not written: {e}") from None
     verdict = results["verdict"]
     partial = " (PARTIAL)" if results["partial"] else ""
     print(f"{VERDICT_LABEL[verdict]}{partial}: {results['verdict_reason']}")
     print(f"helmcheck certify backseat: report in {report_dir}", file=sys.stderr)
     sys.stdout.flush()
+    if hasattr(log_file, "check"):
+        log_file.check()  # the wire log lost on the way is exit 2, after the verdict line
+    if args.wire_log:
+        copy_output(report_dir / "wire.log", args.wire_log, what="wire log copy")
     return exit_code(verdict, strict)

@@ -432,13 +432,19 @@ class EmulatorCore:
                 store.write(name, state, tuple(values[:3]))
 
     def _save_settings(self, path: Path) -> None:
+        """Keep the ``$ORWSET`` settings across runs (RH-SET-2), written atomically (a crash
+        leaves the old file or the new one). A file that cannot be written stops the emulator
+        with :class:`~helmcheck.failures.OutputLost` naming it: a vehicle that acknowledged a
+        write it cannot keep must not go on serving as if it had."""
+        from ...failures import OutputLost
+        from ...reports.atomic import write_text_atomic
+
         data = {k: [st, list(vals)] for k, (st, vals) in self.model.settings.as_dict().items()}
-        tmp = Path(str(path) + ".tmp")
         try:
-            tmp.write_text(json.dumps(data, indent=1) + "\n", encoding="utf-8")
-            tmp.replace(path)
+            write_text_atomic(path, json.dumps(data, indent=1) + "\n")
         except OSError as e:
             self._note(self.wall_time(self.v), f"settings not saved: {e}")
+            raise OutputLost(f"cannot write settings {path}: {e.strerror or e}") from None
 
     # ================================================================ live view
     def view(self) -> dict[str, Any]:

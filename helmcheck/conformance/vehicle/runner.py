@@ -17,10 +17,11 @@ import shutil
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Optional
+from typing import IO, Any, Callable, Optional
 
 from ... import __version__
 from ...clauses import vehicle_clauses
+from ...failures import describe_interrupt
 from ...model.transitions import REMOTE_MODES
 from ...profile import Profile
 from ...reports import results as R
@@ -54,6 +55,11 @@ class Options:
     command: str = ""
     render: bool = True
     explore_budget_s: Optional[float] = None  #: wall seconds for exploration (default: the hypothesis profile's)
+    # Command-line hooks (helmcheck.conformance.vehicle.cli): the link the command already
+    # opened (a port that cannot be opened is a usage error there), and how to open wire.log
+    # (a stream that remembers a write error for the command to report).
+    link: Optional[Any] = None
+    log_opener: Optional[Callable[[Path], IO[str]]] = None
 
 
 @dataclass
@@ -184,6 +190,8 @@ class Run:
         r["stats"] = self.stats
         if final:
             R.finish(r, partial=self.partial, strict=self.o.strict, duration_s=self.stats["wall_s"])
+            if self.partial and self.aborted:
+                r["verdict_reason"] = f"{self.aborted[:1].upper()}{self.aborted[1:]}. {r['verdict_reason']}"
         else:
             r["partial"] = True
             r["verdict"] = R.run_verdict([c["verdict"] for c in r["clauses"]], strict=self.o.strict, partial=True)
@@ -198,11 +206,15 @@ class Run:
     # ------------------------------------------------------------------ main
     def open(self) -> None:
         wire_path = self.dir / R.WIRE_LOG_NAME
-        self.log_file = open(wire_path, "w", encoding="utf-8")
+        if self.o.log_opener is not None:
+            self.log_file = self.o.log_opener(wire_path)
+        else:
+            self.log_file = open(wire_path, "w", encoding="utf-8")
         meta = (f"started {time.strftime('%Y-%m-%dT%H:%M:%SZ', time.gmtime())}  port {self.o.port}  "
                 f"baud {self.p.baud}  time_scale {self.k:g}")
         try:
-            raw = open_link(self.o.port, role="client", baud=self.p.baud)
+            raw = self.o.link if self.o.link is not None else open_link(self.o.port, role="client",
+                                                                         baud=self.p.baud)
         except (OSError, ValueError) as e:
             self.log_file.write("# helmcheck wire-log 1\n")
             raise LinkLost(f"cannot open {self.o.port}: {getattr(e, 'strerror', None) or e}") from None
@@ -329,9 +341,13 @@ def certify(opts: Options) -> Outcome:
         except LinkLost as e:
             run.aborted = run.aborted or f"link fault: {e}"
             run.progress.note(f"link fault: {e}")
-    except KeyboardInterrupt:
+    except KeyboardInterrupt as e:  # Ctrl-C, SIGTERM, SIGHUP (helmcheck.signals)
         run.partial = True
-        run.aborted = "interrupted (Ctrl-C)"
+        run.aborted = describe_interrupt(e)
+    except Exception as e:  # a tester error: the results say partial, the command line says why
+        run.partial = True
+        run.aborted = f"tester error ({type(e).__name__})"
+        raise
     finally:
         run.progress.stop()
         try:
