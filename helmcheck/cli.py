@@ -66,9 +66,14 @@ Run 'helmcheck COMMAND --help' for each command's options.
 """
 
 
+def one_line(text: str) -> str:
+    """``text`` as one printable line: control characters (a ``\\r`` in an argument) escaped."""
+    return "".join(c if c.isprintable() or c == " " else repr(c)[1:-1] for c in " ".join(text.split(" ")))
+
+
 class _Parser(argparse.ArgumentParser):
     def error(self, message: str):  # usage errors exit 64 (not argparse's 2), in one line
-        self.exit(exitcodes.USAGE, f"{self.prog}: error: {message} (see '{self.prog} --help')\n")
+        self.exit(exitcodes.USAGE, one_line(f"{self.prog}: error: {message} (see '{self.prog} --help')") + "\n")
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -103,7 +108,7 @@ def prog_of(args: Optional[argparse.Namespace]) -> str:
 
 
 def _say(prog: str, message: str) -> None:
-    print(f"{prog}: {' '.join(message.split())}", file=sys.stderr)
+    print(one_line(f"{prog}: {message}"), file=sys.stderr)
 
 
 def save_traceback(exc: BaseException, args: Optional[argparse.Namespace]) -> str:
@@ -135,9 +140,11 @@ def _dispatch(argv: list[str]) -> int:
     try:
         parser = build_parser()
         try:
-            args = parser.parse_args(argv)
+            args, extra = parser.parse_known_args(argv)
         except SystemExit as e:  # --help, --version (0) or a usage error (64)
             return e.code if isinstance(e.code, int) else exitcodes.USAGE
+        if extra:  # named by the subcommand that got them, not by the top-level parser
+            raise UsageError(f"error: unrecognized arguments: {' '.join(extra)} (see '{prog_of(args)} --help')")
         if not getattr(args, "func", None):
             raise UsageError(f"no command given; choose one of {', '.join(SUBCOMMANDS)} "
                              f"(see 'helmcheck --help')")
@@ -165,6 +172,7 @@ def _dispatch(argv: list[str]) -> int:
 
 def main(argv: Optional[list[str]] = None) -> int:
     """Run one command; returns its exit status (see the module docstring)."""
+    entry = argv is None  # the process's own entry point (console script, python -m helmcheck)
     if argv is not None:
         sys.argv[1:] = argv
     saved = sys.stdout, sys.stderr
@@ -172,7 +180,7 @@ def main(argv: Optional[list[str]] = None) -> int:
     err = GuardedStream(sys.stderr, "standard error")
     sys.stdout, sys.stderr = out, err  # type: ignore[assignment]
     try:
-        with ending_signals():
+        with ending_signals(linger=entry):
             code = _dispatch(sys.argv[1:])
             try:
                 out.flush()

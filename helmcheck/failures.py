@@ -42,7 +42,7 @@ class Failure(Exception):
     kind: str = "failure"
 
     def __init__(self, message: str):
-        super().__init__(" ".join(str(message).split()) or self.kind)
+        super().__init__(str(message) or self.kind)
 
     @property
     def message(self) -> str:

@@ -42,8 +42,12 @@ class _Handler:
 
 
 @contextmanager
-def ending_signals() -> Iterator[None]:
-    """Within the block, the ending signals raise :class:`Interrupted` (module docstring)."""
+def ending_signals(*, linger: bool = False) -> Iterator[None]:
+    """Within the block, the ending signals raise :class:`Interrupted` (module docstring).
+
+    With ``linger`` (the process's own entry point), once a signal has ended the run SIGTERM
+    and SIGHUP stay ignored after the block too, until the process exits: a repeated ``kill``
+    cannot cut the last lines short. Without it the earlier handlers are put back."""
     if threading.current_thread() is not threading.main_thread():
         yield
         return
@@ -57,4 +61,6 @@ def ending_signals() -> Iterator[None]:
         yield
     finally:
         for sig, h in old.items():
+            if linger and handler.raised is not None and sig != signal.SIGINT:
+                h = signal.SIG_IGN
             signal.signal(sig, h)

@@ -121,6 +121,11 @@ def run(args: argparse.Namespace) -> int:  # noqa: C901 - argument checks, then 
         check_writable(main_log_path, "--main-log")
     if args.settings:
         _check_settings_file(args.settings)
+    from .ports import open_port
+
+    # the port first (before the grammar loads, so a bad one fails fast), then the logs: a port
+    # that cannot be opened leaves every file as it was
+    link = open_port(spec, role="server", baud=baud if baud else 19200, selectable=True)
     log_file = main_log_file = None
     try:
         if args.log:
@@ -128,7 +133,10 @@ def run(args: argparse.Namespace) -> int:  # noqa: C901 - argument checks, then 
         if main_log_path:
             main_log_file = open_output_stream(main_log_path, "--main-log", stop=True, what="main log",
                                                newline="")
-        return _serve(args, profile, spec, baud, missions_dir, log_file, main_log_file)
+        return _serve(args, profile, link, baud, missions_dir, log_file, main_log_file)
+    except BaseException:
+        link.close()
+        raise
     finally:
         for f in (log_file, main_log_file):
             if f is not None and not f.closed:
@@ -138,17 +146,14 @@ def run(args: argparse.Namespace) -> int:  # noqa: C901 - argument checks, then 
                     pass
 
 
-def _serve(args, profile, spec, baud, missions_dir, log_file, main_log_file) -> int:
+def _serve(args, profile, link, baud, missions_dir, log_file, main_log_file) -> int:
     """Serve until stopped. A signal (:mod:`helmcheck.signals`) stops it with exit 0; a link that
     fails during the run is a :class:`~helmcheck.failures.LinkFault` (exit 2); a log that cannot
     be written stops it with :class:`~helmcheck.failures.OutputLost` (exit 2)."""
     import time
 
     from ..failures import LinkFault, describe_interrupt
-    from .ports import open_port
 
-    # before the grammar loads, so a bad port fails fast
-    link = open_port(spec, role="server", baud=baud if baud else 19200, selectable=True)
     log = server = ui = core = None
     try:
         from ..conformance.emulator.core import EmulatorCore, MainLog

@@ -52,6 +52,13 @@ def run(args: argparse.Namespace) -> int:
         doc = load_replay(args.file)
     except ReplayError as e:
         raise PathError(str(e)) from None
+    for i, st in enumerate(doc["steps"]):  # every value usable before the port is opened
+        ok = (isinstance(st.get("send", ""), str) and isinstance(st.get("expect", ""), str)
+              and (not isinstance(st.get("wait", 0.0), bool) and isinstance(st.get("wait", 0.0), (int, float))
+                   and math.isfinite(st.get("wait", 0.0)) and st.get("wait", 0.0) >= 0))
+        if not ok:
+            raise PathError(f"{args.file}: step {i}: send and expect must be text, wait a number of "
+                            f"seconds ≥ 0")
     if args.profile:
         profile = load_profile(args.profile)  # a ProfileError is exit 64 (helmcheck.cli)
     else:
