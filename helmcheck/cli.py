@@ -23,11 +23,7 @@ from __future__ import annotations
 
 import argparse
 import importlib
-import os
 import sys
-import tempfile
-import time
-import traceback
 from pathlib import Path
 from typing import Optional
 
@@ -113,6 +109,11 @@ def _say(prog: str, message: str) -> None:
 
 def save_traceback(exc: BaseException, args: Optional[argparse.Namespace]) -> str:
     """Write the traceback of a tester error to a file; returns where (or why it could not)."""
+    import os
+    import tempfile
+    import time
+    import traceback
+
     text = (f"helmcheck {__version__} tester error\n"
             f"command: helmcheck {' '.join(sys.argv[1:])}\n"
             f"time: {time.strftime('%Y-%m-%dT%H:%M:%SZ', time.gmtime())}\n"
