@@ -4,10 +4,13 @@ The command opens the port (``--port pty`` prints ``port: /dev/pts/N`` as its fi
 standard output, flushed, for the backseat to open; a device path is opened 8N1 at the
 profile's baud; ``socket://HOST:PORT`` serves one client), plays the reference vehicle, stages
 the scenarios of :mod:`.scenarios` and judges every byte the backseat sends (:mod:`.judge`).
-At the end (also after Ctrl-C, a backseat that never connected or one that went away) it writes
+At the end (also after Ctrl-C, SIGTERM or SIGHUP — :mod:`helmcheck.signals` raises them as
+``KeyboardInterrupt`` —, a backseat that never connected or one that went away) it writes
 ``results.json``, ``wire.log`` and every report format into ``--report-dir``, prints one verdict
 line on standard output and exits 0 (pass; non-strict without ``--strict``), 1 (fail), 2
-(inconclusive) or 64 (usage). Progress goes to standard error.
+(inconclusive; or a report, wire log or ``--wire-log`` copy that could not be written) or 64
+(usage: bad option or profile, a port that cannot be opened, a report directory holding an
+earlier run without ``--overwrite``). Progress goes to standard error.
 """
 
 from __future__ import annotations
