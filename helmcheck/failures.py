@@ -7,28 +7,25 @@ raises the class with a one-line message; :mod:`helmcheck.cli` prints it as
 prints, and nothing here imports more than the standard library, so any layer may raise them
 (the emulator core raises :class:`OutputLost` when its settings file cannot be saved).
 
-===================  =====  ===========================================================
-class                code   meaning
-===================  =====  ===========================================================
-:class:`UsageError`    64   a bad option or argument on the command line
-:class:`PathError`     64   a path or port the user named cannot be used at start:
-                            an unreadable input (profile, log, results directory, replay),
-                            an output directory that cannot be created, a port that does
-                            not exist or cannot be opened, an unknown URL scheme
-:class:`ProfileValueError` 64  a profile file with a bad key or value
-:class:`LinkFault`      2   the link worked at start and failed during the run
-:class:`OutputLost`     2   an output file could not be written (a full disk, a vanished
-                            directory); the message names the file
-:class:`Interrupted`    -   SIGINT, SIGTERM or SIGHUP: a :class:`KeyboardInterrupt`, so
-                            code that already ends a run cleanly on Ctrl-C does the same
-===================  =====  ===========================================================
+- :class:`UsageError` (64): a bad option or argument on the command line.
+- :class:`PathError` (64): a path or port the user named cannot be used at start — an
+  unreadable input (profile, log, results directory, replay), an output directory that cannot
+  be created or holds an earlier run, a port that does not exist or cannot be opened, an
+  unknown URL scheme.
+- :class:`~helmcheck.profile.ProfileError` (64): a profile with a bad key or value; defined
+  with the profile, mapped by :mod:`helmcheck.cli` like the classes here.
+- :class:`LinkFault` (2): the link worked at start and failed during the run.
+- :class:`OutputLost` (2): an output file could not be written (a full disk, a vanished
+  directory); the message names the file.
+- :class:`Interrupted`: SIGINT, SIGTERM or SIGHUP, a :class:`KeyboardInterrupt`, so code that
+  already ends a run cleanly on Ctrl-C does the same.
 
 Any other exception is a tester error: exit 2, with the traceback saved to a file.
 """
 
 from __future__ import annotations
 
-__all__ = ["Failure", "UsageError", "PathError", "ProfileValueError", "LinkFault", "OutputLost",
+__all__ = ["Failure", "UsageError", "PathError", "LinkFault", "OutputLost",
            "Interrupted", "USAGE", "TESTER", "describe_interrupt"]
 
 USAGE = 64  #: EX_USAGE: the run did not start
@@ -61,13 +58,6 @@ class PathError(Failure):
 
     code = USAGE
     kind = "path"
-
-
-class ProfileValueError(Failure):
-    """A profile with a bad key or value (exit 64); the message names file, key and value."""
-
-    code = USAGE
-    kind = "profile"
 
 
 class LinkFault(Failure):
