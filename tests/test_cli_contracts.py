@@ -28,7 +28,7 @@ from hypothesis import strategies as st
 from helmcheck.cli import main
 from helmcheck.conformance.transport import PtyLink
 from helmcheck.reports.results import load_results
-from tests.faulty_vehicles import EMU_PROFILE, make_core, serve
+from tests.faulty_vehicles import make_core, serve
 
 ROOT = Path(__file__).resolve().parents[1]
 LOGS = ROOT / "tests" / "fixtures" / "logs"
