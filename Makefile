@@ -4,7 +4,12 @@ VENV   := .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 
-.PHONY: demo test bench docs clean
+.PHONY: demo test fuzz bench docs clean
+
+#: The property tests, for `make fuzz`.
+FUZZ_TESTS := tests/test_grammar_fastpath.py tests/test_grammar_framer.py tests/test_grammar_roundtrip.py \
+              tests/test_model_observe.py tests/test_model_stateful.py tests/test_reports_results.py \
+              tests/test_certify_backseat_judge.py tests/test_cli_contracts.py
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -17,6 +22,11 @@ demo: $(STAMP)
 
 test: $(STAMP)
 	$(PY) -m pytest
+
+# Not run by CI: the same property tests with random seeds and 20 times the examples
+# (tests/conftest.py, profile "fuzz"). A failure prints the blob that reproduces it.
+fuzz: $(STAMP)
+	HYPOTHESIS_PROFILE=fuzz $(PY) -m pytest $(FUZZ_TESTS)
 
 bench: $(STAMP)
 	$(PY) benchmarks/run_all.py

@@ -1,15 +1,22 @@
 """Parse throughput: helmcheck.grammar on a generated mixed capture, and pynmea2 on $GPRMC.
 
-Run: python benchmarks/parse_bench.py [--lines N]   (default 1,000,000)
+Run: python benchmarks/parse_bench.py [--lines N] [--rounds R]   (default 1,000,000 and 5)
 Prints lines per second for the fast path (fully typed objects, ranges checked), for the Lark
-reference path on a sample, and for pynmea2 and helmcheck on the same $GPRMC lines.
+reference path on a sample, and for pynmea2 and helmcheck on the same $GPRMC lines — in
+process, and as whole processes: ``helmcheck parse FILE`` against a ``python -c`` pynmea2 loop
+that reads the same file and prints one line per sentence (start-up, reading and output
+included; median of R alternating runs, so load on the machine hits both alike).
 """
 
 from __future__ import annotations
 
 import argparse
+import os
 import random
+import statistics
+import subprocess
 import sys
+import tempfile
 import time
 from pathlib import Path
 
@@ -50,10 +57,58 @@ def rate(fn, lines) -> float:
     return len(lines) / (time.perf_counter() - t)
 
 
+#: The pynmea2 side of the whole-process comparison: read the file, parse every line with the
+#: checksum checked, print one line per sentence.
+PYNMEA2_LOOP = """
+import sys, pynmea2
+with open(sys.argv[1]) as f:
+    for line in f:
+        m = pynmea2.parse(line, check=True)
+        print(m.sentence_type)
+"""
+
+
+def _wall(argv: list[str]) -> float:
+    t = time.perf_counter()
+    subprocess.run(argv, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, stdin=subprocess.DEVNULL,
+                   check=True)
+    return time.perf_counter() - t
+
+
+def whole_process(rmc: list[bytes], rounds: int) -> None:
+    """``helmcheck parse FILE`` (and ``--json``) against the pynmea2 loop, as whole processes."""
+    root = str(Path(__file__).resolve().parent.parent)
+    env_path = root + os.pathsep + os.environ.get("PYTHONPATH", "")
+    os.environ["PYTHONPATH"] = env_path
+    with tempfile.TemporaryDirectory() as d:
+        path = os.path.join(d, "gprmc.txt")
+        with open(path, "wb") as f:
+            f.writelines(rmc)
+        runs: dict[str, list[float]] = {"helmcheck parse": [], "helmcheck parse --json": [], "pynmea2 loop": []}
+        cmds = {"helmcheck parse": [sys.executable, "-m", "helmcheck", "parse", path],
+                "helmcheck parse --json": [sys.executable, "-m", "helmcheck", "parse", "--json", path],
+                "pynmea2 loop": [sys.executable, "-c", PYNMEA2_LOOP, path]}
+        for _ in range(rounds):
+            for name, argv in cmds.items():
+                runs[name].append(_wall(argv))
+    med = {k: statistics.median(v) for k, v in runs.items()}
+    base = med["pynmea2 loop"]
+    print(f"whole process, {len(rmc):,} $GPRMC lines (median of {rounds} alternating runs):")
+    for name, m in med.items():
+        print(f"  {name:<24} {m:6.2f} s  ({m / base:.2f} x the pynmea2 loop; runs "
+              + ", ".join(f"{x:.2f}" for x in runs[name]) + ")")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--lines", type=int, default=1_000_000)
+    ap.add_argument("--rounds", type=int, default=5, help="alternating whole-process runs (default 5)")
+    ap.add_argument("--whole-process-only", action="store_true", help="skip the in-process figures")
     args = ap.parse_args()
+    if args.whole_process_only:
+        lines = mixed_lines(max(args.lines, 1_700_000))
+        whole_process([x for x in lines if x.startswith(b"$GPRMC")][:200_000], args.rounds)
+        return
     lines = mixed_lines(args.lines)
     bad = sum(1 for x in lines[:20000] if not decode(x).valid)
     assert bad == 0, f"{bad} generated lines are invalid"
@@ -78,6 +133,9 @@ def main() -> None:
         r_p = max(r_p, rate(lambda x: pynmea2.parse(x, check=True), rmc_text))
     print(f"$GPRMC x{len(rmc):,} (best of 3 alternating rounds): helmcheck {r_h:,.0f} lines/s "
           f"(typed, ranges checked); pynmea2 parse(check=True) {r_p:,.0f} lines/s; ratio {r_h / r_p:.2f}")
+    if len(rmc) < 200_000:
+        rmc = [x for x in mixed_lines(1_700_000) if x.startswith(b"$GPRMC")][:200_000]
+    whole_process(rmc, args.rounds)
 
 
 if __name__ == "__main__":

@@ -1,7 +1,22 @@
-"""The ``helmcheck`` command line: one entry point, one module per subcommand.
+"""The ``helmcheck`` command line: one entry point, one module per subcommand, one failure layer.
 
 Exit codes (see :mod:`helmcheck.exitcodes`): 0 conformant, 1 non-conformant, 2 inconclusive or
 tester error, 64 usage. Subcommand modules are imported only when used, so ``--help`` is fast.
+
+:func:`main` is the only place a failure becomes an exit code and a message (the table
+"Failures and exit codes" in ``docs/contracts.md``):
+
+- a :class:`~helmcheck.failures.Failure` (usage, path, profile, link, output) prints
+  ``helmcheck COMMAND: message`` — one line — and exits with the class's code;
+- SIGINT, SIGTERM and SIGHUP raise :class:`~helmcheck.failures.Interrupted` (a
+  :class:`KeyboardInterrupt`) through :mod:`helmcheck.signals`; a command that runs a session
+  ends it with partial results, anything else exits 2 (``emulate``: 0, it was asked to stop);
+- standard output and error are :class:`~helmcheck.streams.GuardedStream` s: a reader that went
+  away (``| head``, a closed terminal) ends the command quietly, any other write error on
+  standard output is exit 2;
+- any other exception is a tester error: exit 2, the traceback saved to ``tester-error.txt`` in
+  the command's report directory (or a temporary file) and one line on stderr pointing to it.
+  A tester error never exits 1 and never prints a bare traceback.
 """
 
 from __future__ import annotations
@@ -9,8 +24,13 @@ from __future__ import annotations
 import argparse
 import importlib
 import sys
+from pathlib import Path
+from typing import Optional
 
 from . import __version__, exitcodes
+from .failures import Failure, UsageError, describe_interrupt
+from .signals import ending_signals
+from .streams import GuardedStream
 
 #: subcommand -> (module, one-line help). Each module has add_parser(sub) and run(args).
 SUBCOMMANDS = {
@@ -25,6 +45,10 @@ SUBCOMMANDS = {
     "keygen": ("helmcheck.commands.keygen_cmd", "make an Ed25519 key pair for signing results"),
     "docs": ("helmcheck.commands.docs_cmd", "regenerate the generated documentation"),
 }
+
+#: Exit code of a command stopped by a signal before it could end its run itself.
+INTERRUPT_CODE = {"emulate": exitcodes.OK}
+TRACEBACK_NAME = "tester-error.txt"
 
 DESCRIPTION = """\
 helmcheck — the formal model and conformance suite for the Iver3 remote helm protocol.
@@ -43,10 +67,14 @@ Run 'helmcheck COMMAND --help' for each command's options.
 """
 
 
+def one_line(text: str) -> str:
+    """``text`` as one printable line: control characters (a ``\\r`` in an argument) escaped."""
+    return "".join(c if c.isprintable() or c == " " else repr(c)[1:-1] for c in " ".join(text.split(" ")))
+
+
 class _Parser(argparse.ArgumentParser):
-    def error(self, message: str):  # usage errors exit 64, not argparse's 2
-        self.print_usage(sys.stderr)
-        self.exit(exitcodes.USAGE, f"{self.prog}: error: {message}\n")
+    def error(self, message: str):  # usage errors exit 64 (not argparse's 2), in one line
+        self.exit(exitcodes.USAGE, one_line(f"{self.prog}: error: {message} (see '{self.prog} --help')") + "\n")
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -70,19 +98,108 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-def main(argv: list[str] | None = None) -> int:
+def prog_of(args: Optional[argparse.Namespace]) -> str:
+    """``helmcheck certify vehicle``, ``helmcheck parse``, … for messages."""
+    words = ["helmcheck"]
+    if args is not None and getattr(args, "command", None):
+        words.append(args.command)
+        if args.command == "certify" and getattr(args, "role", None):
+            words.append(args.role)
+    return " ".join(words)
+
+
+def _say(prog: str, message: str) -> None:
+    print(one_line(f"{prog}: {message}"), file=sys.stderr)
+
+
+def save_traceback(exc: BaseException, args: Optional[argparse.Namespace]) -> str:
+    """Write the traceback of a tester error to a file; returns where (or why it could not)."""
+    import os
+    import tempfile
+    import time
+    import traceback
+
+    text = (f"helmcheck {__version__} tester error\n"
+            f"command: helmcheck {' '.join(sys.argv[1:])}\n"
+            f"time: {time.strftime('%Y-%m-%dT%H:%M:%SZ', time.gmtime())}\n"
+            f"python: {sys.version.split()[0]} on {sys.platform}\n\n"
+            + "".join(traceback.format_exception(exc)))
+    rdir = (getattr(args, "current_report_dir", None) or getattr(args, "report_dir", None)) if args else None
+    if rdir and Path(rdir).is_dir():
+        path = Path(rdir) / TRACEBACK_NAME
+        try:
+            path.write_text(text, encoding="utf-8")
+            return str(path)
+        except OSError:
+            pass
+    try:
+        fd, name = tempfile.mkstemp(prefix="helmcheck-tester-error-", suffix=".txt")
+        with os.fdopen(fd, "w", encoding="utf-8") as f:
+            f.write(text)
+        return name
+    except OSError as e:
+        return f"(not saved: {e.strerror or e})"
+
+
+def _dispatch(argv: list[str]) -> int:
+    args: Optional[argparse.Namespace] = None
+    try:
+        parser = build_parser()
+        try:
+            args, extra = parser.parse_known_args(argv)
+        except SystemExit as e:  # --help, --version (0) or a usage error (64)
+            return e.code if isinstance(e.code, int) else exitcodes.USAGE
+        if extra:  # named by the subcommand that got them, not by the top-level parser
+            raise UsageError(f"error: unrecognized arguments: {' '.join(extra)} (see '{prog_of(args)} --help')")
+        if not getattr(args, "func", None):
+            raise UsageError(f"no command given; choose one of {', '.join(SUBCOMMANDS)} "
+                             f"(see 'helmcheck --help')")
+        return int(args.func(args))
+    except Failure as f:
+        _say(prog_of(args), f.message)
+        return f.code
+    except KeyboardInterrupt as e:
+        _say(prog_of(args), describe_interrupt(e))
+        return INTERRUPT_CODE.get(getattr(args, "command", None) or "", exitcodes.INCONCLUSIVE)
+    except Exception as e:  # noqa: BLE001 - the tester-error row of the contracts table
+        from .profile import ProfileError
+        if isinstance(e, ProfileError):
+            _say(prog_of(args), str(e))
+            return exitcodes.USAGE
+        if isinstance(e, OSError) and e.filename:
+            _say(prog_of(args), f"{e.filename}: {e.strerror or e}")
+            return exitcodes.INCONCLUSIVE
+        where = save_traceback(e, args)
+        first = (str(e).splitlines() or [""])[0]
+        _say(prog_of(args), f"tester error: {type(e).__name__}{': ' + first if first else ''} — "
+                            f"traceback in {where}; please report it")
+        return exitcodes.INCONCLUSIVE
+
+
+def main(argv: Optional[list[str]] = None) -> int:
+    """Run one command; returns its exit status (see the module docstring)."""
+    entry = argv is None  # the process's own entry point (console script, python -m helmcheck)
     if argv is not None:
         sys.argv[1:] = argv
-    parser = build_parser()
-    args = parser.parse_args(sys.argv[1:])
-    if not getattr(args, "func", None):
-        parser.print_help(sys.stderr)
-        return exitcodes.USAGE
+    saved = sys.stdout, sys.stderr
+    out = GuardedStream(sys.stdout, "standard output")
+    err = GuardedStream(sys.stderr, "standard error")
+    sys.stdout, sys.stderr = out, err  # type: ignore[assignment]
     try:
-        return int(args.func(args))
-    except KeyboardInterrupt:
-        print("helmcheck: interrupted", file=sys.stderr)
-        return exitcodes.INCONCLUSIVE
+        with ending_signals(linger=entry):
+            code = _dispatch(sys.argv[1:])
+            try:
+                out.flush()
+                if out.error is not None:
+                    _say(f"helmcheck {sys.argv[1]}" if sys.argv[1:] else "helmcheck",
+                         f"cannot write standard output: {out.error.strerror or out.error}")
+                    code = exitcodes.INCONCLUSIVE
+                err.flush()
+            except KeyboardInterrupt:  # a signal after the command ended changes nothing
+                pass
+        return code
+    finally:
+        sys.stdout, sys.stderr = saved
 
 
 if __name__ == "__main__":  # pragma: no cover

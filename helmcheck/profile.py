@@ -137,7 +137,7 @@ _CHOICES = {
     "depth_unit": ("m", "ft"),
     "fault_injection": ("none", "oxflt"),
     "safety_action": ("park", "srp"),
-    "violation_trigger": ("", "none", "oxflt", "mission-rule", "operator"),
+    "violation_trigger": ("", "none", "oxflt", "mission-rule", "operator"),  # "": derived (Profile.trigger)
 }
 #: Keys whose value must be > 0 (they divide a duration or bound a wait).
 _POSITIVE = ("time_scale", "lockout_s", "ack_window_s", "on_station_m", "max_depth_m")

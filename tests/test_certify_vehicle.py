@@ -226,13 +226,14 @@ def test_usage_errors_exit_64(argv, capsys):
     assert e.value.code == 64
 
 
-def test_unopenable_port_is_inconclusive_with_report(tmp_path):
+def test_unopenable_port_is_a_usage_error_and_writes_nothing(tmp_path, capsys):
+    """A port the user typed that cannot be opened at start is exit 64 (docs/contracts.md)."""
     code = cli_main(["certify", "vehicle", "--port", "/dev/helmcheck-no-such-tty", "--report-dir",
                      str(tmp_path / "r"), "--examples", "0", "--no-progress"])
-    assert code == 2
-    r = load_results(tmp_path / "r")
-    assert r["verdict"] == "inconclusive"
-    assert any("cannot open" in c["reason"] for c in r["clauses"])
+    assert code == 64
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "cannot open /dev/helmcheck-no-such-tty" in err[0]
+    assert not (tmp_path / "r").exists()
 
 
 # ---------------------------------------------------------------------------- RH-MSN-4 bounds

@@ -11,6 +11,7 @@ from helmcheck.grammar import checksum_hex, decode, format, parse
 from helmcheck.grammar import sentences as S
 from helmcheck.grammar.compile import lark_parser
 from helmcheck.grammar.errors import RANGE
+from helmcheck.profile import DEFAULT
 
 from .strategies import ALL
 
@@ -54,12 +55,29 @@ def _frame(body: str) -> bytes:
 @given(from_lark(lark_parser(), start="body"))
 @settings(max_examples=400)
 def test_RH_FRM_1_strings_generated_from_the_grammar_parse(body):
-    """Anything the grammar generates is read by both engines; only range checks may refuse it."""
-    d = decode(_frame(body))
+    """Anything the grammar generates is read by both engines; only range checks may refuse it
+    — and the line length: the grammar does not bound it, framing does (RH-FRM-6), so a
+    generated line over ``max_line_bytes`` must be refused with RH-FRM-6 and read in full when
+    the limit allows it."""
+    line = _frame(body)
+    d = decode(line)
+    if len(line) > DEFAULT.max_line_bytes:
+        assert d.error is not None and d.error.clause == "RH-FRM-6", (len(line), d.error)
+        d = decode(line, DEFAULT.replace(max_line_bytes=len(line)))
     if d.error is not None:
         assert d.error.kind == RANGE, str(d.error)
-    lark = decode(_frame(body), engine="lark")
+    profile = DEFAULT if len(line) <= DEFAULT.max_line_bytes else DEFAULT.replace(max_line_bytes=len(line))
+    lark = decode(line, profile, engine="lark")
     assert (lark.sentence, lark.error) == (d.sentence, d.error)
+
+
+def test_RH_FRM_6_the_generated_257_byte_OYSI_line_is_refused_for_its_length():
+    """The line hypothesis once generated (a flake on main): 257 bytes with CR LF."""
+    body = "OYSI," + "A" * (257 - len("$OYSI,*hh\r\n"))
+    line = _frame(body)
+    assert len(line) == 257
+    d = decode(line)
+    assert d.error is not None and d.error.clause == "RH-FRM-6", d.error
 
 
 @given(st.sampled_from(sorted(ALL, key=lambda c: c.__name__)).flatmap(lambda c: ALL[c]), st.data())

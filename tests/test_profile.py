@@ -74,3 +74,39 @@ def test_empty_end_or_srp_mission_makes_its_case_not_tested():
     assert unmet_need(end, emu) is None and unmet_need(srp, emu) is None
     assert "end_mission" in unmet_need(end, emu.replace(end_mission=""))
     assert "srp_mission" in unmet_need(srp, emu.replace(srp_mission=""))
+
+
+# ---------------------------------------------------------------------------- non-finite numbers
+
+def _float_keys() -> list[str]:
+    import dataclasses
+
+    from helmcheck.profile import BenchSafety, Profile
+
+    keys = [f.name for f in dataclasses.fields(Profile) if isinstance(f.default, float)]
+    keys += [f"bench_safety.{f.name}" for f in dataclasses.fields(BenchSafety) if isinstance(f.default, float)]
+    return keys
+
+
+@pytest.mark.parametrize("value", ["nan", "inf", "-inf", "+inf"])
+@pytest.mark.parametrize("key", _float_keys())
+def test_every_number_key_refuses_nan_and_infinity_naming_file_and_key(key, value, tmp_path):
+    """TOML has nan and inf literals; a duration of nan or inf seconds would hang or never time
+    out (ack_window_s = nan, lockout_s = inf). Every float key refuses them."""
+    from helmcheck.profile import ProfileError, load_profile
+
+    p = tmp_path / "p.toml"
+    table, _, name = key.rpartition(".")
+    p.write_text((f"[{table}]\n" if table else "") + f"{name} = {value}\n")
+    with pytest.raises(ProfileError) as e:
+        load_profile(p)
+    msg = str(e.value)
+    assert str(p) in msg and repr(key) in msg and "finite" in msg and "\n" not in msg
+
+
+def test_a_profile_round_trips_through_as_dict():
+    """What a run stores (results.json, replay files) loads back as the same profile."""
+    from helmcheck.profile import DEFAULT, profile_from_dict
+
+    stored = {k: v for k, v in DEFAULT.as_dict().items() if k != "name"}
+    assert profile_from_dict(stored).replace(name=DEFAULT.name) == DEFAULT

@@ -38,5 +38,11 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         mod.add_arguments(rp)
         certificate_opts.add_arguments(rp, role)  # --sign-key, --operator, --site, --implementation
         rp.set_defaults(func=mod.run)
-    p.set_defaults(func=lambda args: (p.print_help(), 64)[1])
+    p.set_defaults(func=_no_role)
     return p
+
+
+def _no_role(args: argparse.Namespace) -> int:
+    from ..failures import UsageError
+
+    raise UsageError(f"choose a role: {' or '.join(ROLES)} (see 'helmcheck certify --help')")

@@ -3,14 +3,16 @@
 The command owns the command line only; the work is :mod:`helmcheck.conformance.checklog`.
 Exit status, like the certifiers: 0 conformant (every judged clause passes, or non-strict
 without ``--strict``), 1 a clause failed, 2 inconclusive (nothing failed, something could not be
-judged), 64 usage (bad option, unreadable or unrecognised log file, bad profile) with a one-line
-error naming the file. With several files each is checked on its own; the exit status is the
-worst of them.
+judged; or a report that could not be written), 64 usage (bad option, unreadable or
+unrecognised log file, bad profile, a report directory that holds an earlier check without
+``--overwrite``) with a one-line error naming the file. With several files each is checked on
+its own; the exit status is the worst of them.
 """
 
 from __future__ import annotations
 
 import argparse
+import math
 import os
 import shlex
 import sys
@@ -54,6 +56,9 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
                    help="socat's '>' is vehicle→backseat (socat started with the vehicle side first)")
     p.add_argument("--strict", action="store_true", help="a SHOULD not met fails the run")
     p.add_argument("--no-render", action="store_true", help="write results.json only")
+    p.add_argument("--overwrite", action="store_true",
+                   help="replace an earlier check in the report directory (its results, log copy and "
+                        "reports are removed first); without it such a directory is refused")
     p.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None,
                    help="progress bar on stderr (default: for files over 4 MiB on a terminal)")
     p.set_defaults(func=run)
@@ -64,55 +69,64 @@ def _usage(msg: str) -> int:
     return exitcodes.usage_error("helmcheck check-log", msg)
 
 
-def run(args: argparse.Namespace) -> int:
-    from ..profile import ProfileError, load_profile
+def _report_dir(f: Path, args: argparse.Namespace, several: bool) -> Path:
+    if args.report_dir is None:
+        return Path("reports") / f"check-log-{f.stem}"
+    return Path(args.report_dir) / f.stem if several else Path(args.report_dir)
+
+
+def run(args: argparse.Namespace) -> int:  # noqa: C901 - argument checks, then one loop
+    from ..failures import OutputLost, PathError
+    from ..outputs import prepare_report_dir
+    from ..profile import load_profile
     from ..reports import results as R
     from ..reports.results import ReportError
     from ..conformance.checklog.checker import LogFormatError, check_log
     from ..conformance.checklog.report import write_report_dir
 
-    try:
-        profile = load_profile(args.profile)
-    except ProfileError as e:
-        return _usage(str(e))
+    profile = load_profile(args.profile)  # a ProfileError is exit 64 (helmcheck.cli)
     if args.profile is None:
         # Without a declared profile, $OXFLT is taken as honoured, as helmcheck emulate does.
         profile = profile.replace(fault_injection="oxflt")
-    if args.time_scale is not None and not (args.time_scale > 0):
+    if args.time_scale is not None and not (math.isfinite(args.time_scale) and args.time_scale > 0):
         return _usage(f"--time-scale must be positive (got {args.time_scale})")
     catalog = None
     if args.missions is not None:
         from ..conformance.emulator.missionfile import DirectoryCatalog
         if not Path(args.missions).is_dir():
-            return _usage(f"--missions: {args.missions} is not a directory")
+            raise PathError(f"--missions: {args.missions} is not a directory")
         catalog = DirectoryCatalog([Path(args.missions)])
     files = [Path(f) for f in args.files]
     for f in files:
         if not f.is_file() or not os.access(f, os.R_OK):
             why = "no such file" if not f.exists() else ("not a regular file" if not f.is_file() else "not readable")
-            return _usage(f"cannot read {f}: {why}")
+            raise PathError(f"cannot read {f}: {why}")
+    several = len(files) > 1
+    rdirs = [_report_dir(f, args, several) for f in files]
+    if len(set(map(str, rdirs))) < len(rdirs):
+        return _usage("two FILEs have the same name: their reports would share a directory; "
+                      "check them one at a time with --report-dir")
+    for rdir in rdirs:  # every directory usable before any is cleared or written
+        prepare_report_dir(rdir, args.overwrite, clear=False)
     worst = exitcodes.OK
     command = "helmcheck check-log " + " ".join(shlex.quote(a) for a in sys.argv[2:])
-    for f in files:
-        if args.report_dir is None:
-            rdir = Path("reports") / f"check-log-{f.stem}"
-        elif len(files) > 1:
-            rdir = Path(args.report_dir) / f.stem
-        else:
-            rdir = Path(args.report_dir)
+    for f, rdir in zip(files, rdirs):
         try:
             with _progress(f, args.progress) as prog:
                 out = check_log(f, profile=profile, role=args.role, catalog=catalog,
                                 time_scale=args.time_scale, swap=args.swap_directions, progress=prog)
         except LogFormatError as e:
-            return _usage(str(e))
+            raise PathError(str(e)) from None
         except OSError as e:
-            return _usage(f"cannot read {f}: {e.strerror or e}")
+            raise PathError(f"cannot read {f}: {e.strerror or e}") from None
+        prepare_report_dir(rdir, args.overwrite)
+        args.current_report_dir = str(rdir)
         try:
             res = write_report_dir(rdir, out, profile, command, strict=args.strict, render=not args.no_render)
         except (OSError, ReportError) as e:
-            print(f"helmcheck check-log: {e}", file=sys.stderr)
-            return exitcodes.INCONCLUSIVE
+            if isinstance(e, OSError):
+                raise OutputLost(f"cannot write {e.filename or rdir}: {e.strerror or e}") from None
+            raise OutputLost(f"report not written: {e}") from None
         _summary(f, out, res, rdir)
         worst = max(worst, R.exit_code(res["verdict"], args.strict), key=_rank)
     return worst

@@ -2,7 +2,8 @@
 
 The grammar reference comes from ``remote_helm.lark``; the model's transition table and state
 diagram come from ``helmcheck/model/transitions.py``. Nothing in ``docs/`` is written by hand
-except ``contracts.md``.
+except ``contracts.md``. Each file is written atomically; one that cannot be written is exit 2
+naming it. ``--check`` exits 1 when a checked-in copy is stale.
 """
 
 from __future__ import annotations
@@ -21,13 +22,23 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
 
 
 def run(args: argparse.Namespace) -> int:
+    from ..failures import OutputLost
     from ..grammar import docs as grammar_docs
     from ..model import docs as model_docs
+    from ..reports.atomic import write_text_atomic
 
     if args.check:
         stale = (["docs/grammar.md"] if grammar_docs.stale() else []) + list(model_docs.stale())
         for name in stale:
             print(f"stale: {name} (run 'helmcheck docs')")
         return exitcodes.NONCONFORMANT if stale else exitcodes.OK
-    print(f"wrote {grammar_docs.write()}")
-    return model_docs.main([])
+    targets = {grammar_docs.DOCS_FILE: grammar_docs.render_markdown()}
+    targets.update({model_docs.DOCS_DIR / name: text for name, text in model_docs.render_all().items()})
+    for path, text in targets.items():
+        try:
+            path.parent.mkdir(parents=True, exist_ok=True)
+            write_text_atomic(path, text)
+        except OSError as e:
+            raise OutputLost(f"cannot write {path}: {e.strerror or e}") from None
+        print(f"wrote {path}")
+    return exitcodes.OK

@@ -4,8 +4,11 @@ The emulator answers exactly as the reference model does (:mod:`helmcheck.model`
 plant dynamics, mission files, the settings store and the main log
 (:mod:`helmcheck.conformance.emulator`). The first line on standard output is
 ``port: <what to open>`` (flushed), so scripts and backseats can connect; everything else goes
-to standard error (or the live view with ``--tui``). SIGINT/SIGTERM stop it with exit 0;
-bad arguments or a malformed profile exit 64 with a one-line reason.
+to standard error (or the live view with ``--tui``). SIGINT, SIGTERM and SIGHUP stop it with
+exit 0; bad arguments, a malformed profile, a port or file that cannot be opened exit 64 with a
+one-line reason; a link that fails while serving, or a log that cannot be written (``--log``,
+``--main-log``, ``--settings``: the emulator stops rather than serve with its record lost),
+exit 2 with one line naming it.
 """
 
 from __future__ import annotations
@@ -60,125 +63,142 @@ def _usage(msg: str) -> int:
     return exitcodes.usage_error("helmcheck emulate", msg)
 
 
-def run(args: argparse.Namespace) -> int:  # noqa: C901 - argument checks, then one call
-    from ..profile import ProfileError, load_profile
-    from ..conformance.transport import BAUD_RATES, parse_port_spec
+def _check_settings_file(path: str) -> None:
+    """``--settings``: an existing file must be a settings file this emulator wrote (a JSON
+    object); anything else is refused at start rather than silently replaced."""
+    import json
 
+    from ..failures import PathError
+    from ..outputs import check_writable
+
+    p = check_writable(path, "--settings")
+    if not p.exists():
+        return
     try:
-        profile = load_profile(args.profile)
-    except ProfileError as e:
-        return _usage(str(e))
+        data = json.loads(p.read_text(encoding="utf-8"))
+    except OSError as e:
+        raise PathError(f"--settings: cannot read {p}: {e.strerror or e}") from None
+    except ValueError as e:
+        raise PathError(f"--settings: {p} is not a settings file (not JSON: {e}); remove it or name "
+                        f"another file") from None
+    if not isinstance(data, dict):
+        raise PathError(f"--settings: {p} is not a settings file (not a JSON object); remove it or name "
+                        f"another file")
+
+
+def run(args: argparse.Namespace) -> int:  # noqa: C901 - argument checks, then one call
+    from ..conformance.transport import BAUD_RATES
+    from ..outputs import check_writable, is_regular_or_new, open_output_stream
+    from ..profile import load_profile
+    from .ports import port_spec
+
+    profile = load_profile(args.profile)  # a ProfileError is exit 64 (helmcheck.cli)
     scale = args.time_scale if args.time_scale is not None else profile.time_scale
     if not (isinstance(scale, float) or isinstance(scale, int)) or not math.isfinite(scale) or scale <= 0:
         return _usage(f"--time-scale must be a positive number (got {args.time_scale})")
     baud = args.baud if args.baud is not None else profile.baud
     if baud != 0 and baud not in BAUD_RATES:
         return _usage(f"--baud must be 0 or one of {', '.join(map(str, BAUD_RATES))} (got {baud})")
-    try:
-        spec = parse_port_spec(args.port)
-    except ValueError as e:
-        return _usage(f"--port: {e}")
+    spec = port_spec(args.port)
     if spec.kind in ("device", "url") and baud == 0:
         return _usage("--baud 0 (unpaced) needs --port pty or socket://")
     missions_dir = None
     if args.missions is not None:
         missions_dir = Path(args.missions)
         if not missions_dir.is_dir():
-            return _usage(f"--missions: {args.missions} is not a directory")
+            from ..failures import PathError
+            raise PathError(f"--missions: {args.missions} is not a directory")
     profile = profile.replace(time_scale=float(scale), baud=baud if baud else profile.baud,
                               fault_injection="oxflt" if args.fault_injection else "none")
+    main_log_path = args.main_log
+    if args.log:
+        check_writable(args.log, "--log")
+        if main_log_path is None and is_regular_or_new(Path(args.log)):
+            # next to a log file; a log on a device or pipe has no "next to"
+            lp = Path(args.log)
+            main_log_path = str(lp.with_name(lp.stem + ".mainlog.csv"))
+    if main_log_path:
+        check_writable(main_log_path, "--main-log")
+    if args.settings:
+        _check_settings_file(args.settings)
+    from .ports import open_port
+
+    # the port first (before the grammar loads, so a bad one fails fast), then the logs: a port
+    # that cannot be opened leaves every file as it was
+    link = open_port(spec, role="server", baud=baud if baud else 19200, selectable=True)
     log_file = main_log_file = None
     try:
         if args.log:
-            log_file = open(args.log, "w", encoding="utf-8")
-        main_log_path = args.main_log
-        if main_log_path is None and args.log:
-            lp = Path(args.log)
-            main_log_path = str(lp.with_name(lp.stem + ".mainlog.csv"))
+            log_file = open_output_stream(args.log, "--log", stop=True, what="wire log")
         if main_log_path:
-            main_log_file = open(main_log_path, "w", encoding="utf-8", newline="")
-    except OSError as e:
+            main_log_file = open_output_stream(main_log_path, "--main-log", stop=True, what="main log",
+                                               newline="")
+        return _serve(args, profile, link, baud, missions_dir, log_file, main_log_file)
+    except BaseException:
+        link.close()
+        raise
+    finally:
         for f in (log_file, main_log_file):
-            if f is not None:
-                f.close()
-        return _usage(f"cannot write {e.filename}: {e.strerror or e}")
-    return _serve(args, profile, spec, baud, missions_dir, log_file, main_log_file)
+            if f is not None and not f.closed:
+                try:
+                    f.close()
+                except Exception:  # noqa: BLE001 - the first failure is the one reported
+                    pass
 
 
-def _serve(args, profile, spec, baud, missions_dir, log_file, main_log_file) -> int:
-    import signal
+def _serve(args, profile, link, baud, missions_dir, log_file, main_log_file) -> int:
+    """Serve until stopped. A signal (:mod:`helmcheck.signals`) stops it with exit 0; a link that
+    fails during the run is a :class:`~helmcheck.failures.LinkFault` (exit 2); a log that cannot
+    be written stops it with :class:`~helmcheck.failures.OutputLost` (exit 2)."""
     import time
 
-    # Stop cleanly even if a signal arrives while the grammar is still loading.
-    stopping: dict = {"now": False}
+    from ..failures import LinkFault, describe_interrupt
 
-    def early(*_):
-        stopping["now"] = True
-        if "server" in stopping:
-            stopping["server"].stop(0)
-
-    signal.signal(signal.SIGINT, early)
-    signal.signal(signal.SIGTERM, early)
-
-    from ..conformance.transport import open_link
-
-    try:  # before the grammar loads, so a bad port fails fast
-        link = open_link(spec, role="server", baud=baud if baud else 19200)
-    except (OSError, ValueError) as e:
-        return _usage(f"cannot open {args.port}: {getattr(e, 'strerror', None) or e}")
+    log = server = ui = core = None
     try:
-        link.fileno()
-    except OSError:
-        link.close()
-        return _usage(f"--port {args.port}: not selectable (use pty, a device or socket://)")
-
-    from ..conformance.emulator.core import EmulatorCore, MainLog
-    from ..conformance.emulator.missionfile import DirectoryCatalog, builtin_dir
-    from ..conformance.emulator.server import Server
-    from ..grammar.capture import WireLogWriter
-    dirs = ([missions_dir] if missions_dir is not None else []) + [builtin_dir()]
-    catalog = DirectoryCatalog(dirs)
-    started = datetime.now(timezone.utc)
-    log = None
-    if log_file is not None:
-        log = WireLogWriter(log_file, meta=(f"started {started.strftime('%Y-%m-%dT%H:%M:%S.%fZ')}  "
-                                            f"port {link.name}  baud {baud}  time_scale {profile.time_scale:g}"))
-    core = EmulatorCore(profile, catalog, start=time.monotonic(), baud=baud, log=log,
-                        main_log=MainLog(main_log_file) if main_log_file is not None else None,
-                        settings_path=Path(args.settings) if args.settings else None,
-                        utc0=started.timestamp(),
-                        on_error=None if args.tui else lambda text: print(f"helmcheck emulate: {text}",
-                                                                          file=sys.stderr))
-    try:
+        from ..conformance.emulator.core import EmulatorCore, MainLog
+        from ..conformance.emulator.missionfile import DirectoryCatalog, builtin_dir
+        from ..conformance.emulator.server import Server
+        from ..grammar.capture import WireLogWriter
+        dirs = ([missions_dir] if missions_dir is not None else []) + [builtin_dir()]
+        catalog = DirectoryCatalog(dirs)
+        started = datetime.now(timezone.utc)
+        if log_file is not None:
+            log = WireLogWriter(log_file, meta=(f"started {started.strftime('%Y-%m-%dT%H:%M:%S.%fZ')}  "
+                                                f"port {link.name}  baud {baud}  time_scale {profile.time_scale:g}"))
+        core = EmulatorCore(profile, catalog, start=time.monotonic(), baud=baud, log=log,
+                            main_log=MainLog(main_log_file) if main_log_file is not None else None,
+                            settings_path=Path(args.settings) if args.settings else None,
+                            utc0=started.timestamp(),
+                            on_error=None if args.tui else lambda text: print(f"helmcheck emulate: {text}",
+                                                                              file=sys.stderr))
         sys.stdout.write(f"port: {link.name}\n")
         sys.stdout.flush()
-    except OSError:
-        pass
-    print(f"helmcheck emulate: {link.description}, profile {profile.name}, time scale "
-          f"{profile.time_scale:g}, baud {baud or 'unpaced'}, fault injection "
-          f"{profile.fault_injection}, missions {', '.join(str(d) for d in dirs)}", file=sys.stderr)
-    ui = None
-    if args.tui:
-        from ..conformance.emulator.tui import LiveView
-        ui = LiveView(core, link.name)
-    server = Server(link, core, ui=ui)
-    stopping["server"] = server
-    if stopping["now"]:
-        server.stop(0)
-    status = 0
-    try:
-        if ui is not None:
-            ui.start()
-        status = server.run()
+        print(f"helmcheck emulate: {link.description}, profile {profile.name}, time scale "
+              f"{profile.time_scale:g}, baud {baud or 'unpaced'}, fault injection "
+              f"{profile.fault_injection}, missions {', '.join(str(d) for d in dirs)}", file=sys.stderr)
+        if args.tui:
+            from ..conformance.emulator.tui import LiveView
+            ui = LiveView(core, link.name)
+        server = Server(link, core, ui=ui, install_signals=False)
+        stopped = "stopped"
+        try:
+            if ui is not None:
+                ui.start()
+            status = server.run()
+        except KeyboardInterrupt as e:
+            status, stopped = 0, f"stopped: {describe_interrupt(e)}"
     finally:
         if ui is not None:
             ui.close()
         link.close()
-        if log is not None:
+        if log is not None and core is not None and not log_file.closed:
             log.note(time.monotonic() - core.start, "emulator stopped")
-            log.close()
+        if log_file is not None:
+            log_file.close()
         if main_log_file is not None:
             main_log_file.close()
-    if status == 0:
-        print("helmcheck emulate: stopped", file=sys.stderr)
-    return status if status in (0, exitcodes.INCONCLUSIVE) else exitcodes.INCONCLUSIVE
+    if status != 0:
+        raise LinkFault(f"link fault on {link.name}: {server.lost or 'the link failed'}")
+    print(f"helmcheck emulate: {stopped}", file=sys.stderr)
+    return exitcodes.OK

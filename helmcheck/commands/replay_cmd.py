@@ -3,7 +3,8 @@
 The replay file (written by ``helmcheck certify vehicle`` when exploration finds a failure, see
 :mod:`helmcheck.conformance.vehicle.replay`) lists the exact bytes sent and the protocol waits.
 Every reply is judged again by the present reference model. Exit status: 1 it still fails,
-0 it passes now, 2 inconclusive (link fault, a step not sent), 64 usage.
+0 it passes now, 2 inconclusive (link fault, a step not sent; a wire log that could not be
+written), 64 usage (bad option, unreadable replay file or profile, a port that cannot be opened).
 """
 
 from __future__ import annotations
@@ -40,46 +41,52 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
 def run(args: argparse.Namespace) -> int:
     from ..clauses import vehicle_clauses
     from ..conformance.recorder import Recorder
-    from ..conformance.transport import open_link, parse_port_spec
     from ..conformance.vehicle.flow import LinkLost
     from ..conformance.vehicle.link import TesterLink
-    from ..conformance.vehicle.replay import ReplayError, load_replay, redrive
+    from ..conformance.vehicle.replay import ReplayError, load_replay
     from ..conformance.vehicle.session import Session
     from ..judge import Ledger
     from ..judge.vehicle import VehicleObserver
-    from ..profile import ProfileError, load_profile, profile_from_dict
+    from ..failures import PathError, UsageError
+    from ..outputs import check_writable, open_output_stream
+    from ..profile import load_profile, profile_from_dict
+    from .ports import open_port, port_spec
 
     try:
         doc = load_replay(args.file)
     except ReplayError as e:
-        print(f"helmcheck replay: {e}", file=sys.stderr)
-        return exitcodes.USAGE
+        raise PathError(str(e)) from None
+    for i, st in enumerate(doc["steps"]):  # every value usable before the port is opened
+        ok = (isinstance(st.get("send", ""), str) and isinstance(st.get("expect", ""), str)
+              and (not isinstance(st.get("wait", 0.0), bool) and isinstance(st.get("wait", 0.0), (int, float))
+                   and math.isfinite(st.get("wait", 0.0)) and st.get("wait", 0.0) >= 0))
+        if not ok:
+            raise PathError(f"{args.file}: step {i}: send and expect must be text, wait a number of "
+                            f"seconds ≥ 0")
+    if args.profile:
+        profile = load_profile(args.profile)  # a ProfileError is exit 64 (helmcheck.cli)
+    else:
+        stored = doc.get("profile") or {}
+        if not isinstance(stored, dict):
+            raise PathError(f"{args.file}: the stored profile is not a table")
+        stored = {k: v for k, v in stored.items() if k != "name"}
+        profile = profile_from_dict(stored, where=f"{args.file} (stored profile)")
     try:
-        if args.profile:
-            profile = load_profile(args.profile)
-        else:
-            stored = {k: v for k, v in (doc.get("profile") or {}).items() if k != "name"}
-            profile = profile_from_dict(stored, where=f"{args.file} (stored profile)")
-    except ProfileError as e:
-        print(f"helmcheck replay: {e}", file=sys.stderr)
-        return exitcodes.USAGE
-    k = args.time_scale if args.time_scale is not None else float(doc.get("time_scale") or profile.time_scale)
+        k = args.time_scale if args.time_scale is not None else float(doc.get("time_scale") or profile.time_scale)
+    except (TypeError, ValueError):
+        raise PathError(f"{args.file}: time_scale is not a number") from None
     if not math.isfinite(k) or k <= 0:
-        print("helmcheck replay: --time-scale must be positive", file=sys.stderr)
-        return exitcodes.USAGE
-    try:
-        parse_port_spec(args.port)
-    except ValueError as e:
-        print(f"helmcheck replay: --port: {e}", file=sys.stderr)
-        return exitcodes.USAGE
-    log = open(args.wire_log, "w", encoding="utf-8") if args.wire_log else None
+        raise UsageError("--time-scale must be a positive number")
+    spec = port_spec(args.port)
+    if args.wire_log:
+        check_writable(args.wire_log, "--wire-log")
+    raw = open_port(spec, role="client", baud=profile.baud)
+    log = None
     link = None
     try:
-        try:
-            raw = open_link(args.port, role="client", baud=profile.baud)
-        except (OSError, ValueError) as e:
-            print(f"INCONCLUSIVE: cannot open {args.port}: {e}", file=sys.stderr)
-            return exitcodes.INCONCLUSIVE
+        if args.wire_log:
+            log = open_output_stream(args.wire_log, "--wire-log", stop=False, what="wire log")
+        from ..conformance.vehicle.replay import redrive
         ledger = Ledger([c.id for c in vehicle_clauses()])
         observer = VehicleObserver(profile, ledger, time_scale=k, baud=profile.baud)
         recorder = Recorder(log, [f"replay {args.file} port {args.port} time_scale {k:g}"], [observer])
@@ -92,14 +99,21 @@ def run(args: argparse.Namespace) -> int:
     finally:
         if link is not None:
             link.close()
+        else:
+            raw.close()
         if log is not None:
             log.close()
     was = doc.get("clause", "?")
     if verdict == "fail":
         print(f"STILL FAILS: {reason} (recorded as {was})")
-        return exitcodes.NONCONFORMANT
-    if verdict == "pass":
+        code = exitcodes.NONCONFORMANT
+    elif verdict == "pass":
         print(f"PASSES NOW: {reason} (recorded as {was}: {doc.get('reason', '')})")
-        return exitcodes.OK
-    print(f"INCONCLUSIVE: {reason}")
-    return exitcodes.INCONCLUSIVE
+        code = exitcodes.OK
+    else:
+        print(f"INCONCLUSIVE: {reason}")
+        code = exitcodes.INCONCLUSIVE
+    if log is not None:
+        sys.stdout.flush()
+        log.check()  # a wire log lost on the way: exit 2, after the verdict line
+    return code

@@ -38,14 +38,22 @@ class Sentence:
 
     @classmethod
     def field_names(cls) -> tuple[str, ...]:
-        return tuple(f.name for f in fields(cls))  # type: ignore[arg-type]
+        names = _FIELD_NAMES.get(cls)
+        if names is None:
+            names = _FIELD_NAMES[cls] = tuple(f.name for f in fields(cls))  # type: ignore[arg-type]
+        return names
 
     def as_dict(self) -> dict:
         """Field values as JSON-friendly data (Decimals become their exact text)."""
         out = {}
         for name in self.field_names():
-            out[name] = _jsonable(getattr(self, name))
+            v = getattr(self, name)
+            out[name] = v if type(v) in _PLAIN else _jsonable(v)
         return out
+
+
+_FIELD_NAMES: dict[type, tuple[str, ...]] = {}
+_PLAIN = frozenset({str, int, bool, type(None)})
 
 
 def _jsonable(v):

@@ -5,10 +5,13 @@ standard output, flushed, for the backseat to open; a device path is opened 8N1 
 profile's baud; ``socket://HOST:PORT`` serves one client), plays the reference vehicle, stages
 the scenarios of :mod:`.scenarios` and judges every byte the backseat sends
 (:class:`helmcheck.judge.backseat.BackseatObserver`, the judge ``check-log`` uses too).
-At the end (also after Ctrl-C, a backseat that never connected or one that went away) it writes
+At the end (also after Ctrl-C, SIGTERM or SIGHUP — :mod:`helmcheck.signals` raises them as
+``KeyboardInterrupt`` —, a backseat that never connected or one that went away) it writes
 ``results.json``, ``wire.log`` and every report format into ``--report-dir``, prints one verdict
 line on standard output and exits 0 (pass; non-strict without ``--strict``), 1 (fail), 2
-(inconclusive) or 64 (usage). Progress goes to standard error.
+(inconclusive; or a report, wire log or ``--wire-log`` copy that could not be written) or 64
+(usage: bad option or profile, a port that cannot be opened, a report directory holding an
+earlier run without ``--overwrite``). Progress goes to standard error.
 
 With ``--exec CMD`` helmcheck starts the backseat itself once the port is open and stops it at
 the end (:mod:`.process`); a backseat that exits or dies before the end fails the run.
@@ -19,16 +22,14 @@ from __future__ import annotations
 import argparse
 import math
 import shlex
-import shutil
-import signal
 import sys
-import threading
 import time
 from datetime import datetime, timezone
 from pathlib import Path
 from typing import Any, Callable, Optional
 
 from ... import exitcodes
+from ...failures import describe_interrupt
 from .scenarios import SCENARIOS
 
 __all__ = ["add_arguments", "run", "EPILOG"]
@@ -92,6 +93,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="start the backseat under test on the port ({port} is replaced, or the port appended)")
     p.add_argument("--exec-grace", type=float, default=5.0, metavar="S",
                    help="seconds between SIGTERM and SIGKILL when stopping it (default 5)")
+    p.add_argument("--overwrite", action="store_true",
+                   help="replace an earlier run in --report-dir (its results, wire log and reports are "
+                        "removed first); without it such a directory is refused")
 
 
 def _usage(msg: str) -> int:
@@ -181,11 +185,9 @@ def run(args: argparse.Namespace, *, on_port: Optional[Callable[[str], None]] = 
     started_dt = datetime.now(timezone.utc)
     stamp = started_dt.strftime("%Y%m%dT%H%M%SZ")
     report_dir = Path(args.report_dir) if args.report_dir else Path("reports") / f"backseat-{stamp}"
-    try:
-        report_dir.mkdir(parents=True, exist_ok=True)
-        log_file = open(report_dir / "wire.log", "w", encoding="utf-8")
-    except OSError as e:
-        return _usage(f"cannot write to {report_dir}: {e.strerror or e}")
+    # Command-line hooks (helmcheck.outputs, helmcheck.commands.ports): every path and the port
+    # checked before anything is written; the port opened once, here (exit 64 if it cannot be).
+    link, log_file = _open_outputs_and_port(args, spec, profile, report_dir)
     settings: dict[str, Any] = {"time_scale": float(scale), "strict": bool(args.strict),
                                 "duration_s": float(args.duration), "planned_s": round(plan.total, 3),
                                 "scenarios": list(dict.fromkeys(names)), "baud": baud,
@@ -195,26 +197,37 @@ def run(args: argparse.Namespace, *, on_port: Optional[Callable[[str], None]] = 
                                                          else ["--port", args.port])
     started = started_dt.isoformat(timespec="seconds").replace("+00:00", "Z")
     return _certify(args, profile, spec, plan, report_dir, log_file, settings, command, started, started_dt,
-                    on_port, cert)
+                    on_port, cert, link)
+
+
+def _open_outputs_and_port(args, spec, profile, report_dir: Path):
+    """(link, wire-log stream): paths checked, port opened, report directory prepared."""
+    from ...commands.ports import open_port
+    from ...outputs import check_writable, open_output_stream, prepare_report_dir
+    from .link import HangupPty
+
+    if args.wire_log:
+        check_writable(args.wire_log, "--wire-log")
+    prepare_report_dir(report_dir, args.overwrite, clear=False)
+    link = open_port(spec, role="server", baud=profile.baud,
+                     opener=(lambda: HangupPty(profile.baud)) if spec.kind == "pty" else None)
+    try:
+        prepare_report_dir(report_dir, args.overwrite)
+        args.report_dir = str(report_dir)  # where a tester error's traceback goes
+        return link, open_output_stream(report_dir / "wire.log", "--report-dir", stop=False, what="wire log")
+    except BaseException:
+        link.close()
+        raise
 
 
 def _certify(args, profile, spec, plan, report_dir: Path, log_file, settings, command: str,
-             started: str, started_dt: datetime, on_port=None, cert=None) -> int:
-    from ..transport import open_link
-    from .link import HangupPty
-
+             started: str, started_dt: datetime, on_port=None, cert=None, link=None) -> int:
     strict = bool(args.strict)
-    link = None
     outcome = None
     reason = ""
     progress = None
     child = process = None  # --exec: the backseat under test (.process)
     try:
-        try:
-            link = HangupPty(profile.baud) if spec.kind == "pty" else open_link(spec, role="server", baud=profile.baud)
-        except (OSError, ValueError) as e:
-            reason = f"cannot open {args.port}: {getattr(e, 'strerror', None) or e}"
-            print(f"helmcheck certify backseat: {reason}", file=sys.stderr)
         if link is not None:
             try:
                 sys.stdout.write(f"port: {link.name}\n")
@@ -244,15 +257,14 @@ def _certify(args, profile, spec, plan, report_dir: Path, log_file, settings, co
                                                           time_scale=profile.time_scale, grace_s=args.exec_grace)
                 except OSError as e:
                     runner.stop(f"stopped: the backseat under test could not be started ({e.strerror or e})")
-            old = {}
-            if threading.current_thread() is threading.main_thread():
-                for sig in (signal.SIGINT, signal.SIGTERM):
-                    old[sig] = signal.signal(sig, lambda *_: runner.stop("interrupted"))
             try:
                 outcome = runner.run()
+            except KeyboardInterrupt as e:  # Ctrl-C, SIGTERM, SIGHUP (helmcheck.signals)
+                outcome = runner.outcome
+                outcome.status = "interrupted"
+                outcome.reason = (f"the run was {describe_interrupt(e)} after "
+                                  f"{outcome.ended_at - (outcome.connected_at or 0.0):.1f} s")
             finally:
-                for sig, h in old.items():
-                    signal.signal(sig, h)
                 progress.stop()
                 if child is not None:
                     from .process import end_backseat
@@ -267,6 +279,8 @@ def _certify(args, profile, spec, plan, report_dir: Path, log_file, settings, co
             log_file.close()
         except OSError:
             pass
+    from ...failures import OutputLost
+    from ...outputs import copy_output
     from ...reports.certificate import finish_run
     from ...reports.render import render_all
     from ...reports.results import ReportError, exit_code
@@ -283,13 +297,14 @@ def _certify(args, profile, spec, plan, report_dir: Path, log_file, settings, co
         # results.json with the certificate (profile.toml, digests, identity, scope, signature), then the reports
         finish_run(results, report_dir, profile, cert)
         render_all(report_dir)
-        if args.wire_log:
-            shutil.copyfile(report_dir / "wire.log", args.wire_log)
     except (ReportError, OSError) as e:
-        print(f"helmcheck certify backseat: report not written: {e}", file=sys.stderr)
-        return exitcodes.INCONCLUSIVE
+        raise OutputLost(f"report not written: {e}") from None
     verdict = results["verdict"]
     print(f"{headline(results)}. {results['verdict_reason']}")  # the headline says when the run was cut short
     print(f"helmcheck certify backseat: report in {report_dir}", file=sys.stderr)
     sys.stdout.flush()
+    if hasattr(log_file, "check"):
+        log_file.check()  # the wire log lost on the way is exit 2, after the verdict line
+    if args.wire_log:
+        copy_output(report_dir / "wire.log", args.wire_log, what="wire log copy")
     return exit_code(verdict, strict)

@@ -97,6 +97,19 @@ class MainLog:
         self._f.close()
 
 
+def _reply_label(raw: bytes) -> str:
+    """What a live view says about a sentence the vehicle sent: an ``$ACK`` is ``accepted``
+    (status 0) or ``refused (err N)`` (status 1, RH-ACK-1); other sentences say nothing."""
+    if not raw.startswith(b"$ACK,"):
+        return ""
+    fields = raw[5:].split(b"*", 1)[0].split(b",")
+    if len(fields) < 3:
+        return ""
+    if fields[1] == b"0":
+        return "accepted"
+    return f"refused (err {fields[2].decode('ascii', 'replace')})"
+
+
 def _event_text(e: Any) -> str:
     parts = [f"{f.name}={getattr(e, f.name)!r}" for f in dc_fields(e) if f.name != "at"]
     clause = getattr(e, "clause", "")
@@ -274,7 +287,8 @@ class EmulatorCore:
         else:
             verdict = f"discard {d.error}" if d.error is not None else "discard"
         text = escape(raw.rstrip(b"\r\n")[:160])
-        self.history.append(HistoryEntry(now - self.start, ">", text, verdict))
+        entry = HistoryEntry(now - self.start, ">", text, verdict)
+        self.history.append(entry)
         if item is None:
             self.stats["discarded"] += 1
             return
@@ -282,9 +296,21 @@ class EmulatorCore:
             self.stats["answered_errors"] += 1
         else:
             self.stats["commands"] += 1
-        self._command(item, now, v)
+        ack = self._command(item, now, v)
+        if ack is not None and ack.status != 0:
+            why = f": {item}" if isinstance(item, SentenceError) else ""
+            self._relabel(entry, f"refused (err {ack.err}){why}")
 
-    def _command(self, item: Any, now: float, v: float) -> None:
+    def _relabel(self, entry: HistoryEntry, verdict: str) -> None:
+        """A command the vehicle refused (``$ACK`` status 1) is shown as refused, not ok."""
+        h = self.history
+        for i in range(len(h) - 1, max(-1, len(h) - 64), -1):
+            if h[i] is entry:
+                h[i] = HistoryEntry(entry.t, entry.direction, entry.text, verdict)
+                return
+
+    def _command(self, item: Any, now: float, v: float) -> Optional[s.ACK]:
+        """Hand one command to the model and queue its replies; returns its ``$ACK``, if any."""
         m = self.model
         snap_before = m.snapshot
         if isinstance(item, s.OXFLT):
@@ -293,7 +319,7 @@ class EmulatorCore:
                 self._note(now, f"fault injected ($OXFLT): {item.code}")
         replies = self._model_call(lambda: m.receive(item, v), now)
         if replies is None:
-            return
+            return None
         if isinstance(item, s.Command) and type(item) is not s.OSD:
             self.last_command = item
             self.last_command_v = v
@@ -308,6 +334,7 @@ class EmulatorCore:
         for r in replies:
             self._send(format_sentence(r), now)
         self._after_model(now)
+        return next((r for r in reversed(replies) if isinstance(r, s.ACK)), None)
 
     def _model_call(self, fn: Callable[[], Any], now: float) -> Any:
         """Call into the model; a model exception is logged, never fatal to the emulator."""
@@ -404,7 +431,8 @@ class EmulatorCore:
             self.stats["sentences_out"] += 1
             if self.log is not None:
                 self.log.bytes(now - self.start, FROM_VEHICLE, raw)
-            self.history.append(HistoryEntry(now - self.start, "<", escape(raw.rstrip(b"\r\n")[:160])))
+            self.history.append(HistoryEntry(now - self.start, "<", escape(raw.rstrip(b"\r\n")[:160]),
+                                             _reply_label(raw)))
         self.stats["bytes_out"] += len(out)
         return bytes(out)
 
@@ -432,13 +460,19 @@ class EmulatorCore:
                 store.write(name, state, tuple(values[:3]))
 
     def _save_settings(self, path: Path) -> None:
+        """Keep the ``$ORWSET`` settings across runs (RH-SET-2), written atomically (a crash
+        leaves the old file or the new one). A file that cannot be written stops the emulator
+        with :class:`~helmcheck.failures.OutputLost` naming it: a vehicle that acknowledged a
+        write it cannot keep must not go on serving as if it had."""
+        from ...failures import OutputLost
+        from ...reports.atomic import write_text_atomic
+
         data = {k: [st, list(vals)] for k, (st, vals) in self.model.settings.as_dict().items()}
-        tmp = Path(str(path) + ".tmp")
         try:
-            tmp.write_text(json.dumps(data, indent=1) + "\n", encoding="utf-8")
-            tmp.replace(path)
+            write_text_atomic(path, json.dumps(data, indent=1) + "\n")
         except OSError as e:
             self._note(self.wall_time(self.v), f"settings not saved: {e}")
+            raise OutputLost(f"cannot write settings {path}: {e.strerror or e}") from None
 
     # ================================================================ live view
     def view(self) -> dict[str, Any]:

@@ -10,8 +10,10 @@ loses them too).
 
 Link changes: on a TCP serial server a client's disconnect resets the framer and drops unsent
 replies (the model's state persists for the next client); a serial device that disappears ends
-the loop with exit status 2. SIGINT and SIGTERM end the loop cleanly (exit status 0): the
-handlers only set a flag and wake the selector through ``signal.set_wakeup_fd``.
+the loop with exit status 2 (:attr:`Server.lost` says why). SIGINT, SIGTERM and SIGHUP end the
+loop cleanly (exit status 0): the handlers only set a flag and wake the selector through
+``signal.set_wakeup_fd``. ``helmcheck emulate`` passes ``install_signals=False``: there the
+command line's handlers (:mod:`helmcheck.signals`) end the loop by raising ``Interrupted``.
 """
 
 from __future__ import annotations
@@ -43,6 +45,7 @@ class Server:
         self.install_signals = install_signals and threading.current_thread() is threading.main_thread()
         self._stop = False
         self.exit_status = 0
+        self.lost: Optional[str] = None  #: why the link ended the loop (exit status 2)
         self._pending = bytearray()
         self._dropped = 0
         self._wake_r, self._wake_w = socket.socketpair()
@@ -69,7 +72,7 @@ class Server:
         old: dict[int, Any] = {}
         old_wakeup = None
         if self.install_signals:
-            for sig in (signal.SIGINT, signal.SIGTERM):
+            for sig in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP):
                 old[sig] = signal.signal(sig, lambda *_: self.stop(0))
             old_wakeup = signal.set_wakeup_fd(self._wake_w.fileno(), warn_on_full_buffer=False)
         sel = selectors.DefaultSelector()
@@ -142,6 +145,7 @@ class Server:
         try:
             events = self.link.poll()
         except LinkClosed as e:
+            self.lost = str(e.strerror or e)
             self.core.note(self.clock(), f"link lost: {e}")
             self.core.disconnect(self.clock(), "link lost")
             self.stop(2)

@@ -3,6 +3,10 @@
 ``add_arguments(parser)`` and ``run(args) -> int`` are what
 :mod:`helmcheck.commands.certify_cmd` dispatches to; :data:`EPILOG` is the ``--help`` epilog.
 Exit status: 0 pass (or non-strict without ``--strict``), 1 fail, 2 inconclusive, 64 usage.
+The port is opened here, once, before anything is written (``helmcheck.commands.ports``: one
+that cannot be opened is exit 64); the report directory is checked first and cleared with
+``--overwrite`` (:mod:`helmcheck.outputs`); the reports are rendered and ``--wire-log`` copied
+here after the run, and a file that cannot be written is exit 2 naming it.
 """
 
 from __future__ import annotations
@@ -51,8 +55,11 @@ certificate: a run that judges every vehicle clause is a certificate; --select r
   --sign-key KEY signs the run (helmcheck keygen); helmcheck verify DIR checks it.
 
 results: DIR/results.json (schema 1), DIR/wire.log, DIR/profile.toml, DIR/signature.json (signed runs),
-  DIR/report.html, DIR/junit.xml, DIR/report.md.
-exit status: 0 pass (or non-strict without --strict), 1 fail, 2 inconclusive, 64 usage.
+  DIR/report.html, DIR/junit.xml, DIR/report.md. A DIR that holds an earlier run is refused
+  unless --overwrite. SIGINT, SIGTERM and SIGHUP end the run early: results marked partial,
+  reports rendered.
+exit status: 0 pass (or non-strict without --strict), 1 fail, 2 inconclusive, link fault, tester
+  error or an output that could not be written, 64 usage (bad option, profile, port or path).
 """
 
 
@@ -82,33 +89,24 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="seconds between SIGTERM and SIGKILL when stopping it (default 5)")
     p.add_argument("--exec-ready", type=float, default=30.0, metavar="S",
                    help="seconds it may take to open (or listen on) the port (default 30)")
+    p.add_argument("--overwrite", action="store_true",
+                   help="replace an earlier run in --report-dir (its results, wire log, reports and "
+                        "replays are removed first); without it such a directory is refused")
 
 
 def _usage(msg: str) -> int:
     return exitcodes.usage_error("helmcheck certify vehicle", msg)
 
 
-def _sigterm_interrupts() -> None:
-    """SIGTERM ends the run like Ctrl-C: a partial report, and the started vehicle stopped."""
-    import signal
-    import threading
-
-    def interrupt(*_):
-        raise KeyboardInterrupt
-
-    if threading.current_thread() is threading.main_thread():
-        signal.signal(signal.SIGTERM, interrupt)
-
-
-def run(args: argparse.Namespace) -> int:
-    from ...profile import ProfileError, load_profile
-    from ..transport import BAUD_RATES, parse_port_spec
+def run(args: argparse.Namespace) -> int:  # noqa: C901 - argument checks, then one call
+    from ...failures import OutputLost
+    from ...outputs import OutputStream, check_writable, prepare_report_dir
+    from ...profile import load_profile
+    from ...commands.ports import open_port, port_spec
+    from ..transport import BAUD_RATES
     from .runner import Options, certify
 
-    try:
-        profile = load_profile(args.profile)
-    except ProfileError as e:
-        return _usage(str(e))
+    profile = load_profile(args.profile)  # a ProfileError is exit 64 (helmcheck.cli)
     k = args.time_scale if args.time_scale is not None else profile.time_scale
     if not math.isfinite(k) or k <= 0:
         return _usage(f"--time-scale must be a positive number (got {k})")
@@ -130,10 +128,7 @@ def run(args: argparse.Namespace) -> int:
             args.port = "pty"
     elif args.port is None:
         return _usage("--port is required (or --exec CMD to start the vehicle under test)")
-    try:
-        spec = parse_port_spec(args.port)
-    except ValueError as e:
-        return _usage(f"--port: {e}")
+    spec = port_spec(args.port)
     if spec.kind == "pty" and args.exec_cmd is None:
         return _usage("--port pty creates a new pseudo-terminal; give the vehicle's port (e.g. /dev/pts/N) "
                       "or --exec CMD to start the vehicle on it")
@@ -153,17 +148,55 @@ def run(args: argparse.Namespace) -> int:
         cert = declaration(args, "vehicle")
     except DeclarationError as e:
         return _usage(str(e))
-    hp = args.hypothesis_profile or ("fast" if k > 1 else "patient")
-    command = "helmcheck certify vehicle " + shlex.join(sys.argv[3:] if len(sys.argv) > 3 else [])
-    opts = Options(port=args.port, profile=profile, time_scale=float(k), report_dir=Path(args.report_dir),
-                   select=select, examples=args.examples, seed=args.seed, strict=args.strict,
-                   wire_log=Path(args.wire_log) if args.wire_log else None, hypothesis_profile=hp,
-                   explore=args.examples != 0, progress=not args.no_progress, command=command.strip(),
-                   exec_cmd=args.exec_cmd, exec_grace_s=args.exec_grace, exec_ready_s=args.exec_ready,
-                   certificate=cert)
-    if args.exec_cmd is not None:
-        _sigterm_interrupts()  # a cancelled CI job must not leave the vehicle under test running
-    out = certify(opts)
+    if args.wire_log:
+        check_writable(args.wire_log, "--wire-log")
+    report_dir = prepare_report_dir(args.report_dir, args.overwrite, clear=False)
+    # the vehicle's port is opened here (a port that cannot be opened is a usage error); with
+    # --exec the runner starts the vehicle under test, which opens it
+    link = open_port(spec, role="client", baud=profile.baud) if args.exec_cmd is None else None
+    try:
+        prepare_report_dir(report_dir, args.overwrite)
+        wire: list[OutputStream] = []
+
+        def open_wire_log(path: Path) -> OutputStream:
+            try:
+                f = open(path, "w", encoding="utf-8")
+            except OSError as e:
+                raise OutputLost(f"cannot write wire log {path}: {e.strerror or e}") from None
+            wire.append(OutputStream(f, path, stop=False, what="wire log"))
+            return wire[-1]
+
+        hp = args.hypothesis_profile or ("fast" if k > 1 else "patient")
+        command = "helmcheck certify vehicle " + shlex.join(sys.argv[3:] if len(sys.argv) > 3 else [])
+        opts = Options(port=args.port, profile=profile, time_scale=float(k), report_dir=report_dir,
+                       select=select, examples=args.examples, seed=args.seed, strict=args.strict,
+                       wire_log=None, hypothesis_profile=hp, explore=args.examples != 0,
+                       progress=not args.no_progress, command=command.strip(), render=False,
+                       link=link, log_opener=open_wire_log, exec_cmd=args.exec_cmd,
+                       exec_grace_s=args.exec_grace, exec_ready_s=args.exec_ready, certificate=cert)
+        out = certify(opts)
+    finally:
+        if link is not None:
+            link.close()
     from ...reports.scope import headline
     print(f"{headline(out.results)}. {out.reason} — report: {out.report_dir / 'report.html'}")
+    sys.stdout.flush()
+    _finish_outputs(out.report_dir, wire, args.wire_log)
     return out.exit_code
+
+
+def _finish_outputs(report_dir: Path, wire: list, wire_copy) -> None:
+    """Reports rendered, the wire log whole, its copy written — or :class:`OutputLost` (exit 2)."""
+    from ...failures import OutputLost
+    from ...outputs import copy_output
+    from ...reports.render import render_all
+    from ...reports.results import ReportError
+
+    for w in wire:
+        w.check()
+    try:
+        render_all(report_dir)
+    except ReportError as e:
+        raise OutputLost(f"report not written: {e}") from None
+    if wire_copy:
+        copy_output(report_dir / "wire.log", wire_copy, what="wire log copy")

@@ -30,10 +30,11 @@ import time
 from dataclasses import dataclass, field
 from fnmatch import fnmatchcase
 from pathlib import Path
-from typing import Optional
+from typing import IO, Any, Callable, Optional
 
 from ... import __version__
 from ...clauses import vehicle_clauses
+from ...failures import describe_interrupt
 from ...judge import Ledger
 from ...judge.vehicle import VehicleObserver
 from ...judge.wire import tester_note
@@ -74,6 +75,11 @@ class Options:
     exec_grace_s: float = 5.0  #: SIGTERM → SIGKILL when stopping it
     exec_ready_s: float = 30.0  #: how long it may take to open (or listen on) the port
     certificate: Optional[RunDeclaration] = None  #: identity and signing key (helmcheck.reports.certificate)
+    # Command-line hooks (helmcheck.conformance.vehicle.cli): the link the command already
+    # opened (a port that cannot be opened is a usage error there), and how to open wire.log
+    # (a stream that remembers a write error for the command to report).
+    link: Optional[Any] = None
+    log_opener: Optional[Callable[[Path], IO[str]]] = None
 
 
 @dataclass
@@ -167,6 +173,8 @@ class Run:
         r["stats"] = self.stats
         if final:
             R.finish(r, partial=self.partial, strict=self.o.strict, duration_s=self.stats["wall_s"])
+            if self.partial and self.aborted:
+                r["verdict_reason"] = f"{self.aborted[:1].upper()}{self.aborted[1:]}. {r['verdict_reason']}"
         else:
             r["partial"] = True
             r["verdict"] = R.run_verdict([c["verdict"] for c in r["clauses"]], strict=self.o.strict, partial=True)
@@ -175,10 +183,16 @@ class Run:
 
     # ------------------------------------------------------------------ main
     def open(self) -> None:
-        wire = open(self.dir / R.WIRE_LOG_NAME, "w", encoding="utf-8")
+        wire_path = self.dir / R.WIRE_LOG_NAME
+        wire = (self.o.log_opener(wire_path) if self.o.log_opener is not None
+                else open(wire_path, "w", encoding="utf-8"))
         try:
-            raw = (self._start_child() if self.o.exec_cmd
-                   else open_link(self.o.port, role="client", baud=self.p.baud))
+            if self.o.exec_cmd:
+                raw = self._start_child()
+            elif self.o.link is not None:
+                raw = self.o.link
+            else:
+                raw = open_link(self.o.port, role="client", baud=self.p.baud)
         except (OSError, ValueError) as e:
             self.recorder = Recorder(wire, [], [self.observer])
             raise LinkLost(f"cannot open {self.o.port}: {getattr(e, 'strerror', None) or e}") from None
@@ -333,9 +347,13 @@ def certify(opts: Options) -> Outcome:
         except LinkLost as e:
             run.aborted = run.aborted or f"link fault: {e}"
             run.progress.note(f"link fault: {e}")
-    except KeyboardInterrupt:
+    except KeyboardInterrupt as e:  # Ctrl-C, SIGTERM, SIGHUP (helmcheck.signals)
         run.partial = True
-        run.aborted = "interrupted (Ctrl-C)"
+        run.aborted = describe_interrupt(e)
+    except Exception as e:  # a tester error: the results say partial, the command line says why
+        run.partial = True
+        run.aborted = f"tester error ({type(e).__name__})"
+        raise
     finally:
         run.progress.stop()
         try:
