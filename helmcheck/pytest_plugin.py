@@ -11,7 +11,8 @@ it adds one item per clause of that role, named by clause ID (``helmcheck.vehicl
 ``helmcheck.backseat::RH-BS-1``), then the item ``run-verdict``. The certification runs once per
 session, in the setup of the first helmcheck item that runs (its time is charged to that item),
 through the public runner APIs; the report directory (``--helm-report-dir``) gets
-``results.json``, the wire log and every report format, as the commands write them.
+``results.json``, the wire log and every report format, as the commands write them. The
+directory belongs to the plugin: each session replaces the previous session's run in it.
 
 Item outcomes (decisions where the issue left a choice):
 
@@ -61,7 +62,8 @@ def pytest_addoption(parser: pytest.Parser) -> None:
     g.addoption("--helm-profile", metavar="FILE", help="TOML profile (default: rh5)")
     g.addoption("--helm-time-scale", type=float, metavar="K", help="time scale (default: the profile's)")
     g.addoption("--helm-report-dir", metavar="DIR",
-                help="where results.json and the reports go (default: helmcheck-reports/<role>)")
+                help="where results.json and the reports go, replaced each session "
+                     "(default: helmcheck-reports/<role>)")
     g.addoption("--helm-exec-port", metavar="PORT", default="pty",
                 help="with an --helm-*-exec option: pty (default) or socket://127.0.0.1:0")
     g.addoption("--helm-strict", action="store_true", help="a SHOULD not met (NON-STRICT) fails its item")
@@ -154,7 +156,7 @@ class _Certification:
         opt = self.config.getoption
         argv = ["--port", opt("helm_exec_port"), "--duration", str(opt("helm_duration")),
                 "--time-scale", repr(self.time_scale), "--report-dir", str(self.report_dir),
-                "--exec", self.exec_cmd or ""]
+                "--exec", self.exec_cmd or "", "--overwrite"]  # the plugin's own directory: each session replaces it
         if opt("helm_profile"):
             argv += ["--profile", opt("helm_profile")]
         if self.strict:

@@ -1,16 +1,22 @@
 """Self-test by mutation: each faulty vehicle must fail certification on the right clause.
 
 Every mutant in :mod:`tests.faulty_vehicles` is served behind a real pty (the emulator's own I/O
-loop in a thread) at its time scale (25, or 60 where a whole mission must run) and certified with
-only the clauses that reach its fault selected, so each run takes a few seconds.
+loop in a thread) and certified, at each of its two time scales, with only the clauses that
+reach its fault selected, so each run takes a few seconds. The conforming core passes the same
+selections at the same time scales (no false alarms). Every run directory is also re-judged
+offline by the suite's agreement check (``tests/conftest.py``): live and offline must agree.
 """
 
 from __future__ import annotations
 
 import pytest
 
+from helmcheck.clauses import vehicle_clauses
 from helmcheck.conformance.vehicle.runner import Options, certify
 from tests.faulty_vehicles import EMU_PROFILE, MUTANTS, make_core, serve
+
+CASES = [(m, k) for m in MUTANTS for k in m.time_scales]
+
 
 def _certify(port, tmp_path, select, k, examples=0):
     opts = Options(port=port, profile=EMU_PROFILE.replace(time_scale=k), time_scale=k,
@@ -19,9 +25,8 @@ def _certify(port, tmp_path, select, k, examples=0):
     return certify(opts)
 
 
-@pytest.mark.parametrize("mutant", MUTANTS, ids=[m.name for m in MUTANTS])
-def test_mutant_fails_on_its_clause(mutant, tmp_path):
-    k = mutant.time_scale
+@pytest.mark.parametrize("mutant,k", CASES, ids=[f"{m.name}-x{k:g}" for m, k in CASES])
+def test_mutant_fails_on_its_clause(mutant, k, tmp_path):
     with serve(lambda start: make_core(mutant, k, start)) as port:
         out = _certify(port, tmp_path, mutant.select, k)
     failed = {c["id"]: c for c in out.results["clauses"] if c["verdict"] == "fail"}
@@ -32,13 +37,24 @@ def test_mutant_fails_on_its_clause(mutant, tmp_path):
     assert entry["reason"] and entry["evidence"], entry
 
 
-@pytest.mark.parametrize("k", sorted({m.time_scale for m in MUTANTS}))
+SCALES = sorted({k for m in MUTANTS for k in m.time_scales})
+
+
+@pytest.mark.parametrize("k", SCALES)
 def test_conforming_core_passes_the_same_selections(k, tmp_path):
-    """The unmutated core passes every selection the mutants use, at their time scale (no false alarms)."""
-    select = sorted({c for m in MUTANTS if m.time_scale == k for c in m.select})
+    """The unmutated core passes every selection the mutants use, at their time scales."""
+    select = sorted({c for m in MUTANTS if k in m.time_scales for c in m.select})
     with serve(lambda start: make_core(None, k, start)) as port:
         out = _certify(port, tmp_path, select, k)
     bad = {c["id"]: c["reason"] for c in out.results["clauses"] if c["verdict"] not in ("pass", "not-tested")}
     assert not bad, bad
     assert out.verdict == "pass"
     assert {c["id"] for c in out.results["clauses"] if c["verdict"] == "pass"} >= set(select)
+
+
+def test_every_vehicle_clause_has_a_faulty_vehicle():
+    """Mutation coverage: a clause no faulty vehicle fails is a clause the suite cannot show it
+    judges."""
+    covered = {m.clause for m in MUTANTS}
+    missing = [c.id for c in vehicle_clauses() if c.id not in covered]
+    assert not missing, f"no faulty vehicle for {', '.join(missing)}"

@@ -261,7 +261,7 @@ def test_row_link_fault_certify_backseat_peer_gone_is_2_with_a_partial_report(tm
         if proc.poll() is None:
             proc.kill()
     assert proc.returncode == 2, err
-    assert out.decode().startswith("INCONCLUSIVE (PARTIAL)")
+    assert out.decode().startswith("INCONCLUSIVE — partial:")
     assert load_results(tmp_path / "r")["partial"] and (tmp_path / "r" / "report.html").exists()
 
 

@@ -71,7 +71,7 @@ def test_certify_vehicle_signalled_mid_run_writes_partial_results_and_reports(si
     assert "Traceback" not in err
     r = _assert_interrupted_results(rdir, sig)
     assert proc.returncode == (1 if r["verdict"] == "fail" else 2)
-    assert out.startswith(f"{r['verdict'].upper()} (partial)"), out
+    assert out.startswith(f"{r['verdict'].upper()} — partial:"), out
 
 
 @pytest.mark.parametrize("sig", SIGNALS)
@@ -99,7 +99,7 @@ def test_certify_backseat_signalled_mid_run_writes_partial_results_and_reports(s
     assert proc.returncode == 2, err
     assert "Traceback" not in err
     _assert_interrupted_results(rdir, sig)
-    assert out.startswith("INCONCLUSIVE (PARTIAL)"), out
+    assert out.startswith("INCONCLUSIVE — partial:"), out
 
 
 @pytest.mark.parametrize("sig", SIGNALS)

@@ -128,7 +128,7 @@ def test_emulator_with_k_selection_passes_and_is_certified_once(pytester):
 
 def _served_mutant(name: str):
     m = next(m for m in MUTANTS if m.name == name)
-    return serve(lambda start: make_core(m, m.time_scale, start))
+    return serve(lambda start: make_core(m, m.time_scales[0], start))
 
 
 def test_faulty_vehicle_fails_its_clause_with_reason_and_evidence(pytester):

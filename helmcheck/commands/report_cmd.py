@@ -17,7 +17,8 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p = sub.add_parser("report", help="render results.json to HTML, JUnit XML and Markdown",
                        description=render.__doc__.strip().splitlines()[0] if render.__doc__ else None,
                        formatter_class=argparse.RawDescriptionHelpFormatter,
-                       epilog="exit status: 0 written; 2 a report could not be written; 64 usage "
+                       epilog="exit status: 0 written; 1 with --fail-on-regression, when a clause "
+                              "regressed or lost coverage; 2 a report could not be written; 64 usage "
                               "(bad option, an unreadable or invalid results directory).")
     render.add_arguments(p)
     p.set_defaults(func=run)
@@ -27,12 +28,14 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
 def run(args: argparse.Namespace) -> int:
     import sys
 
-    from ..failures import OutputLost, PathError
-    from ..reports.compare import compare_runs, compare_text
+    from ..failures import OutputLost, PathError, UsageError
+    from ..reports.compare import compare_runs, compare_text, worsened
     from ..reports.results import ReportError
     from ..reports.rundir import load_run
-    from ..reports.view import VERDICT_LABEL
+    from ..reports.scope import headline
 
+    if getattr(args, "fail_on_regression", False) and args.compare_dir is None:
+        raise UsageError("--fail-on-regression needs --compare OLD_DIR")
     try:
         run_ = load_run(args.directory)
         cmp = compare_runs(load_run(args.compare_dir), run_) if args.compare_dir is not None else None
@@ -43,11 +46,14 @@ def run(args: argparse.Namespace) -> int:
     except ReportError as exc:
         raise OutputLost(str(exc)) from None
     r = run_.results
-    partial = " (PARTIAL)" if r["partial"] else ""
-    print(f"{VERDICT_LABEL[r['verdict']]}{partial}: {r['verdict_reason']}")
+    print(f"{headline(r)}. {r['verdict_reason']}")  # the headline says when the run was cut short
     print(f"digest {run_.digest.combined}")
     for path in paths:
         print(f"wrote {path}")
     if cmp:
         print(compare_text(cmp), end="", file=sys.stdout)
+        if getattr(args, "fail_on_regression", False) and worsened(cmp):
+            print(f"helmcheck report: {len(cmp['regressed'])} clause(s) regressed and {len(cmp['lost'])} lost "
+                  f"coverage since {args.compare_dir}", file=sys.stderr)
+            return 1
     return 0

@@ -34,6 +34,7 @@ from typing import Optional
 from ...grammar import sentences as s
 from ...grammar.errors import SentenceError
 from ...model.timers import tolerance
+from ...model.transitions import INTERNAL_EVENTS, STAY, rows_for
 from ...model.vehicle import VehicleModel
 from ...profile import Profile
 from ..facts import ASCENT_REFUSED, INTERRUPTS, LOCKOUT_REFUSED
@@ -263,7 +264,18 @@ class Beliefs:
             if p.model.now is None or v_sent > p.model.now:
                 p.model.advance(v_sent)
             p.drain()
-            causes = [c for row in p.pending for c in row.clauses]
+            rows = list(p.pending)
+            if osi.mode != p.model.mode:
+                # a wrong mode: the rows that set a mode since the last report, latest first, are
+                # what the vehicle got wrong (a lockout's start or end changes no mode)
+                setters = [row for row in reversed(rows) if row.target != STAY]
+                # then an internal transition open to the model now that gives the reported mode
+                # under another guard (at the surface: park instead of the SRP, RH-SAF-4)
+                m = p.model
+                setters += [row for ev in INTERNAL_EVENTS for row in rows_for(m.mode, m.phase, ev)
+                            if row.target == osi.mode and row not in setters]
+                rows = setters + [row for row in rows if row not in setters]
+            causes = [c for row in rows for c in row.clauses]
             causes += [c for tt in p.timed for c in tt.row.clauses]
             released = any("RH-INT-2" in row.clauses for row in p.pending)
             if released and "opk" in p.abandoned:
@@ -274,6 +286,8 @@ class Beliefs:
                 causes.insert(0, "RH-SAF-2")
             if osi.mode == p.model.mode:  # the mode is right: a countdown is what differs
                 causes += {"mP": ["RH-PK-2"], "W": ["RH-OMW-4"]}.get(osi.mode, [])
+            if p.timed or any(tt for tt in (p.model.timer(),) if tt is not None and abs(tt[0] - v) <= 2 * tt[1]):
+                causes += ["RH-TIM-1", "RH-TIM-2"]  # a duration was being timed around this report
             result.causes = tuple(dict.fromkeys(c for c in causes if c != "RH-OUT-4"))
             self._confirm(p, osi, v_sent, v_recv, slack_v, passes=None, own=set())
             return result
