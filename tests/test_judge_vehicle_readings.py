@@ -180,3 +180,29 @@ def test_the_first_report_of_a_record_gives_the_state_it_starts_in(tmp_path):
     v = judge(tmp_path, rec)
     assert no_fail(v) == []
     assert verdict(v, "RH-OUT-4") == "pass"
+
+
+# ------------------------------------------------------------------------- timing brackets
+
+@pytest.mark.parametrize("early", [0.0, 0.003, 0.3])
+def test_RH_PRM_4_a_timeout_reported_just_before_the_model_deadline_is_still_timed(tmp_path, early):
+    """The $OMP's 10 s timeout ends within its tolerance but a little *before* the observer's own
+    deadline: the last report showing the primitive still starts the bracket (RH-TIM-1), so the
+    timer is judged PASS, not left NOT-TESTED."""
+    rec = poll(0.0, mode="S") + [(0.1, ">", "OMP,8a8a767690,00,10"), (0.11, "<", "ACK,10,0,0")]
+    rec += poll(0.2, mode="M", act="8A8A767690", speed=0.57)
+    rec += poll(9.5, mode="M", act="8A8A767690", speed=0.57)
+    rec += poll(10.11 - early, mode="S")  # the ACK came at 0.11: the deadline is 10.11
+    rec += poll(10.4, mode="S")  # the next report, after the deadline, closes the bracket
+    v = judge(tmp_path, rec)
+    assert no_fail(v) == []
+    assert verdict(v, "RH-PRM-4") == "pass", v["RH-PRM-4"]["reason"]
+    assert verdict(v, "RH-TIM-1") == "pass"
+
+
+def test_RH_PRM_4_a_timeout_far_before_its_deadline_fails(tmp_path):
+    rec = poll(0.0, mode="S") + [(0.1, ">", "OMP,8a8a767690,00,10"), (0.11, "<", "ACK,10,0,0")]
+    rec += poll(0.2, mode="M", act="8A8A767690", speed=0.57)
+    rec += poll(7.0, mode="S")
+    v = judge(tmp_path, rec)
+    assert verdict(v, "RH-OUT-4") == "fail" or verdict(v, "RH-PRM-4") == "fail"

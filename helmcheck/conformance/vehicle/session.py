@@ -33,7 +33,7 @@ from ...judge.timing import ack_allowance, ack_fail_after, tolerance
 from ...judge.vehicle import Sent, VehicleObserver
 from ...judge.wire import case_end_note, case_note, tester_note
 from ...profile import Profile
-from .flow import CaseStop, LinkLost, LinkSilent
+from .flow import CaseStop, LinkSilent
 from .link import TesterLink
 
 __all__ = ["Session", "frame"]

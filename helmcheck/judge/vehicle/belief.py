@@ -366,7 +366,7 @@ class Beliefs:
             own.add("RH-SAF-2")
             c.refused_locked = False
         self._plant(c, osi)
-        c.seen_v, c.seen_mode = v_sent, osi.mode
+        c.saw(v_sent, osi.mode)
         self._retime(c, osi, v_sent, v_recv, slack_v)
         c.lapse_uncertainty()
         if not c.timed:

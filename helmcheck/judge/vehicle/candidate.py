@@ -17,11 +17,16 @@ A :class:`Candidate` wraps a :class:`~helmcheck.model.vehicle.VehicleModel` (wit
   a primitive timeout from ``S``: RH-PRM-4), for the neutral fins-and-motor check;
 * ``refused_locked`` — a command was refused during the lockout; the first ``$OSI`` confirmed
   after the lockout shows it had no effect (RH-SAF-2);
-* ``seen_v`` / ``seen_mode`` / ``locked_v`` — the latest observations that tell a timer's
-  before-state: the ``$OSI`` mode, and the last err 26 to a command only the lockout refuses.
+* ``seen_v`` / ``seen_mode`` / ``seen_at`` / ``locked_v`` — the latest observations that tell a
+  timer's before-state: the ``$OSI`` mode (the latest report, and the latest of each mode: a
+  report of the after-state a little before the model's own deadline, within the tolerance,
+  leaves the last report of the before-state as the bracket's start), and the last err 26 to a
+  command only the lockout refuses.
 """
 
 from __future__ import annotations
+
+import math
 
 from dataclasses import dataclass
 from typing import Optional
@@ -68,7 +73,7 @@ class Candidate:
     """See the module docstring."""
 
     __slots__ = ("model", "events", "story", "extra_v", "window", "pending", "timed", "abandoned",
-                 "s_cause", "refused_locked", "seen_v", "seen_mode", "locked_v", "code_unknown",
+                 "s_cause", "refused_locked", "seen_v", "seen_mode", "seen_at", "locked_v", "code_unknown",
                  "_mode", "_phase")
 
     def __init__(self, model: VehicleModel):
@@ -86,6 +91,7 @@ class Candidate:
         self.refused_locked = False
         self.seen_v: Optional[float] = None
         self.seen_mode = ""
+        self.seen_at: dict[str, float] = {}
         self.locked_v: Optional[float] = None
         self.code_unknown = False
         self._mode = model.mode
@@ -101,6 +107,7 @@ class Candidate:
         c.abandoned = set(self.abandoned)
         c.s_cause, c.refused_locked = self.s_cause, self.refused_locked
         c.seen_v, c.seen_mode, c.locked_v = self.seen_v, self.seen_mode, self.locked_v
+        c.seen_at = dict(self.seen_at)
         c.code_unknown = self.code_unknown
         c._mode, c._phase = self._mode, self._phase
         return c
@@ -138,8 +145,8 @@ class Candidate:
                 if st.timer == "lockout":
                     if self.locked_v is not None and self.locked_v >= start:
                         t_old = self.locked_v
-                elif self.seen_v is not None and self.seen_v >= start and self.seen_mode == before_mode:
-                    t_old = self.seen_v
+                elif self.seen_at.get(before_mode, -math.inf) >= start:
+                    t_old = self.seen_at[before_mode]
                 self.timed.append(Timed(st.timer, row, st.at, st.duration, before_mode, t_old, self.extra_v))
             self._book(row, before_mode, before_phase)
         return fired
@@ -166,6 +173,11 @@ class Candidate:
     def check(self, osi, v: float, slack_v: float) -> list[tuple[str, str]]:
         """``[]`` when this candidate explains ``osi`` at ``v`` (RH-OUT-4, RH-TIM-1)."""
         return quick_expectation(self.model, v, slack_v + self.extra_v).check(osi)
+
+    def saw(self, v: float, mode: str) -> None:
+        """A confirmed ``$OSI`` showed ``mode``, sent at vehicle time ``v``."""
+        self.seen_v, self.seen_mode = v, mode
+        self.seen_at[mode] = v
 
     def lapse_uncertainty(self) -> None:
         """Drop ``extra_v`` once no timer started inside the adoption window remains."""

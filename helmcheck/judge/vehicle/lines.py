@@ -18,7 +18,7 @@ import re
 from dataclasses import dataclass
 from typing import Optional
 
-from ...grammar import Decoded, decode
+from ...grammar import Decoded
 from ...grammar import sentences as s
 from ...grammar.capture import escape
 from ...grammar.errors import SentenceError

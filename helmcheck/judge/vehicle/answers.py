@@ -1,0 +1,243 @@
+"""What the vehicle answered: ACK pairing, the command's effect, and every ``$OSI`` judged.
+
+:class:`Answers` is the part of :class:`~helmcheck.judge.vehicle.observer.VehicleObserver` that
+judges replies, split out to keep one concern per module; it works on the observer's own state
+(``pending``, ``silent``, ``gave_up``, ``beliefs``, ``checks``, the ledger) and is never used alone.
+
+* **ACK pairing** (RH-ACK-1, RH-ACK-6): the oldest waiting command of the ACK's type takes it;
+  one that a later command's ACK overtook is matched only when no other waits. An ACK after the
+  give-up deadline belongs to its late command (RH-ACK-2); one answering a line that must be
+  discarded fails that line's clause (RH-FRM-2/4/5/6/7, RH-SAF-5 for ``$OXFLT``).
+* **The ACK window** (RH-ACK-2, :func:`~helmcheck.judge.timing.ack_allowance`), the answer
+  against the mirror (:mod:`.belief`), and ``$OSD``'s data before its ACK (RH-ACK-5, RH-OSD-1).
+* **Every** ``$OSI`` against the mirror (RH-OUT-4 and the clauses of what led there, attributed by
+  :mod:`.blame`), the timers it brackets (RH-TIM-1/2), and the checks beyond the mirror
+  (:mod:`.osichecks`).
+"""
+
+from __future__ import annotations
+
+from ...grammar import sentences as s
+from ..ledger import Evidence
+from ..timing import ACK_GRACE_S, JITTER_S, ack_allowance, ack_fail_after
+from .blame import command_clauses, passable
+from .sent import Sent, brief, names, text_of
+
+__all__ = ["Answers", "UNSOLICITED", "OWN_REASON"]
+
+#: ACK types a vehicle sends unasked (RH-ACK-1).
+UNSOLICITED = (13, 14)
+OWN_REASON = {"RH-INT-3": "after the control that interrupted an $OPK park ended, the mission resumed, "
+                          "not the park",
+              "RH-OMW-5": "after the control that interrupted the $OMW queue ended, the mission resumed, "
+                          "not the queue",
+              "RH-SAF-2": "the commands refused during the lockout had no effect after it"}
+
+
+class Answers:
+    """ACK pairing and ``$OSI`` judging (module docstring); a base of the vehicle observer."""
+
+    # ------------------------------------------------------------------ ACK pairing
+    def _ack(self, a: s.ACK, t: float, evd: Evidence) -> None:
+        if a.type in UNSOLICITED:
+            self.ledger.passed("RH-ACK-1", "an unsolicited $ACK of its own type", [evd], self.case)
+            return
+        # the oldest waiting command of its type keeps the order; one the ACK of a later command
+        # already overtook is matched only when no other waits (then it is out of order, RH-ACK-6)
+        idx = next((i for i, p in enumerate(self.pending) if p.kind.ack_type == a.type and not p.overtaken),
+                   None)
+        if idx is None:
+            idx = next((i for i, p in enumerate(self.pending) if p.kind.ack_type == a.type), None)
+        if idx is not None:
+            p = self.pending[idx]
+            self._processed(p, t)
+            del self.pending[idx]
+            for i in range(idx):  # still waiting: an ACK that comes is out of order, none is missing
+                self.pending[i].overtaken = True
+            if p.overtaken:
+                self.book("fail", ("RH-ACK-6",), f"$ACK,{a.type} for {text_of(p)} came after the ACK of a "
+                                                 f"later command (ACKs out of order)", [p.ev, evd], at=p)
+            elif idx == 0:
+                self.ledger.passed("RH-ACK-6", "ACKs in command order", [p.ev, evd], p.case)
+            self._answered(p, a, t, evd, late=False)
+            return
+        late = next((q for q in self.gave_up if q.kind.ack_type == a.type and q.ack is None), None)
+        if late is not None:
+            self.gave_up.remove(late)
+            self._answered(late, a, t, evd, late=True)
+            return
+        silent = next((q for q in reversed(self.silent)
+                       if q.kind.kind != "oxflt" and q.kind.would_be in (a.type, None)), None)
+        oxflt = next((q for q in reversed(self.silent) if q.kind.kind == "oxflt"), None)
+        if oxflt is not None and silent is None:
+            oxflt.state, oxflt.ack = "answered-discard", a
+            self.silent.remove(oxflt)
+            self.book("fail", ("RH-SAF-5",), f"$ACK,{a.type},{a.status},{a.err} answered $OXFLT, which gets "
+                                             f"no ACK", [oxflt.ev, evd], at=oxflt)
+            return
+        if silent is not None:
+            silent.state, silent.ack = "answered-discard", a
+            self.silent.remove(silent)
+            self.book("fail", (silent.kind.clause,), f"{text_of(silent)} must be discarded silently "
+                                                     f"({silent.kind.clause}); the vehicle answered "
+                                                     f"$ACK,{a.type},{a.status},{a.err}", [silent.ev, evd],
+                      at=silent)
+            return
+        if self.first_command_t is None:
+            self.ledger.inconclusive("RH-ACK-1", "an $ACK before the first command of the record (its "
+                                                 "command may predate it)", [evd], self.case)
+            return
+        self.book("fail", ("RH-ACK-1",), f"$ACK,{a.type},{a.status},{a.err} answers no command waiting "
+                                         f"for one (a second ACK, or one for a line never sent)", [evd])
+
+    def _answered(self, p: Sent, a: s.ACK, t: float, evd: Evidence, late: bool) -> None:
+        p.state, p.ack, p.t_ack = "answered", a, t
+        ev = [p.ev, evd]
+        replies = self.vbytes - p.vbytes0
+        allowance = ack_allowance(self.profile.ack_window_s, len(p.raw), replies, self.baud, self.res)
+        dt = t - p.t
+        if late and p.late_booked:
+            pass  # RH-ACK-2 was booked when the give-up deadline passed
+        elif late or dt > ack_fail_after(allowance):
+            self.book("fail", ("RH-ACK-2",), f"$ACK,{a.type} came {dt:.2f} s after {text_of(p)}; the window with "
+                                             f"transmit time is {allowance - ACK_GRACE_S:.2f} s", ev, at=p)
+        elif dt > allowance:
+            self.ledger.inconclusive("RH-ACK-2", f"an $ACK came {dt:.2f} s after its command, over the "
+                                                 f"{allowance:.2f} s allowed by a margin host load can explain",
+                                     ev, self.case)
+        elif self.res > self.profile.ack_window_s / 10:
+            self.ledger.inconclusive("RH-ACK-2", f"timestamps step {self.res:g} s cannot bound a "
+                                                 f"{self.profile.ack_window_s:g} s window (RH-TIM-1)", ev, self.case)
+        else:
+            self.ledger.passed("RH-ACK-2", f"$ACK within {dt:.3f} s (allowed {allowance:.3f} s)", ev, self.case)
+        if not late:
+            self.ledger.passed("RH-ACK-1", "one $ACK of its own type", ev, self.case)
+        observed = [cls for _, cls, _ in p.data] + [a]
+        if p.branched:  # already in the mirror, unanswered: judge the late answer's content only
+            self._late_answer(p, a, observed, ev)
+            return
+        v_ack = self.v(t)
+        res = self.beliefs.command(p.kind.item, v_ack, self.k * (dt + JITTER_S + self.res), observed)
+        p.expected = res.expected
+        want = next((r for r in res.expected if isinstance(r, s.ACK)), None)
+        p.negative = want is not None and want.status == 1
+        if a.status:
+            self.event(t, "ack-error", f"{text_of(p)[:40]} → $ACK,{a.type},{a.status},{a.err}",
+                       negative_test=bool(p.negative and res.matched))
+        elif not isinstance(p.kind.item, s.OSD):
+            self.event(p.t, "command", text_of(p)[:60])
+            if res.before[0] in ("A", "M", "mP", "W") and res.row is not None and res.row.target != "=":
+                self.interrupt_pairs.add((res.before[0], p.kind.item.ID))
+        cands = command_clauses(p.kind.item, want, res.row)
+        if p.kind.variant:
+            cands = (p.kind.variant,) + cands
+        if res.matched:
+            self._matched(p, a, res, cands, ev)
+        else:
+            if want is not None and want.status == 1 and a.status == 1 and want.err != 26:
+                # refused, as it should be, with the wrong error number: RH-ACK-4 for a refused
+                # precondition, else RH-ACK-3 (each command's own "incorrect values" error)
+                first = "RH-ACK-4" if "RH-ACK-4" in cands else "RH-ACK-3"
+                cands = (first,) + tuple(c for c in cands if c != first)
+            what = (f"{text_of(p)}: a conforming vehicle in mode {res.before[0]} answers "
+                    f"{brief(res.expected)}; got {brief(observed)}")
+            if res.desync:
+                self.book("inconclusive", cands, f"{what} — not judged: the observer lost track of the "
+                                                 f"vehicle's state before ({res.desync})", ev, at=p)
+            else:
+                self.book("fail", cands, what, ev, at=p)
+        for tt, verdict, reason in res.timings:
+            self._timing(tt, verdict, reason, ev)
+        if p.kind.ack_type == 8:
+            self.last_osd = p
+            self._osd_data(p, a, ev)
+        self.checks.answered(p, a, res, ev)
+
+    def _late_answer(self, p: Sent, a: s.ACK, observed: list, ev: list) -> None:
+        want = next((r for r in p.expected if isinstance(r, s.ACK)), None)
+        if want is None or (want.status, want.err) == (a.status, a.err):
+            return
+        row = self.beliefs.primary.model.row_for(p.kind.item) if not hasattr(p.kind.item, "ack_err") else None
+        self.book("inconclusive", command_clauses(p.kind.item, want, row),
+                  f"{text_of(p)} answered late, out of order, {brief([a])}; a conforming vehicle answers "
+                  f"{brief([want])} — not judged: the state it met is not known", ev, at=p)
+
+    def _matched(self, p: Sent, a: s.ACK, res, cands: tuple[str, ...], ev: list) -> None:
+        if res.mission_dependent:
+            self.book("inconclusive", cands, f"{text_of(p)} answered {brief([a])}: the answer depends on the "
+                                             f"vehicle's mission files, which the observer does not have", ev,
+                      at=p)
+            return
+        if res.adopted:
+            for cid in cands[:1]:
+                self.ledger.remark(cid, f"explained by an unseen event: {res.adopted[-1]}.")
+        row = res.row
+        if a.status:
+            self.passed(passable(cands), f"{text_of(p)} refused with $ACK,{a.type},1,{a.err} as a conforming "
+                                         f"vehicle in mode {res.before[0]} does", ev)
+            if a.err == 26:
+                self.ledger.passed("RH-SAF-1" if res.before[1] == "lockout" else "RH-SAF-3",
+                                   f"{text_of(p)} refused with err 26", ev, self.case)
+        elif row is not None and row.target == "=" and row.phase_to is None:
+            self.passed(passable(cands), f"{text_of(p)} accepted in mode {res.before[0]}", ev)
+        elif p.kind.variant:
+            self.passed((p.kind.variant,), f"{text_of(p)} read and answered", ev)
+
+    def _osd_data(self, p: Sent, a: s.ACK, ev: list) -> None:
+        """RH-ACK-5, RH-OSD-1, RH-OSD-2 for an answered ``$OSD``."""
+        got = [cls for _, cls, _ in p.data]
+        if a.status:
+            if got:
+                self.book("fail", ("RH-OSD-2",), f"a refused $OSD carried {len(got)} data sentence(s)", ev, at=p)
+            return
+        want = [type(r).__name__ for r in p.expected if not isinstance(r, s.ACK)]
+        if got == want:
+            if want:
+                self.ledger.passed("RH-ACK-5", "the data came before the $ACK,8", ev, self.case)
+            self.ledger.passed("RH-OSD-1", f"{len(got)} data sentence(s) in request order", ev, self.case)
+        elif len(got) < len(want) and got == want[:len(got)]:
+            self.book("fail", ("RH-ACK-5", "RH-OSD-1"), f"$ACK,8 came before all its data: got "
+                                                       f"{names(got)}, expected {names(want)}", ev, at=p)
+        else:
+            self.book("fail", ("RH-OSD-1",), f"$OSD answered {names(got)}; expected {names(want)} "
+                                             f"in request order", ev, at=p)
+
+    # ------------------------------------------------------------------ $OSI
+    def _osi(self, osi: s.OSI, p: Sent, t: float, evd: Evidence) -> None:
+        """RH-OUT-4 and the clauses of what led to the reported state."""
+        ev = [p.ev, evd]
+        self.last_osi, self.last_osi_t = osi, t
+        self.mode_seen(t, osi.mode)
+        res = self.beliefs.osi(osi, self.v(p.t), self.v(t), self.slack_v())
+        if res.findings:
+            cands = ("RH-OUT-4",) + tuple(c for c in res.causes if c != "RH-OUT-4") + self.checks.recent()
+            msg = res.findings[0][1]
+            if res.desync:
+                self.book("inconclusive", cands, f"{msg} — not judged: the observer lost track of the "
+                                                 f"vehicle's state before ({res.desync})", ev, at=p)
+            else:
+                self.book("fail", cands, msg, ev, at=p)
+            self.checks.after_osi(osi, p, t, ev, judged=False)
+            return
+        self.ledger.passed("RH-OUT-4", f"mode {osi.mode}, waypoint {osi.next_waypoint}, P{osi.park_time}, "
+                                       f"error {osi.error_state} as a conforming vehicle reports", ev, self.case)
+        if res.adopted:
+            self.ledger.remark("RH-OUT-4", f"unseen events were adopted to explain reports, e.g. {res.adopted[-1]}.")
+        self.passed(passable(res.passes), f"seen to take effect: $OSI mode {osi.mode}", ev)
+        for cid in sorted(res.own):
+            self.ledger.passed(cid, OWN_REASON[cid], ev, self.case)
+        for tt, verdict, reason in res.timings:
+            self._timing(tt, verdict, reason, ev)
+        self.checks.after_osi(osi, p, t, ev, judged=True, passes=res.passes)
+
+    def _timing(self, tt, verdict: str, reason: str, ev: list) -> None:
+        """RH-TIM-1 (and the timer's clause) from a transition's bracket."""
+        clauses = tt.clauses + ("RH-TIM-1", "RH-TIM-2")
+        for cid in clauses:
+            if verdict == "pass":
+                text = reason if cid != "RH-TIM-2" else f"{reason} at the declared time scale {self.k:g}"
+                self.ledger.passed(cid, text, ev, self.case)
+            elif verdict == "not-tested":
+                self.ledger.not_tested(cid, reason, self.case)
+            else:
+                self.ledger.inconclusive(cid, reason, ev, self.case)

@@ -1,0 +1,78 @@
+"""One backseat line as the vehicle observer classified it, and how it is quoted in reasons.
+
+:class:`Sent` is what :class:`~helmcheck.judge.vehicle.observer.VehicleObserver` keeps per line
+it saw go to the vehicle (its kind, its case, the ACK and data that answered it); a live driver
+waits on it. The helpers format lines and replies for verdict reasons.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Optional
+
+from ...grammar import sentences as s
+from ...grammar.capture import escape
+from ..ledger import Evidence
+from .lines import Kind
+
+__all__ = ["Sent", "class_of_id", "text_of", "brief", "names"]
+
+
+@dataclass
+class Sent:
+    """One backseat line as the observer classified it, and what became of it."""
+
+    seq: int
+    t: float  #: wall time of the record holding its last byte
+    raw: bytes
+    ev: Evidence
+    kind: Kind
+    case: str = ""
+    case_clauses: tuple = ()
+    vbytes0: int = 0  #: vehicle bytes seen before it (for the transmit time of the replies)
+    state: str = "pending"  #: pending | answered | missing | silent | answered-discard
+    ack: Optional[s.ACK] = None
+    t_ack: Optional[float] = None
+    data: list = field(default_factory=list)  #: (sentence or None, class name, Evidence)
+    expected: list = field(default_factory=list)
+    osi: Optional[s.OSI] = None
+    negative: bool = False  #: a conforming vehicle refuses it: the tester's own negative test
+    overtaken: bool = False  #: the ACK of a later command came first
+    waited: float = 0.0  #: how long the observer waited before calling its ACK missing
+    branched: bool = False  #: a later command was answered first: taken into the mirror unanswered
+    late_booked: bool = False  #: RH-ACK-2 booked: no ACK by the give-up deadline
+    missing_booked: bool = False  #: RH-ACK-1 booked: no ACK at all
+
+    @property
+    def done(self) -> bool:
+        return self.state != "pending"
+
+    @property
+    def accepted(self) -> bool:
+        return self.ack is not None and self.ack.status == 0
+
+
+def class_of_id(sid: Optional[str]) -> str:
+    """The data class an ``$OSD`` letter asks for (``C`` → ``Compass``)."""
+    return {"C": "Compass"}.get(sid or "", sid or "?")
+
+
+def text_of(p: Sent) -> str:
+    """A backseat line as evidence text (escaped, at most 80 characters)."""
+    return escape(p.raw.rstrip(b"\r\n"))[:80]
+
+
+def brief(replies: list) -> str:
+    """Replies as ``$ACK,t,s,e, $OSI`` for a reason."""
+    out = []
+    for r in replies:
+        if isinstance(r, s.ACK):
+            out.append(f"$ACK,{r.type},{r.status},{r.err}")
+        else:
+            out.append("$" + (r if isinstance(r, str) else type(r).__name__))
+    return ", ".join(out) or "nothing"
+
+
+def names(xs: list) -> str:
+    """Sentence names as ``$OSI,$Compass``."""
+    return ",".join("$" + x for x in xs) or "none"
