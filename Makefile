@@ -20,8 +20,11 @@ $(STAMP): pyproject.toml
 demo: $(STAMP)
 	$(PY) -m helmcheck.demo
 
+# The suite mostly waits on ptys and scaled time, so it runs on more workers than cores.
+TEST_WORKERS ?= 4
+
 test: $(STAMP)
-	$(PY) -m pytest
+	$(PY) -m pytest -n $(TEST_WORKERS) --dist loadgroup
 
 # Not run by CI: the same property tests with random seeds and 20 times the examples
 # (tests/conftest.py, profile "fuzz"). A failure prints the blob that reproduces it.

@@ -7,6 +7,11 @@ a database, and :data:`FUZZ_FACTOR` times the examples each test asks for.
 
 It also checks that no process helmcheck started (``--exec``) outlives the test session, and
 that every results directory a test writes verifies (live and offline judging agree).
+
+``make test`` runs the suite on several workers (pytest-xdist, ``--dist loadgroup``): a module
+whose tests share a module-scoped run marks itself ``xdist_group`` so the run happens once, and
+the full signed emulator certification (:func:`full_emulator_run`) is shared by the tests of the
+group ``full-emulator-run``.
 """
 
 import os
@@ -100,3 +105,33 @@ def pytest_runtest_makereport(item, call):
     rep = outcome.get_result()
     if rep.when == "call":
         item.rep_call = rep
+
+
+#: Time scale of the shared full certification.
+FULL_RUN_K = 40.0
+
+
+@pytest.fixture(scope="session")
+def full_emulator_run(tmp_path_factory):
+    """One full, signed certification of the built-in emulator (``helmcheck emulate`` on a pty,
+    time scale 40, 5 explored sequences, seed 2), shared by the tests that read it. Returns
+    ``(root, exit_code, emulator_alive)``: ``root/full`` is the run, ``root/lab.key``/``.pub`` and
+    ``root/other.*`` two key pairs, ``root/emu.toml`` the profile given; ``emulator_alive`` says the
+    emulator was still running when the certification ended."""
+    from helmcheck.cli import main as cli_main
+    from helmcheck.conformance.emulator.process import EmulatorProcess
+
+    root = tmp_path_factory.mktemp("full-run")
+    assert cli_main(["keygen", "--out", str(root / "lab")]) == 0
+    assert cli_main(["keygen", "--out", str(root / "other")]) == 0
+    prof = root / "emu.toml"
+    prof.write_text('fault_injection = "oxflt"\nbaud = 115200\nvehicle_serial = "EMU-0001"\n'
+                    'uvc_version = "emulator 0.1.0"\n')
+    with EmulatorProcess(time_scale=FULL_RUN_K, baud=115200) as emu:
+        code = cli_main(["certify", "vehicle", "--port", emu.port, "--time-scale", str(FULL_RUN_K),
+                         "--profile", str(prof), "--examples", "5", "--seed", "2", "--no-progress",
+                         "--report-dir", str(root / "full"), "--sign-key", str(root / "lab.key"),
+                         "--operator", "J. Doe", "--site", "Bench 2"])
+        alive = emu.proc.poll() is None
+    return root, code, alive
+

@@ -20,8 +20,14 @@ MARKER = "HELMCHECK_TEST_RUN"
 
 
 def install_marker() -> str:
-    """Set (once) this session's marker in the environment; returns its value."""
-    return os.environ.setdefault(MARKER, uuid.uuid4().hex)
+    """Set (once) this session's marker in the environment; returns its value. Each pytest-xdist
+    worker has its own (a worker's survivors are its own tests' processes, not another worker's
+    that are still running)."""
+    suffix = "-" + os.environ.get("PYTEST_XDIST_WORKER", "main")
+    current = os.environ.get(MARKER, "")
+    if not current.endswith(suffix):
+        os.environ[MARKER] = uuid.uuid4().hex + suffix
+    return os.environ[MARKER]
 
 
 def _environ(pid: str) -> dict[str, str]:

@@ -93,6 +93,10 @@ def certify(report_dir: Path, backseat: list[str] | None, *, extra: tuple[str, .
             "backseat_err": errs.read_text(errors="replace") if errs.exists() else ""}
 
 
+#: The module-scoped run below is made once: all of this module's tests go to one worker.
+pytestmark = pytest.mark.xdist_group("test_certify_backseat")
+
+
 @pytest.fixture(scope="module")
 def runs(tmp_path_factory):
     """Every certification of this module, one batch per time scale (each batch at once).

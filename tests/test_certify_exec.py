@@ -56,6 +56,10 @@ def _run(root: Path, name: str, argv: tuple[str, ...]) -> dict:
             "results": load_results(report), "left": left}
 
 
+#: The module-scoped run below is made once: all of this module's tests go to one worker.
+pytestmark = pytest.mark.xdist_group("test_certify_exec")
+
+
 @pytest.fixture(scope="module")
 def runs(tmp_path_factory):
     root = tmp_path_factory.mktemp("exec")

@@ -359,7 +359,7 @@ def test_row_output_parse_to_a_full_device_is_2_naming_standard_output(tmp_path)
 @pytest.mark.parametrize("content, json_mode, want", [
     (b"$OMSTOP,0*06\r\n" * 50000, True, 0),  # parse --json … | head -1: quiet, exit 0
     (b"$OMSTOP,0*07\r\n" * 50000, False, 1),  # invalid lines were reported before the cut
-])
+], ids=["json", "invalid-lines"])
 def test_row_output_a_reader_that_goes_away_ends_parse_quietly(tmp_path, content, json_mode, want):
     f = tmp_path / "cap.txt"
     f.write_bytes(content)

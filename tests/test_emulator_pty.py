@@ -24,6 +24,10 @@ K = 20.0  # time scale
 SOAK_S = float(os.environ.get("HELMCHECK_SOAK_S", "8"))
 
 
+#: The module-scoped run below is made once: all of this module's tests go to one worker.
+pytestmark = pytest.mark.xdist_group("test_emulator_pty")
+
+
 @pytest.fixture(scope="module")
 def missions_dir(tmp_path_factory):
     root = tmp_path_factory.mktemp("emu")

@@ -10,6 +10,10 @@ import pytest
 from helmcheck.conformance.emulator.process import EmulatorProcess, HelmClient, frame
 from helmcheck.conformance.transport import open_link
 
+#: The module-scoped run below is made once: all of this module's tests go to one worker.
+pytestmark = pytest.mark.xdist_group("test_emulator_tcp")
+
+
 @pytest.fixture(scope="module")
 def emulator():
     emu = EmulatorProcess(port="socket://127.0.0.1:0", time_scale=20, baud=0).start()

@@ -64,6 +64,10 @@ class Cells(HTMLParser):
             self._heading.append(data)
 
 
+#: The module-scoped run below is made once: all of this module's tests go to one worker.
+pytestmark = pytest.mark.xdist_group("test_matrix")
+
+
 @pytest.fixture(scope="module")
 def run_dirs(tmp_path_factory):
     root = tmp_path_factory.mktemp("matrix")

@@ -28,22 +28,19 @@ K = 40.0
 GOOD_BACKSEAT = Path(__file__).resolve().parent / "backseats" / "good_backseat.py"
 
 
+pytestmark = pytest.mark.xdist_group("full-emulator-run")
+
+
 @pytest.fixture(scope="module")
-def runs(tmp_path_factory):
-    """A signed full emulator certification, a --select run of it, and a signed backseat run."""
-    root = tmp_path_factory.mktemp("verify")
-    assert cli_main(["keygen", "--out", str(root / "lab")]) == 0
-    assert cli_main(["keygen", "--out", str(root / "other")]) == 0
-    prof = root / "emu.toml"
-    prof.write_text('fault_injection = "oxflt"\nbaud = 115200\nvehicle_serial = "EMU-0001"\n'
-                    'uvc_version = "emulator 0.1.0"\n')
-    codes = {}
+def runs(full_emulator_run):
+    """The shared signed full emulator certification (``tests/conftest.py``), a ``--select`` run
+    of the emulator, and a signed backseat run, side by side under one root."""
+    root, code, _alive = full_emulator_run
+    codes = {"full": code}
     with EmulatorProcess(time_scale=K, baud=115200) as emu:
-        base = ["certify", "vehicle", "--port", emu.port, "--time-scale", str(K), "--profile", str(prof),
-                "--examples", "5", "--seed", "2", "--no-progress"]
-        codes["full"] = cli_main(base + ["--report-dir", str(root / "full"), "--sign-key", str(root / "lab.key"),
-                                         "--operator", "J. Doe", "--site", "Bench 2"])
-        codes["select"] = cli_main(base + ["--report-dir", str(root / "select"), "--select", "RH-SRV-*"])
+        codes["select"] = cli_main(["certify", "vehicle", "--port", emu.port, "--time-scale", str(K),
+                                    "--profile", str(root / "emu.toml"), "--examples", "5", "--seed", "2",
+                                    "--no-progress", "--report-dir", str(root / "select"), "--select", "RH-SRV-*"])
     codes["backseat"] = _certify_backseat(root / "backseat", root / "lab.key")
     return root, codes
 

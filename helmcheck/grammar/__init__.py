@@ -10,18 +10,19 @@ Public API::
     format(sentence) -> bytes                          # canonical: upper-case checksum, CR LF
     checksum(body) -> int;  checksum_hex(body) -> str
     Framer(max_line=256).feed(bytes) -> [Line | Discard]
+    prepare()                                          # build lazily-built parsers now (live use)
 """
 
 from .capture import WireLogError, WireLogWriter, WireRecord, read_records
 from .checksum import checksum, checksum_hex
-from .codec import KNOWN_IDS, Decoded, decode, format, format_body, parse
+from .codec import KNOWN_IDS, Decoded, decode, format, format_body, parse, prepare
 from .errors import Finding, SentenceError
 from .framer import Discard, Framer, Line
 from .sentences import *  # noqa: F401,F403
 from .sentences import __all__ as _sentence_names
 
 __all__ = [
-    "parse", "decode", "format", "format_body", "Decoded", "KNOWN_IDS", "checksum",
+    "parse", "decode", "format", "format_body", "prepare", "Decoded", "KNOWN_IDS", "checksum",
     "checksum_hex", "Framer", "Line", "Discard", "SentenceError", "Finding", "WireRecord",
     "WireLogError", "WireLogWriter", "read_records", *_sentence_names,
 ]

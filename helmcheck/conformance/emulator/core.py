@@ -47,7 +47,8 @@ from dataclasses import dataclass, fields as dc_fields
 from pathlib import Path
 from typing import IO, Any, Callable, Optional
 
-from ...grammar import Decoded, Discard, Framer, decode, format as format_sentence
+from ...grammar import Decoded, Discard, Framer, decode, prepare
+from ...grammar import format as format_sentence
 from ...grammar import sentences as s
 from ...grammar.capture import FROM_VEHICLE, NOTE, TO_VEHICLE, WireLogWriter, escape
 from ...grammar.errors import SentenceError
@@ -127,6 +128,7 @@ class EmulatorCore:
                  params: Optional[PlantParams] = None, history: int = 400,
                  on_error: Optional[Callable[[str], None]] = None,
                  model_factory: Callable[[Profile, Optional[MissionCatalog]], VehicleModel] = VehicleModel):
+        prepare()  # the first malformed line is answered within the ACK window too (RH-ACK-2)
         self.profile = profile
         self.time_scale = float(time_scale if time_scale is not None else profile.time_scale)
         if self.time_scale <= 0:

@@ -35,6 +35,7 @@ from typing import IO, Any, Callable, Optional
 from ... import __version__
 from ...clauses import vehicle_clauses
 from ...failures import describe_interrupt
+from ...grammar import prepare
 from ...judge import Ledger
 from ...judge.vehicle import VehicleObserver
 from ...judge.wire import tester_note
@@ -187,6 +188,7 @@ class Run:
         wire = (self.o.log_opener(wire_path) if self.o.log_opener is not None
                 else open(wire_path, "w", encoding="utf-8"))
         try:
+            prepare()  # before the first byte: reading a malformed line must not stall the clock
             if self.o.exec_cmd:
                 raw = self._start_child()
             elif self.o.link is not None:
