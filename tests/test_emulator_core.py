@@ -83,6 +83,43 @@ def test_mission_file_round_trip_and_errors():
             parse_mission(bad, "bad.mis")
 
 
+def test_RH_SAF_5_max_time_s_parses_round_trips_and_is_checked():
+    m = parse_mission("helmcheck-mission 1\nmax_time_s 90 # Maximum Operation Time\n1 2 3 4 0\n", "t.mis")
+    assert m.max_time_s == 90.0
+    assert parse_mission(format_mission(m), "t.mis") == m
+    assert parse_mission("helmcheck-mission 1\n1 2 3 4 0\n", "t.mis").max_time_s is None
+    for bad in ("max_time_s 0", "max_time_s -5", "max_time_s", "max_time_s 1 2", "max_time_s x",
+                "max_time_s 1\nmax_time_s 2"):
+        with pytest.raises(MissionFileError):
+            parse_mission(f"helmcheck-mission 1\n{bad}\n1 2 3 4 0\n", "bad.mis")
+
+
+@pytest.mark.parametrize("limit", [15.0, 37.5])
+def test_RH_SAF_5_a_missions_own_rule_trips_stl_at_its_time_and_once_per_start(tmp_path, limit):
+    """The emulator raises Stl ``max_time_s`` vehicle seconds after the mission starts (not
+    before, not twice); a new start runs the clock again; a stopped mission never trips."""
+    (tmp_path / "t.mis").write_text(f"helmcheck-mission 1\nmax_time_s {limit}\n"
+                                    "41.53 -71.32 10 2 0\n41.54 -71.32 10 2 0\n")
+    k = 10.0
+    core = EmulatorCore(DEFAULT.replace(baud=0), DirectoryCatalog([tmp_path, builtin_dir()]), time_scale=k,
+                        baud=0)
+    assert acks(core.feed(frame("OMSTART,0,0,0,0,t.mis,"), 0.0)) == [(3, 0, 0)]
+    due = limit / k
+    run_until(core, 0.0, due - 0.05)
+    assert osi(core, due - 0.05).error_state == "N"
+    run_until(core, due - 0.05, due + 0.05)
+    assert osi(core, due + 0.05).error_state == "Stl"
+    assert core.stats["faults"] == 1
+    # after the lockout, a stop and a new start: the clock runs again from the new start
+    t = due + 40 / k
+    run_until(core, due + 0.05, t)
+    assert acks(core.feed(frame("OMSTOP,0"), t)) == [(1, 0, 0)]
+    assert acks(core.feed(frame("OMSTART,0,0,0,0,t.mis,"), t + 0.1)) == [(3, 0, 0)]
+    assert acks(core.feed(frame("OMSTOP,0"), t + 0.2)) == [(1, 0, 0)]  # stopped before it trips
+    run_until(core, t + 0.2, t + 0.2 + 2 * due)
+    assert core.stats["faults"] == 1
+
+
 def test_RH_MSN_1_catalogue_never_leaves_its_directory(tmp_path):
     root = tmp_path / "missions"
     (root / "sub").mkdir(parents=True)

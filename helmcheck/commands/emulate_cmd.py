@@ -33,6 +33,12 @@ examples:
 socket only). Built-in missions: conformance.mis (the profile's test mission), short.mis,
 srp.mis; --missions DIR adds a directory that overrides them. $OXFLT,<code> (RH-SAF-5) is
 honoured unless --no-fault-injection.
+
+the vehicle's own safety rules (RH-SAF-5), for certifying without $OXFLT:
+  a mission file line 'max_time_s 120' is the mission's Maximum Operation Time: the vehicle
+  raises Stl 120 vehicle seconds after the mission starts (profile violation_trigger =
+  "mission-rule"). SIGUSR1 is an operator tripping the leak sensor on the bench: the vehicle
+  raises Sle at once (profile violation_trigger = "operator"), e.g. kill -USR1 <pid>.
 """
 
 
@@ -172,15 +178,16 @@ def _serve(args, profile, link, baud, missions_dir, log_file, main_log_file) -> 
                             utc0=started.timestamp(),
                             on_error=None if args.tui else lambda text: print(f"helmcheck emulate: {text}",
                                                                               file=sys.stderr))
+        if args.tui:
+            from ..conformance.emulator.tui import LiveView
+            ui = LiveView(core, link.name)
+        server = Server(link, core, ui=ui, install_signals=False)
+        _operator_trips(server)  # before the port is announced: a trip is never fatal
         sys.stdout.write(f"port: {link.name}\n")
         sys.stdout.flush()
         print(f"helmcheck emulate: {link.description}, profile {profile.name}, time scale "
               f"{profile.time_scale:g}, baud {baud or 'unpaced'}, fault injection "
               f"{profile.fault_injection}, missions {', '.join(str(d) for d in dirs)}", file=sys.stderr)
-        if args.tui:
-            from ..conformance.emulator.tui import LiveView
-            ui = LiveView(core, link.name)
-        server = Server(link, core, ui=ui, install_signals=False)
         stopped = "stopped"
         try:
             if ui is not None:
@@ -202,3 +209,16 @@ def _serve(args, profile, link, baud, missions_dir, log_file, main_log_file) -> 
         raise LinkFault(f"link fault on {link.name}: {server.lost or 'the link failed'}")
     print(f"helmcheck emulate: {stopped}", file=sys.stderr)
     return exitcodes.OK
+
+
+#: The code an operator's trip raises (SIGUSR1): the leak sensor, the one a bench can trip.
+OPERATOR_CODE = "Sle"
+
+
+def _operator_trips(server) -> None:
+    """SIGUSR1: an operator tripped the leak sensor (RH-SAF-5, ``violation_trigger = "operator"``)."""
+    import signal
+
+    if hasattr(signal, "SIGUSR1"):
+        signal.signal(signal.SIGUSR1, lambda *_: server.request_fault(OPERATOR_CODE, "operator: SIGUSR1"))
+

@@ -74,6 +74,10 @@ class Mission:
 
     name: str
     waypoints: Union[tuple[Waypoint, ...], OpenWaypoints]
+    #: The mission's Maximum Operation Time safety rule, in vehicle seconds from its start, or
+    #: ``None``. The vehicle raises ``Stl`` when it trips (RH-SAF-5); the model does not time it
+    #: (a violation is the vehicle's own event, told to the model as a plant event).
+    max_time_s: Optional[float] = None
 
     def __post_init__(self) -> None:
         if isinstance(self.waypoints, OpenWaypoints):

@@ -58,6 +58,7 @@ from ...model.vehicle import VehicleModel
 from ...profile import SAFETY_CODES, Profile
 from ..transport import LinePacer
 from .plant import Plant, PlantParams
+from .rules import OperationTimeRule
 
 __all__ = ["EmulatorCore", "HistoryEntry", "MainLog", "MAX_OUTBOX_BYTES", "DEFAULT_UTC0"]
 
@@ -137,6 +138,7 @@ class EmulatorCore:
         self.utc0 = utc0
         self.plant = Plant(profile, params or PlantParams())
         self.model = model_factory(profile, missions)
+        self.rules = OperationTimeRule()  #: a mission's own Maximum Operation Time (RH-SAF-5)
         self.framer = Framer(profile.max_line_bytes)
         self.pacer = LinePacer(profile.baud if baud is None else baud)
         self.log = log
@@ -188,6 +190,10 @@ class EmulatorCore:
         md = self.model.next_deadline()
         if md is not None:
             best = self.wall_time(max(md, self.v))
+        rd = self.rules.due_v
+        if rd is not None:
+            w = self.wall_time(max(rd, self.v))
+            best = w if best is None else min(best, w)
         pb = self.plant.next_event_in(self.model)
         if pb is not None:
             w = self.wall_time(self.v + max(pb, self.plant.params.dt / 4))
@@ -339,7 +345,8 @@ class EmulatorCore:
         return next((r for r in reversed(replies) if isinstance(r, s.ACK)), None)
 
     def _model_call(self, fn: Callable[[], Any], now: float) -> Any:
-        """Call into the model; a model exception is logged, never fatal to the emulator."""
+        """Call into the model; a model exception is logged, never fatal to the emulator. The
+        mission's own rule sees every change (a mission started or stopped at ``self.v``)."""
         try:
             return fn()
         except Exception as e:  # noqa: BLE001 - keep serving; the note names the failure
@@ -349,6 +356,8 @@ class EmulatorCore:
             if self._on_error is not None:
                 self._on_error(text)
             return None
+        finally:
+            self.rules.observe(self.model, self.v)
 
     def _after_model(self, now: float) -> None:
         """Flush the model's pending events to the log and let the plant see the new goal."""
@@ -383,7 +392,18 @@ class EmulatorCore:
                     self._note(wall, f"model: {_event_text(me)}")
                 p.sync(m)
                 continue
-            seg_end = target if md is None or md > target else md
+            rd = self.rules.due_v
+            if rd is not None and rd <= self.v:  # the mission's Maximum Operation Time tripped
+                self._push_snapshot()
+                wall = self.wall_time(self.v)
+                ev = self.rules.fire()
+                self.stats["faults"] += 1
+                self._note(wall, f"plant: {_event_text(ev)} at v={self.v:.3f}")
+                for me in self._model_call(lambda: m.plant(ev, self.v), wall) or ():
+                    self._note(wall, f"model: {_event_text(me)}")
+                p.sync(m)
+                continue
+            seg_end = min(x for x in (target, md, rd) if x is not None)
             if self.v >= seg_end:
                 break
             evs = p.step(m, seg_end - self.v)

@@ -15,6 +15,11 @@ waypoint 0)::
     41.521349   -71.320000    2.0      2.0       0
     41.522698   -71.320000    2.0      2.0       300
 
+A line ``max_time_s <seconds>`` (at most one, anywhere after the header) gives the mission a
+Maximum Operation Time safety rule: the vehicle raises ``Stl`` that many vehicle seconds after
+the mission starts (RH-SAF-5; a bench vehicle's own rule that a certification can wait for,
+profile ``violation_trigger = "mission-rule"``). The value is positive, at most 7 days.
+
 Waypoint fields are separated by blanks or commas: latitude and longitude in signed decimal
 degrees ([-90, 90], [-180, 180]), depth in metres from the surface ([0, 1000]), speed in knots
 (> 0, at most 10), and the mission park time in seconds (>= 0; 0 = no park). A trailing
@@ -42,7 +47,7 @@ import re
 import stat
 from importlib import resources
 from pathlib import Path
-from typing import Iterable, Union
+from typing import Iterable, Optional, Union
 
 from ...model.missions import (BadMission, LookupResult, MissingMission, Mission, Waypoint,
                                mission_name_problem, normalise_name)
@@ -73,11 +78,21 @@ def parse_mission(text: str, name: str) -> Mission:
     if not lines or lines[0].strip() != HEADER:
         raise MissionFileError(f"line 1: header must be {HEADER!r}")
     wps: list[Waypoint] = []
+    max_time: Optional[float] = None
     for lineno, line in enumerate(lines[1:], 2):
         body = line.split("#", 1)[0].strip()
         if not body:
             continue
         parts = [p for p in _SPLIT.split(body) if p]
+        if parts[0] == "max_time_s":
+            if len(parts) != 2:
+                raise MissionFileError(f"line {lineno}: want 'max_time_s <seconds>'")
+            if max_time is not None:
+                raise MissionFileError(f"line {lineno}: a second max_time_s")
+            max_time = _num(parts[1], "max_time_s", lineno)
+            if not 0 < max_time <= 7 * 86400:
+                raise MissionFileError(f"line {lineno}: max_time_s {max_time} outside (0, 604800] s")
+            continue
         if len(parts) != 5:
             raise MissionFileError(f"line {lineno}: want 5 fields 'lat lon depth_m speed_kn park_s', "
                                    f"got {len(parts)}")
@@ -101,12 +116,14 @@ def parse_mission(text: str, name: str) -> Mission:
             raise MissionFileError(f"line {lineno}: more than {MAX_WAYPOINTS} waypoints")
     if not wps:
         raise MissionFileError("no waypoints")
-    return Mission(name, tuple(wps))
+    return Mission(name, tuple(wps), max_time_s=max_time)
 
 
 def format_mission(mission: Mission) -> str:
     """The mission as file text (``parse_mission(format_mission(m), m.name) == m``)."""
     out = [HEADER, "# lat        lon          depth_m  speed_kn  park_s"]
+    if mission.max_time_s is not None:
+        out.append(f"max_time_s {mission.max_time_s!r}")
     for w in mission.waypoints:
         out.append(f"{w.lat!r} {w.lon!r} {w.depth!r} {w.speed!r} {w.park_s!r}")
     return "\n".join(out) + "\n"

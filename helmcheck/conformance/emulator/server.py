@@ -48,6 +48,7 @@ class Server:
         self.lost: Optional[str] = None  #: why the link ended the loop (exit status 2)
         self._pending = bytearray()
         self._dropped = 0
+        self._requests: list[tuple[str, str]] = []  #: faults asked for by a signal handler
         self._wake_r, self._wake_w = socket.socketpair()
         self._wake_r.setblocking(False)
         self._wake_w.setblocking(False)
@@ -67,6 +68,15 @@ class Server:
         self._queue(self.core.inject_fault(code, self.clock(), source))
         self._flush()
 
+    def request_fault(self, code: str, source: str) -> None:
+        """Raise a safety violation at the loop's next turn: safe from a signal handler (an
+        operator tripping a sensor on the bench, ``helmcheck emulate``'s SIGUSR1)."""
+        self._requests.append((code, source))
+        try:
+            self._wake_w.send(b"\0")
+        except OSError:
+            pass
+
     # ------------------------------------------------------------------ the loop
     def run(self) -> int:
         old: dict[int, Any] = {}
@@ -85,6 +95,9 @@ class Server:
         try:
             while not self._stop:
                 now = self.clock()
+                while self._requests:
+                    code, source = self._requests.pop(0)
+                    self._queue(self.core.inject_fault(code, now, source))
                 self._queue(self.core.tick(now))
                 self._flush()
                 if self.ui is not None:

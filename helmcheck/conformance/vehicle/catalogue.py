@@ -298,7 +298,7 @@ CASES: tuple[Case, ...] = (
        Settle("lockout", probe="ORWSET,Sle,R"), Poll(mode_not="M"), needs=("violation",)),
     _c("V-60", "RH-SAF-3", "After the lockout only $OMP is released until the surface",
        "after the lockout, while still under water, $OMS is refused (26) and $OMP is accepted", "N",
-       Wait(12.0), Fault("Sed"), Settle("lockout"), Send(OMS),
+       Wait(12.0), Fault("Sed"), Settle("lockout"), Poll(submerged=True), Send(OMS),
        Send("OMP,8080808080,00,5", expect="$ACK,10,0,0"), Poll(mode="M"), needs=("violation",)),
     _c("V-61", "RH-SAF-4", "At the surface the SafetyAction runs",
        "with SafetyAction park the vehicle parks at the surface: mode P, P0, the code kept", "N",
@@ -333,12 +333,11 @@ def unmet_need(case: Case, profile: Profile) -> Optional[str]:
     """Why the profile does not let this case run, or ``None``."""
     for need in case.needs:
         kind, _, arg = need.partition(":")
-        if kind in ("oxflt", "violation") and profile.trigger != "oxflt":
-            if kind == "oxflt":
-                return "the profile declares no $OXFLT test extension (fault_injection = \"none\")"
-            if profile.trigger == "none":
-                return ("the profile declares no way to raise a safety violation (violation_trigger = "
-                        "\"none\", RH-SAF-5): the lockout is judged only if one happens by itself")
+        if kind == "oxflt" and profile.fault_injection != "oxflt":
+            return "the profile declares no $OXFLT test extension (fault_injection = \"none\")"
+        if kind == "violation" and profile.trigger == "none":
+            return ("the profile declares no way to raise a safety violation (violation_trigger = "
+                    "\"none\", RH-SAF-5): the lockout is judged only if one happens by itself")
         if kind == "letter" and arg not in profile.osd_letters:
             return f"the profile's osd_letters lack {arg}"
         if kind == "safety_action" and profile.safety_action != arg:

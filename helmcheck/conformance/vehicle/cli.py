@@ -33,6 +33,14 @@ how it works:
 verdicts: pass, non-strict (a SHOULD missed), fail, inconclusive (link fault, noisy timing),
   not-tested (the profile does not claim it). A link fault is never a fail.
 
+safety violations (§7, RH-SAF-5), per the profile's violation_trigger:
+  oxflt         $OXFLT,<code> raises one at once (emulators, firmware with the test extension)
+  mission-rule  the profile's violation_mission is started and helmcheck waits violation_after_s
+                for its own safety rule (e.g. Maximum Operation Time) to trip
+  operator      helmcheck tells you on this terminal when to trip a sensor (e.g. the leak sensor)
+                and waits for $OSI field 8; without a terminal these clauses are NOT-TESTED
+  none          §7 is NOT-TESTED, unless a violation happens by itself (then it is judged)
+
 bench safety: unless the profile says [bench_safety] in_water = true, no $OMP motor byte above
   max_motor_byte and no speed above max_speed_kn is ever sent, whatever a case or hypothesis asks.
 
@@ -173,7 +181,8 @@ def run(args: argparse.Namespace) -> int:  # noqa: C901 - argument checks, then 
                        wire_log=None, hypothesis_profile=hp, explore=args.examples != 0,
                        progress=not args.no_progress, command=command.strip(), render=False,
                        link=link, log_opener=open_wire_log, exec_cmd=args.exec_cmd,
-                       exec_grace_s=args.exec_grace, exec_ready_s=args.exec_ready, certificate=cert)
+                       exec_grace_s=args.exec_grace, exec_ready_s=args.exec_ready, certificate=cert,
+                       operator=_at_a_terminal())
         out = certify(opts)
     finally:
         if link is not None:
@@ -183,6 +192,15 @@ def run(args: argparse.Namespace) -> int:  # noqa: C901 - argument checks, then 
     sys.stdout.flush()
     _finish_outputs(out.report_dir, wire, args.wire_log)
     return out.exit_code
+
+
+def _at_a_terminal() -> bool:
+    """A person can be told to act (``violation_trigger = "operator"``): standard input and
+    standard error are a terminal."""
+    try:
+        return sys.stdin.isatty() and sys.stderr.isatty()
+    except (AttributeError, ValueError):
+        return False
 
 
 def _finish_outputs(report_dir: Path, wire: list, wire_copy) -> None:

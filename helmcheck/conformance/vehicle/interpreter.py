@@ -125,7 +125,7 @@ def _not_reached(session: Session, what: str) -> CaseStop:
 
 
 def _condition(session: Session, osi: s.OSI, mode: Optional[str], mode_not: Optional[str] = None,
-               park_below: Optional[int] = None) -> bool:
+               park_below: Optional[int] = None, submerged: Optional[bool] = None) -> bool:
     ok = True
     if mode is not None and osi.mode not in mode.split("|"):
         ok = False
@@ -133,6 +133,9 @@ def _condition(session: Session, osi: s.OSI, mode: Optional[str], mode_not: Opti
         ok = False
     if park_below is not None and not osi.park_time < park_below:
         ok = False
+    if submerged is not None:
+        under = osi.depth is not None and float(osi.depth) > session.profile.gps_fix_depth_m
+        ok = ok and under == submerged
     return ok
 
 
@@ -146,8 +149,9 @@ def _check_expect(session: Session, sent, text: str) -> None:
         return
     got = [str(model.type), str(model.status), str(model.err)]
     if want[:3] != got:
-        reason = (f"{session.case}: the case expects $ACK,{','.join(want[:3])} but the reference model "
-                  f"answers $ACK,{','.join(got)} here (a fault of the case, not the vehicle)")
+        reason = (f"{session.case}: the case needs the answer $ACK,{','.join(want[:3])} here, but in the state "
+                  f"the vehicle reported a conforming vehicle answers $ACK,{','.join(got)}: the case could not "
+                  f"exercise its clause (not a finding about the vehicle)")
         session.tester("inconclusive", session.case_clauses[:1], reason)
         raise CaseStop("inconclusive", reason)
 
@@ -162,7 +166,10 @@ def run_step(session: Session, st, ctx: dict) -> None:
     elif isinstance(st, Poll):
         osi = session.poll()
         _here(session, ctx)
-        if not _condition(session, osi, st.mode, st.mode_not, st.park_below):
+        if not _condition(session, osi, st.mode, st.mode_not, st.park_below, st.submerged):
+            if st.submerged is not None:
+                raise _not_reached(session, f"the vehicle reports depth {osi.depth} m where the case needs it "
+                                            f"{'under water' if st.submerged else 'at the surface'}")
             want = st.mode or (f"not {st.mode_not}" if st.mode_not else f"P below {st.park_below}")
             raise _not_reached(session, f"the vehicle reports {osi.mode} P{osi.park_time} where the case "
                                         f"needs {want}")
@@ -175,10 +182,12 @@ def run_step(session: Session, st, ctx: dict) -> None:
         _until(session, st)
         _here(session, ctx)
     elif isinstance(st, Fault):
-        session.exchange(frame(f"OXFLT,{st.code}"))
+        _violation(session, st)
     elif isinstance(st, Start):
         p = session.profile
         name = getattr(p, st.which)
+        if st.which == "mission" and session.mission_override:
+            name = session.mission_override
         session.start_mission(name, p.srp_mission if st.srp else "", st.ignore_gps)
         _here(session, ctx)
     elif isinstance(st, MissionEnd):
@@ -278,6 +287,45 @@ def _set_round_trip(session: Session, st: SetRoundTrip) -> None:
             session.stop_on_fail = stop
 
 
+#: Wall seconds an operator gets to trip a sensor once told (``violation_trigger = "operator"``).
+OPERATOR_WAIT_S = 120.0
+
+
+def _violation(session: Session, st: Fault) -> None:
+    """RH-SAF-5: raise a safety violation the way the profile says (``violation_trigger``).
+
+    ``oxflt``: send ``$OXFLT,<code>`` (no ACK). ``mission-rule``: the case runs the profile's
+    ``violation_mission``; wait until ``$OSI`` field 8 shows a code, at most ``violation_after_s``
+    after the mission's start plus a quarter of it (at least 10 s) for the rule's own timing.
+    ``operator``: tell the person at the terminal to trip a sensor now and wait for the code, at
+    most :data:`OPERATOR_WAIT_S` of wall time. The observer adopts the violation wherever it falls
+    between two reports; the code shown need not be ``st.code``.
+    """
+    p = session.profile
+    trig = p.trigger
+    if trig == "oxflt" or "oxflt" in session.case_needs:
+        session.exchange(frame(f"OXFLT,{st.code}"))
+        return
+    shown = lambda o: o.error_state not in ("N", "")  # noqa: E731
+    if trig == "mission-rule":
+        started = session.mission_started_at if session.mission_started_at is not None else session.now()
+        elapsed_v = (session.now() - started) * session.k
+        budget_v = max(0.0, p.violation_after_s - elapsed_v) + max(10.0, 0.25 * p.violation_after_s)
+        session.until(f"the safety code of {p.violation_mission}'s own rule (violation_after_s = "
+                      f"{p.violation_after_s:g} s after its start)", shown, budget_v, session.case_clauses[0])
+        return
+    if trig == "operator":
+        if session.operator is None:  # run_case checks first; kept for exploration and replays
+            raise CaseStop("not-tested", "violation_trigger = \"operator\" and nobody at a terminal")
+        session.operator(f"{session.case}: trip a safety sensor on the vehicle NOW (e.g. the leak sensor). "
+                         f"helmcheck waits up to {OPERATOR_WAIT_S:.0f} s for $OSI field 8 to show its code.")
+        osi = session.until("the safety code of the sensor the operator trips", shown,
+                            OPERATOR_WAIT_S * session.k, session.case_clauses[0])
+        session.operator(f"{session.case}: seen {osi.error_state} — thank you; leave the vehicle alone now.")
+        return
+    raise CaseStop("not-tested", "the profile declares no way to raise a safety violation")
+
+
 # ============================================================================ cases
 
 def run_case(session: Session, case: Case) -> tuple[str, str]:
@@ -286,7 +334,15 @@ def run_case(session: Session, case: Case) -> tuple[str, str]:
     if why:
         session.tester("not-tested", case.clauses, f"{case.id}: {why}")
         return "not-tested", why
+    if "violation" in case.needs and session.profile.trigger == "operator" and session.operator is None:
+        why = ("violation_trigger = \"operator\" needs a person at a terminal to trip a sensor when told, "
+               "and helmcheck runs without one (standard input and error are not a terminal)")
+        session.tester("not-tested", case.clauses, f"{case.id}: {why}")
+        return "not-tested", why
     session.begin_case(case.id, case.clauses, case.title)
+    rule = "violation" in case.needs and session.profile.trigger == "mission-rule"
+    session.mission_override = session.profile.violation_mission if rule else None
+    session.case_needs = case.needs
     try:
         session.reset(mission=case.start in ("N", "P"), park=case.start == "P")
         ctx = context(session)
@@ -303,4 +359,6 @@ def run_case(session: Session, case: Case) -> tuple[str, str]:
     except CaseStop as e:
         return e.outcome, e.reason
     finally:
+        session.mission_override = None
+        session.case_needs = ()
         session.end_case()

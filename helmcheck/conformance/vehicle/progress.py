@@ -10,7 +10,7 @@ __all__ = ["Progress"]
 
 class Progress:
     """``start(total)``, ``step(label, verdict)``, ``explore(ran, total, left_s)``, ``note(text)``,
-    ``stop()``. The verdict shown for a case is its subject clause's verdict as the ledger has it —
+    ``alert(text)``, ``stop()``. The verdict shown for a case is its subject clause's verdict as the ledger has it —
     the word the report will use."""
 
     def __init__(self, stream: Optional[IO[str]] = None, enabled: bool = True):
@@ -66,6 +66,18 @@ class Progress:
             self.rich.console.print(text)
         else:
             print(text, file=self.stream, flush=True)
+
+    def alert(self, text: str) -> None:
+        """Something a person must act on: shown even with the progress display off, with the
+        terminal's bell."""
+        bell = "\a" if getattr(self.stream, "isatty", lambda: False)() else ""
+        if self.rich is not None:
+            self.rich.console.print(f"[bold]>>> {text}[/bold]", markup=True, highlight=False)
+            if bell:
+                self.stream.write(bell)
+                self.stream.flush()
+        else:
+            print(f">>> {text}{bell}", file=self.stream, flush=True)
 
     def stop(self) -> None:
         if self.rich is not None:

@@ -81,6 +81,8 @@ class Options:
     # (a stream that remembers a write error for the command to report).
     link: Optional[Any] = None
     log_opener: Optional[Callable[[Path], IO[str]]] = None
+    #: a person at a terminal can be told to trip a sensor (``violation_trigger = "operator"``)
+    operator: bool = False
 
 
 @dataclass
@@ -214,6 +216,14 @@ class Run:
             pass
         self.link.note(f"link: {self.p.baud} baud 8N1 {self.o.port}")
         self.session = Session(self.link, self.p, self.k, self.observer, max_wait=self.o.max_wait)
+        if self.o.operator:
+            self.session.operator = self.tell_operator
+
+    def tell_operator(self, text: str) -> None:
+        """An instruction to the person at the bench: on the terminal, and in the record."""
+        assert self.link is not None
+        self.link.note(f"operator: {text}")
+        self.progress.alert(text)
 
     def probe(self) -> None:
         """Does anything answer? Nothing at all, or only garbage, is a link fault."""

@@ -66,6 +66,14 @@ class Session:
         self.lazy_silence = False  #: do not sit out the window after a line the vehicle discards
         self.stop_on_fail = True
         self.on_poll: Optional[Callable[[], None]] = None
+        #: the mission the verified reset starts: the profile's test mission, or for a case that
+        #: waits for a mission's own safety rule, ``violation_mission`` (RH-SAF-5)
+        self.mission_override: Optional[str] = None
+        self.mission_started_at: Optional[float] = None  #: wall time of the last accepted $OMSTART
+        self.case_needs: tuple = ()  #: the present case's needs (catalogue)
+        #: tells the person at the terminal what to do (``violation_trigger = "operator"``); None
+        #: when nobody is there
+        self.operator: Optional[Callable[[str], None]] = None
 
     # ================================================================ helpers
     def now(self) -> float:
@@ -296,7 +304,7 @@ class Session:
         if osi.mode != "S":
             raise CaseStop("inconclusive", f"after an accepted $OMSTOP,0 the vehicle reports {osi.mode}")
         if mission:
-            self.start_mission(p.mission, clause="RH-MSN-2")
+            self.start_mission(self.mission_override or p.mission, clause="RH-MSN-2")
         if park:
             self.reach_park()
 
@@ -309,6 +317,7 @@ class Session:
                    f" (is it on the vehicle?)")
             self.tester("inconclusive", self.case_clauses or (clause,), why)
             raise CaseStop("inconclusive", why, clause)
+        self.mission_started_at = sent.t_ack if sent.t_ack is not None else self.now()
         osi = self.poll()
         if osi.mode not in ("N", "P"):
             raise CaseStop("inconclusive", f"after $OMSTART the vehicle reports {osi.mode}, not a running mission")

@@ -59,11 +59,13 @@ class Raw:
 
 @dataclass(frozen=True)
 class Poll:
-    """``$OSD,S``. ``mode``/``mode_not``/``park_below``: exercise conditions (module docstring)."""
+    """``$OSD,S``. ``mode``/``mode_not``/``park_below``/``submerged`` (a depth below the
+    profile's ``gps_fix_depth_m``): exercise conditions (module docstring)."""
 
     mode: Optional[str] = None
     mode_not: Optional[str] = None
     park_below: Optional[int] = None
+    submerged: Optional[bool] = None
 
 
 @dataclass(frozen=True)
