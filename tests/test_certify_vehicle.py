@@ -181,6 +181,13 @@ def test_bench_guard_reads_every_line():
     assert g.problem(b"$OMW,41.5,-71.3,2,,15,1,0,*11\r\n")
     assert g.problem(b"$OMW,CLEAR,41.5,-71.3,2,,15,1,0,*11\r\n")
     assert g.problem(b"noise$OSD,S*27\r\n$OMS,1,2,3,9,5*00\r\n")
+    # a shifted line is checked in every alignment a vehicle could execute (issue: one judge)
+    assert g.problem(b"$OMW,,41.5,-71.3,2,,15,3.0,0,*11\r\n")  # read from its second field: 3 kn
+    assert g.problem(b"$OMW,,,41.5,-71.3,2,,15,3.0,0,*11\r\n")
+    assert g.problem(b"$OPK,,41.5,-71.3,1,0.9*11\r\n")
+    assert g.problem(b"$OMS,,90,2,20,3.0,10*11\r\n")
+    assert not g.problem(b"$OMW,,41.5,-71.3,2,,15,0.4,0,*11\r\n")  # 15 is the pitch when shifted
+    assert not g.problem(b"$OMW,41.5,-71.3,2,,15,0.5,30,*11\r\n")
     assert not g.problem(b"$OMP,8080808090,00,10*00\r\n")
     assert not g.problem(b"$OMS,90,2,20,0.5,10*00\r\n")
     assert not BenchGuard(DEFAULT.replace(bench_safety=type(DEFAULT.bench_safety)(in_water=True))).problem(

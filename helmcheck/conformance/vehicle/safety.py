@@ -5,7 +5,10 @@ motor byte is above ``max_motor_byte``, nor an ``$OMS``/``$OPK``/``$OMW`` whose 
 ``max_speed_kn`` — whatever a case or a hypothesis strategy asks for. The check runs on the raw
 bytes at the link's one send function (:meth:`helmcheck.conformance.vehicle.link.TesterLink.send`),
 and it reads malformed lines too (a bad checksum or an unknown case of the ID): a faulty vehicle
-might act on a line it should have discarded, so such a line must be safe as well.
+might act on a line it should have discarded, so such a line must be safe as well. For the same
+reason a motion command's speed is checked in **every alignment a vehicle could execute**: as
+sent, and with up to two leading empty fields or a clear keyword passed over
+(``$OMW,,<lat>,<lon>,…`` read from its second field), wherever the position fields are numbers.
 """
 
 from __future__ import annotations
@@ -19,6 +22,24 @@ __all__ = ["BenchGuard", "BenchSafetyRefused"]
 
 #: field index (1 = first field after the ID) of the speed in each motion command
 _SPEED_FIELD = {"OMS": 4, "OPK": 4, "OMW": 6}
+
+
+#: How many leading empty fields (or a clear keyword, ``$OMW,CLEAR,<waypoint>``) a lenient or
+#: faulty vehicle might pass over before reading a motion command's fields.
+_MAX_SHIFT = 2
+_CLEAR_WORDS = ("CLR", "CLEAR", "STOP")
+
+
+def _skippable(field: str) -> bool:
+    f = field.strip()
+    return not f or f.upper() in _CLEAR_WORDS
+
+
+def _executable(sid: str, f: list[str]) -> bool:
+    """Could a vehicle act on these fields (``f[0]`` in the ID's place)? A waypoint needs a
+    numeric latitude and longitude; ``$OMS`` a numeric heading."""
+    need = 2 if sid in ("OMW", "OPK") else 1
+    return len(f) > need and all(_number(x) is not None for x in f[1:need + 1])
 
 
 class BenchSafetyRefused(Exception):
@@ -76,12 +97,15 @@ class BenchGuard:
         idx = _SPEED_FIELD.get(sid)
         if idx is None:
             return None
-        if sid == "OMW" and len(fields) > 1 and fields[1].strip().upper() in ("CLR", "CLEAR", "STOP"):
-            idx += 1  # CLEAR,<waypoint fields>
-        if len(fields) > idx:
-            v = _number(fields[idx])
+        for shift in range(_MAX_SHIFT + 1):
+            if shift and not _skippable(fields[shift]):
+                break  # only empty fields and clear keywords can be passed over
+            f = fields[shift:]  # f[0] stands where the ID would
+            if not _executable(sid, f) or len(f) <= idx:
+                continue
+            v = _number(f[idx])
             if v is not None and v > self.max_speed:
-                return (f"${sid} speed {fields[idx].strip()} kn is above the bench limit "
+                return (f"${sid} speed {f[idx].strip()} kn is above the bench limit "
                         f"{self.max_speed} kn ([bench_safety] max_speed_kn)")
         return None
 
