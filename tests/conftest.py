@@ -108,13 +108,13 @@ def pytest_runtest_makereport(item, call):
 
 
 #: Time scale of the shared full certification.
-FULL_RUN_K = 40.0
+FULL_RUN_K = 25.0
 
 
 @pytest.fixture(scope="session")
 def full_emulator_run(tmp_path_factory):
     """One full, signed certification of the built-in emulator (``helmcheck emulate`` on a pty,
-    time scale 40, 5 explored sequences, seed 2), shared by the tests that read it. Returns
+    time scale 25, 5 explored sequences, seed 2), shared by the tests that read it. Returns
     ``(root, exit_code, emulator_alive)``: ``root/full`` is the run, ``root/lab.key``/``.pub`` and
     ``root/other.*`` two key pairs, ``root/emu.toml`` the profile given; ``emulator_alive`` says the
     emulator was still running when the certification ended."""
@@ -134,4 +134,3 @@ def full_emulator_run(tmp_path_factory):
                          "--operator", "J. Doe", "--site", "Bench 2"])
         alive = emu.proc.poll() is None
     return root, code, alive
-

@@ -80,6 +80,7 @@ def test_builtin_emulator_certifies(full_emulator_run):
     for name in ("results.json", "wire.log", "report.html", "junit.xml", "report.md"):
         assert (out / name).stat().st_size > 0, name
     assert r["settings"]["bench_safety"]["enforced"] is True
+    assert r["restore"]["verified"] is True and r["restore"]["left"]["mode"] == "S", r["restore"]
     assert {"S", "N", "A", "M", "mP", "W", "P"} <= set(r["coverage"]["modes"])
     assert r["coverage"]["interrupt_pairs"] and r["timeline"] and r["events"]
     assert len(r["cases"]) >= 60
@@ -188,6 +189,8 @@ def test_bench_guard_reads_every_line():
     assert g.problem(b"$OMS,,90,2,20,3.0,10*11\r\n")
     assert not g.problem(b"$OMW,,41.5,-71.3,2,,15,0.4,0,*11\r\n")  # 15 is the pitch when shifted
     assert not g.problem(b"$OMW,41.5,-71.3,2,,15,0.5,30,*11\r\n")
+    for short in (b"$OMW*00\r\n", b"$OMW,,*00\r\n", b"$OMS\r\n", b"$OPK,*00\r\n", b"$OMW,Clr*00\r\n"):
+        assert not g.problem(short)  # nothing to execute, and no exception
     assert not g.problem(b"$OMP,8080808090,00,10*00\r\n")
     assert not g.problem(b"$OMS,90,2,20,0.5,10*00\r\n")
     assert not BenchGuard(DEFAULT.replace(bench_safety=type(DEFAULT.bench_safety)(in_water=True))).problem(

@@ -1,6 +1,6 @@
 """``helmcheck verify``: a report anyone can check against its evidence (issue: certificates).
 
-Real runs, real files: the emulator (``helmcheck emulate`` on a pty, time scale 40) certified by
+Real runs, real files: the emulator (``helmcheck emulate`` on a pty, time scale 25) certified by
 ``helmcheck certify vehicle --sign-key``, a ``--select 'RH-SRV-*'`` run of it, and a backseat
 certified by ``helmcheck certify backseat --implementation … --sign-key`` with the example
 backseat. Each tamper test works on a copy of a run directory and checks that ``verify`` exits 1
@@ -24,7 +24,7 @@ from helmcheck.profile_toml import emit_profile
 from helmcheck.reports.manifest import sha256_file
 from helmcheck.reports.results import finish, load_results, write_results_atomic
 
-K = 40.0
+K = 25.0
 GOOD_BACKSEAT = Path(__file__).resolve().parent / "backseats" / "good_backseat.py"
 
 

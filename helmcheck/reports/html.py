@@ -328,6 +328,40 @@ def _process(run: Run) -> str:
     return "\n".join(out)
 
 
+def _restore(run: Run) -> str:
+    """The vehicle left as found: each setting before and after, the mode, what to do by hand."""
+    rec = run.results.get("restore")
+    if not isinstance(rec, Mapping):
+        return ""
+    ok = bool(rec.get("verified"))
+    found = rec.get("found") or {}
+    left = rec.get("left") or {}
+    head = ("Every setting the run changed was written back and read again as found; the vehicle "
+            "was stopped." if ok and rec.get("attempted") else
+            "Nothing needed restoring." if ok else "The vehicle was NOT verified as restored.")
+    out = [f'<div class="finding {"v-pass" if ok else "v-fail"}" id="restore-status"><p>{_e(head)}</p>']
+    rows = [("found in mode", found.get("mode")), ("found running", found.get("mission")),
+            ("left in mode", left.get("mode")), ("note", left.get("note"))]
+    out.append(_kv_table([(k, v) for k, v in rows if v is not None]))
+    settings = rec.get("settings") or []
+    if settings:
+        out.append('<table class="kv" id="restore-settings"><tr><th>setting</th><th>as found</th>'
+                   '<th>written by the run</th><th>after the restore</th><th>verified</th></tr>')
+        for st in settings:
+            def show(v):
+                return "—" if v is None else ",".join(map(str, v))
+            out.append(f"<tr><td>{_e(st.get('name'))}</td><td>{_e(show(st.get('before')))}</td>"
+                       f"<td>{'yes' if st.get('written') else 'no'}</td><td>{_e(show(st.get('after')))}</td>"
+                       f"<td>{'yes' if st.get('verified') else ('—' if not st.get('written') else 'NO')}</td></tr>")
+        out.append("</table>")
+    for problem in rec.get("problems") or ():
+        out.append(f"<p class=\"warn\">{_e(problem)}</p>")
+    if rec.get("by_hand"):
+        out.append("<p>Set by hand:</p><pre>" + _e("\n".join(rec["by_hand"])) + "</pre>")
+    out.append("</div>")
+    return "\n".join(out)
+
+
 def _matrix(run: Run) -> str:
     out = []
     for section, title, rows in sections(run.results):
@@ -507,6 +541,7 @@ def render_html(run: Run, comparison_html: str | None = None) -> str:
         f"<title>{_e(title)}</title><style>{_CSS}</style></head><body>",
         _certificate_page(run),
         *([_section("process", "Process under test", _process(run))] if run.results.get("process") else []),
+        *([_section("restore", "Vehicle restored", _restore(run))] if run.results.get("restore") else []),
         _section("matrix", f"Clauses ({n})", _matrix(run)),
         _section("findings", "Findings", _findings(run)),
         _section("evidence", "Evidence for passing clauses", _pass_evidence(run)),

@@ -99,6 +99,16 @@ def render_markdown(run: Run, comparison_md: str | None = None) -> str:
         out += [f"Process under test: `{md_code(proc.get('command', ''))}`. "
                 f"{md_escape(describe_process(proc, r['role']))}", ""]
 
+    rec = r.get("restore")
+    if isinstance(rec, dict):
+        if rec.get("verified"):
+            names = [st["name"] for st in rec.get("settings") or () if st.get("written")]
+            out += ["Vehicle restored: stopped" + (f"; {', '.join(names)} written back and read again as found"
+                                                     if names else "") + ".", ""]
+        else:
+            out += ["**Vehicle NOT verified as restored**: " + md_escape("; ".join(rec.get("problems") or []))
+                    + ". Set by hand: " + md_escape("; ".join(rec.get("by_hand") or [])) + ".", ""]
+
     c = counts(r)
     out.append("| " + " | ".join(VERDICT_LABEL[v] for v in c) + " | total |")
     out.append("|" + "---:|" * (len(c) + 1))

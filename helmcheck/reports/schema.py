@@ -216,6 +216,8 @@ def validate(results: Any) -> list[str]:
         _check_relative(ck, "wire_log", r("wire_log"))
     if "process" in results:
         _check_process(ck, r("process"))
+    if "restore" in results:
+        _check_restore(ck, r("restore"))
     _check_certificate_keys(ck, results)
 
     if not ck.errors:
@@ -253,6 +255,35 @@ def _check_process(ck: _Checker, process: Any) -> None:
     ck.typed("process.ended_early", process.get("ended_early"), (bool,), "a boolean")
     if "output_tail" in process:
         ck.str_list("process.output_tail", process["output_tail"])
+
+
+def _check_restore(ck: _Checker, restore: Any) -> None:
+    """The vehicle left as found (``helmcheck.conformance.vehicle.restore``)."""
+    if not ck.obj("restore", restore):
+        return
+    for key in ("attempted", "verified"):
+        ck.typed(f"restore.{key}", restore.get(key), (bool,), "a boolean")
+    for key in ("found", "left"):
+        if ck.obj(f"restore.{key}", restore.get(key)):
+            ck.string(f"restore.{key}.mode", restore[key].get("mode"), optional=True)
+    ck.str_list("restore.problems", restore.get("problems"))
+    ck.str_list("restore.by_hand", restore.get("by_hand"))
+    settings = restore.get("settings")
+    if not isinstance(settings, list):
+        ck.err("restore.settings", "must be a list")
+        return
+    for i, st in enumerate(settings):
+        path = f"restore.settings[{i}]"
+        if not ck.obj(path, st):
+            continue
+        ck.string(f"{path}.name", st.get("name"))
+        for key in ("before", "after"):
+            if st.get(key) is not None:
+                ck.str_list(f"{path}.{key}", st[key])
+        for key in ("written", "verified"):
+            ck.typed(f"{path}.{key}", st.get(key), (bool,), "a boolean")
+    if restore.get("verified") is True and restore.get("problems"):
+        ck.err("restore.verified", "true, but problems are listed")
 
 
 def _check_sha(ck: _Checker, path: str, value: Any, *, optional: bool = False) -> None:

@@ -62,12 +62,19 @@ certificate: a run that judges every vehicle clause is a certificate; --select r
   NOT-TESTED or INCONCLUSIVE clause say "partial: N of 60 claimed clauses judged; not a certificate".
   --sign-key KEY signs the run (helmcheck keygen); helmcheck verify DIR checks it.
 
+the vehicle left as found: before it writes a setting helmcheck reads it (in S), and at the end
+  of every run (also after a FAIL, Ctrl-C, SIGTERM or SIGHUP) it stops the vehicle ($OMSTOP until
+  S), writes back every setting it changed and reads them again. A restore that cannot be verified
+  is exit 2 and a message naming what to set by hand; the report's "Vehicle restored" section
+  lists each setting before and after.
+
 results: DIR/results.json (schema 1), DIR/wire.log, DIR/profile.toml, DIR/signature.json (signed runs),
   DIR/report.html, DIR/junit.xml, DIR/report.md. A DIR that holds an earlier run is refused
   unless --overwrite. SIGINT, SIGTERM and SIGHUP end the run early: results marked partial,
   reports rendered.
 exit status: 0 pass (or non-strict without --strict), 1 fail, 2 inconclusive, link fault, tester
-  error or an output that could not be written, 64 usage (bad option, profile, port or path).
+  error, a vehicle not verified as restored, or an output that could not be written, 64 usage
+  (bad option, profile, port or path).
 """
 
 
@@ -190,6 +197,10 @@ def run(args: argparse.Namespace) -> int:  # noqa: C901 - argument checks, then 
     from ...reports.scope import headline
     print(f"{headline(out.results)}. {out.reason} — report: {out.report_dir / 'report.html'}")
     sys.stdout.flush()
+    restore = out.results.get("restore")
+    if restore is not None and restore.get("attempted") and not restore.get("verified"):
+        from .restore import unverified_text
+        print(f"helmcheck certify vehicle: {unverified_text(restore)}", file=sys.stderr)
     _finish_outputs(out.report_dir, wire, args.wire_log)
     return out.exit_code
 

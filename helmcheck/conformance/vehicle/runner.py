@@ -49,6 +49,8 @@ from .flow import LinkLost, LinkSilent
 from .interpreter import run_case
 from .link import TesterLink
 from .progress import Progress
+from .restore import Custodian, written_settings
+from .safety import BenchSafetyRefused
 from .session import Session, frame
 
 __all__ = ["Options", "certify", "Outcome", "Run"]
@@ -138,6 +140,7 @@ class Run:
         self.session: Optional[Session] = None
         self.stats: dict = {}
         self.child = None  #: the vehicle under test, when helmcheck started it (a Launcher)
+        self.custodian = Custodian(written_settings(select_cases(opts.select, self.p)))
 
     # ------------------------------------------------------------------ results
     def save(self, final: bool = False) -> None:
@@ -170,6 +173,8 @@ class Run:
             r["implementation"]["vehicle_name"] = obs.last_osi.vehicle_name
         if self.link is not None:
             r["settings"]["bench_safety"]["refused_lines"] = self.link.guard.refused
+        if self.custodian.attempted or any(x.before is not None for x in self.custodian.records.values()):
+            r["restore"] = self.custodian.record()
         if self.session is not None:
             self.stats["forced_wait_s"] = round(self.session.forced_wait, 3)
         self.stats["wall_s"] = round(time.monotonic() - self.t_start, 3)
@@ -216,6 +221,7 @@ class Run:
             pass
         self.link.note(f"link: {self.p.baud} baud 8N1 {self.o.port}")
         self.session = Session(self.link, self.p, self.k, self.observer, max_wait=self.o.max_wait)
+        self.session.custodian = self.custodian
         if self.o.operator:
             self.session.operator = self.tell_operator
 
@@ -241,12 +247,56 @@ class Run:
                 if self.observer.alive_t is not None:
                     link.sleep(0.1)
                     link.drain()
+                    self._found()
                     return
         if link.bytes_in == 0:
             raise LinkSilent(f"no bytes at all from {self.o.port} in {link.now():.1f} s: is a vehicle on "
                              f"this port, powered, at {self.p.baud} baud?")
         raise LinkLost(f"{link.bytes_in} bytes from {self.o.port}, none of them a valid sentence "
                        f"(garbage: wrong baud or not a remote-helm vehicle?)")
+
+    def _found(self) -> None:
+        """What the vehicle was found in (:mod:`.restore`): its mode, and in ``S`` its settings."""
+        osi = self.observer.last_osi
+        self.custodian.found(osi)
+        if osi is not None and osi.mode == "S" and self.session is not None:
+            stop, self.session.stop_on_fail = self.session.stop_on_fail, False
+            try:
+                self.custodian.survey(self.session)
+            finally:
+                self.session.stop_on_fail = stop
+
+    def restore(self) -> None:
+        """Leave the vehicle as it was found (:mod:`.restore`), whatever ended the run."""
+        c = self.custodian
+        if self.session is None or self.link is None or not c.needed:
+            return
+        if self.child_gone():
+            return  # the vehicle under test, started by helmcheck, has ended: nothing left to restore
+        if self.link.lost and not self._reopen():
+            c.could_not(f"the link is gone ({self.link.lost})")
+            return
+        self.progress.note("restoring the vehicle as it was found …")
+        try:
+            c.restore(self.session)
+        except LinkLost as e:
+            c.could_not(f"the link failed during the restore ({e})")
+        except KeyboardInterrupt as e:
+            c.could_not(f"interrupted again during the restore ({describe_interrupt(e)})")
+        except BenchSafetyRefused as e:
+            c.could_not(str(e))
+
+    def _reopen(self) -> bool:
+        """A link lost during the run: open the port again for the restore (a vehicle that came
+        back). ``--exec`` and a link the caller gave are not reopened here."""
+        if self.o.exec_cmd or self.o.link is not None or self.link is None:
+            return False
+        try:
+            raw = open_link(self.o.port, role="client", baud=self.p.baud)
+        except (OSError, ValueError):
+            return False
+        self.link.reattach(raw, f"link reopened for the restore: {self.o.port}")
+        return True
 
     def run_cases(self, cases: list) -> None:
         ses = self.session
@@ -367,6 +417,10 @@ def certify(opts: Options) -> Outcome:
         run.aborted = f"tester error ({type(e).__name__})"
         raise
     finally:
+        try:
+            run.restore()
+        except Exception as e:  # noqa: BLE001 - never lose the record over the restore
+            run.custodian.could_not(f"tester error during the restore ({type(e).__name__}: {e})")
         run.progress.stop()
         try:
             run.end(run.aborted)
@@ -394,4 +448,8 @@ def certify(opts: Options) -> Outcome:
             except Exception as e:  # noqa: BLE001 - the results file is the certificate
                 run.progress.note(f"reports not rendered: {e}")
     r = run.results
-    return Outcome(r["verdict"], r["verdict_reason"], R.exit_code(r["verdict"], opts.strict), run.dir, r)
+    code = R.exit_code(r["verdict"], opts.strict)
+    restore = r.get("restore")
+    if restore is not None and restore["attempted"] and not restore["verified"]:
+        code = 2  # the vehicle may have left with a setting changed: never a green run
+    return Outcome(r["verdict"], r["verdict_reason"], code, run.dir, r)

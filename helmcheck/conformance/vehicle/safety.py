@@ -98,6 +98,8 @@ class BenchGuard:
         if idx is None:
             return None
         for shift in range(_MAX_SHIFT + 1):
+            if shift >= len(fields):
+                break
             if shift and not _skippable(fields[shift]):
                 break  # only empty fields and clear keywords can be passed over
             f = fields[shift:]  # f[0] stands where the ID would

@@ -17,7 +17,8 @@ into the ledger. The session only decides what to send next and how long to wait
   bracket it (RH-TIM-1). Waits end as soon as an ``$OSI`` decides them; one past its budget is
   INCONCLUSIVE with the reason and the option that extends it (``--max-wait``).
 * :meth:`Session.reset` — the verified reset between cases: ``$OMSTOP,0`` (waiting out a
-  lockout), ``S`` seen; then the profile's mission started by name (rh5 form) and seen running.
+  lockout), ``S`` seen (then the settings a case may write are read, :mod:`.restore`); then the
+  profile's mission started by name (rh5 form) and seen running.
 
 Tester facts go to the log as notes (``not tested …``, ``inconclusive …``) so that an offline
 check of the log reaches the same verdicts.
@@ -74,6 +75,8 @@ class Session:
         #: tells the person at the terminal what to do (``violation_trigger = "operator"``); None
         #: when nobody is there
         self.operator: Optional[Callable[[str], None]] = None
+        #: keeps what the vehicle was found in and puts it back (:mod:`.restore`); None: not kept
+        self.custodian = None
 
     # ================================================================ helpers
     def now(self) -> float:
@@ -117,6 +120,8 @@ class Session:
     def send(self, raw: bytes) -> Optional[Sent]:
         """Write ``raw``; the observer's record of its last line (``None`` if nothing framed)."""
         seq = self.obs.seq
+        if self.custodian is not None:
+            self.custodian.check_write(raw)  # no setting is written unless its restore is known
         t = self.link.send(raw)
         self._trace({"send": _esc(raw), "t": round(t, 6)})
         for sent in reversed(self.obs.sent):
@@ -169,6 +174,9 @@ class Session:
         """Write several commands at once, then wait for all their answers (RH-ACK-6)."""
         self.link.drain()
         seq = self.obs.seq
+        if self.custodian is not None:
+            for raw in raws:
+                self.custodian.check_write(raw)
         t = self.link.send(b"".join(raws))
         self._trace({"send": _esc(b"".join(raws)), "t": round(t, 6)})
         sents = [x for x in self.obs.sent if x.seq > seq]
@@ -303,6 +311,8 @@ class Session:
         osi = self.poll()
         if osi.mode != "S":
             raise CaseStop("inconclusive", f"after an accepted $OMSTOP,0 the vehicle reports {osi.mode}")
+        if self.custodian is not None:
+            self.custodian.survey(self)  # in S: read what a case may write, before it does
         if mission:
             self.start_mission(self.mission_override or p.mission, clause="RH-MSN-2")
         if park:
