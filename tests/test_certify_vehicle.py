@@ -50,8 +50,20 @@ def _assert_bench_safe(path: Path, max_motor=0x90, max_speed=Decimal("0.5")):
             if sid == "OMP" and len(fields) > 1 and re.fullmatch(r"[0-9A-Fa-f]{10}.*", fields[1]):
                 assert int(fields[1][8:10], 16) <= max_motor, raw
             idx = {"OMS": 4, "OPK": 4, "OMW": 6}.get(sid)
-            if idx and len(fields) > idx and re.fullmatch(r"-?\d+(\.\d+)?", fields[idx].strip()):
-                assert Decimal(fields[idx]) <= max_speed, raw
+            if not idx:
+                continue
+            # every alignment a vehicle could act on: as sent, or with leading empty fields or a
+            # clear keyword passed over, wherever the position (or heading) fields are numbers
+            num = re.compile(r"-?\d+(\.\d+)?")
+            need = 1 if sid == "OMS" else 2
+            for shift in range(3):
+                if shift and (shift >= len(fields) or fields[shift].strip().upper() not in ("", "CLR", "CLEAR", "STOP")):
+                    break
+                f = fields[shift:]
+                if len(f) <= idx or not all(num.fullmatch(x.strip()) for x in f[1:need + 1]):
+                    continue
+                if num.fullmatch(f[idx].strip()):
+                    assert Decimal(f[idx]) <= max_speed, raw
 
 
 # ---------------------------------------------------------------------------- the emulator

@@ -145,9 +145,9 @@ def test_a_terminal_that_stops_reading_never_stalls_the_emulator(tui):
         worst = 0.0
         while time.monotonic() - t0 < 6.0:  # ~48 frames offered while nobody reads
             t = time.monotonic()
-            assert client.ack("OSD,S", 8, timeout=1.0).status == 0
+            assert client.ack("OSD,S", 8, timeout=2.0).status == 0
             worst = max(worst, time.monotonic() - t)
-        assert worst < 0.5, worst
+        assert worst < 1.0, worst  # within the ACK window (RH-ACK-2); a blocked write would never answer
         term.reading.set()  # reading again: the picture comes back, up to date
         client.ack("OMS,400,2,20,0,5", 9)
         term.wait_screen(lambda ls: any("$ACK,9,1" in ln for ln in ls))

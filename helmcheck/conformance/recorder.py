@@ -25,13 +25,19 @@ __all__ = ["Recorder"]
 class Recorder:
     """Writes the wire log and feeds the observers (module docstring)."""
 
-    def __init__(self, stream: Optional[IO[str]], meta: Iterable[str] = (), observers: Iterable = ()):
+    def __init__(self, stream: Optional[IO[str]], meta: Iterable[str] = (), observers: Iterable = (), *,
+                 after: Optional[tuple[int, float]] = None):
+        """``after=(lines, last_t)``: ``stream`` continues a log that already holds ``lines``
+        lines up to time ``last_t`` (a resumed run): no header, numbering and time go on."""
         self._f = stream
         self.observers = list(observers)
         self.lineno = 0
         self.write_error: Optional[str] = None
         self.records = 0
         self._last_t = 0.0
+        if after is not None:
+            self.lineno, self._last_t = after
+            return
         self._write(HEADER)
         for m in meta:
             self._write(f"# {m}".replace("\n", " "))

@@ -30,6 +30,9 @@ wire-log format (``docs/contracts.md``):
 ``operator: <instruction>``                 an operator was asked to act (RH-SAF-5)
 ``run aborted: <reason>``                   the run ended early: what was not judged is
                                             INCONCLUSIVE with this reason
+``run resumed: <what>``                     an interrupted run goes on (``--resume``): the
+                                            vehicle's state is unknown again; commands left
+                                            unanswered at the interruption are not judged
 ==========================================  ===================================================
 """
 
@@ -66,7 +69,8 @@ class Note:
     """A note a judge acts on: ``kind`` and its parts (see the module docstring)."""
 
     kind: str  #: case | case-end | not-tested | inconclusive | link | plant | fault | lockout |
-    #: lockout-end | scenario | silence | silence-end | reject | reject-end | operator | aborted
+    #: lockout-end | scenario | silence | silence-end | reject | reject-end | operator | aborted |
+    #: resumed
     case: str = ""
     clauses: tuple[str, ...] = ()
     text: str = ""
@@ -141,6 +145,8 @@ def parse_note(text: str) -> Optional[Note]:
         return Note("operator", text=text[10:])
     if text.startswith("run aborted: "):
         return Note("aborted", text=text[13:])
+    if text.startswith("run resumed: "):
+        return Note("resumed", text=text[13:])
     return None
 
 

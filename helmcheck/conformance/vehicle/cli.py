@@ -50,6 +50,7 @@ examples:
   helmcheck certify vehicle --port /dev/ttyUSB0 --profile iver3.toml --hypothesis-profile patient
   helmcheck certify vehicle --port socket://10.0.0.5:4001 --select 'RH-SRV-*' --select RH-ACK-2
   helmcheck certify vehicle --exec './uvc-sim --serial {port}' --time-scale 20   # start the vehicle too
+  helmcheck certify vehicle --port /dev/ttyUSB0 --resume reports/vehicle   # go on after an interruption
 
 --exec CMD starts the vehicle under test (a simulator, a firmware build on the host) on a new
 pty ({port} is its path; without {port} the path is appended), or with --port socket://HOST:0
@@ -104,6 +105,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="seconds between SIGTERM and SIGKILL when stopping it (default 5)")
     p.add_argument("--exec-ready", type=float, default=30.0, metavar="S",
                    help="seconds it may take to open (or listen on) the port (default 30)")
+    p.add_argument("--resume", metavar="DIR",
+                   help="continue the interrupted run in DIR from its last completed case, into the same "
+                        "report (its profile, selection, time scale and seed are the run's own)")
     p.add_argument("--overwrite", action="store_true",
                    help="replace an earlier run in --report-dir (its results, wire log, reports and "
                         "replays are removed first); without it such a directory is refused")
@@ -121,6 +125,10 @@ def run(args: argparse.Namespace) -> int:  # noqa: C901 - argument checks, then 
     from ..transport import BAUD_RATES
     from .runner import Options, certify
 
+    if args.resume is not None:
+        why = _resume_args(args)
+        if why:
+            return _usage(why)
     profile = load_profile(args.profile)  # a ProfileError is exit 64 (helmcheck.cli)
     k = args.time_scale if args.time_scale is not None else profile.time_scale
     if not math.isfinite(k) or k <= 0:
@@ -165,17 +173,20 @@ def run(args: argparse.Namespace) -> int:  # noqa: C901 - argument checks, then 
         return _usage(str(e))
     if args.wire_log:
         check_writable(args.wire_log, "--wire-log")
-    report_dir = prepare_report_dir(args.report_dir, args.overwrite, clear=False)
+    resume = args.resume is not None
+    report_dir = (Path(args.resume) if resume else
+                  prepare_report_dir(args.report_dir, args.overwrite, clear=False))
     # the vehicle's port is opened here (a port that cannot be opened is a usage error); with
     # --exec the runner starts the vehicle under test, which opens it
     link = open_port(spec, role="client", baud=profile.baud) if args.exec_cmd is None else None
     try:
-        prepare_report_dir(report_dir, args.overwrite)
+        if not resume:
+            prepare_report_dir(report_dir, args.overwrite)
         wire: list[OutputStream] = []
 
         def open_wire_log(path: Path) -> OutputStream:
             try:
-                f = open(path, "w", encoding="utf-8")
+                f = open(path, "a" if resume else "w", encoding="utf-8")
             except OSError as e:
                 raise OutputLost(f"cannot write wire log {path}: {e.strerror or e}") from None
             wire.append(OutputStream(f, path, stop=False, what="wire log"))
@@ -189,7 +200,7 @@ def run(args: argparse.Namespace) -> int:  # noqa: C901 - argument checks, then 
                        progress=not args.no_progress, command=command.strip(), render=False,
                        link=link, log_opener=open_wire_log, exec_cmd=args.exec_cmd,
                        exec_grace_s=args.exec_grace, exec_ready_s=args.exec_ready, certificate=cert,
-                       operator=_at_a_terminal())
+                       operator=_at_a_terminal(), resume=resume)
         out = certify(opts)
     finally:
         if link is not None:
@@ -203,6 +214,44 @@ def run(args: argparse.Namespace) -> int:  # noqa: C901 - argument checks, then 
         print(f"helmcheck certify vehicle: {unverified_text(restore)}", file=sys.stderr)
     _finish_outputs(out.report_dir, wire, args.wire_log)
     return out.exit_code
+
+
+#: Options a resumed run takes from its record, never from the command line.
+_RESUME_FIXED = {"profile": "--profile", "time_scale": "--time-scale", "baud": "--baud", "select": "--select",
+                 "examples": "--examples", "seed": "--seed", "strict": "--strict",
+                 "hypothesis_profile": "--hypothesis-profile", "overwrite": "--overwrite"}
+
+
+def _resume_args(args: argparse.Namespace) -> str:
+    """``--resume DIR``: check DIR holds an interrupted vehicle run and fill ``args`` with its
+    profile, time scale, selection and seed; the usage error, or ``""``."""
+    from ...reports.results import ReportError, load_results
+
+    given = [flag for key, flag in _RESUME_FIXED.items() if getattr(args, key, None) not in (None, False)]
+    if given:
+        return f"--resume continues the run as it was recorded; drop {', '.join(given)}"
+    if args.report_dir != "reports/vehicle":
+        return "--resume DIR is the report directory; drop --report-dir"
+    d = Path(args.resume)
+    try:
+        prior = load_results(d)
+    except ReportError as e:
+        return f"--resume: {e}"
+    if prior.get("role") != "vehicle":
+        return f"--resume: {d} holds a {prior.get('role')} run, not a vehicle certification"
+    if not prior.get("partial"):
+        return f"--resume: {d} holds a finished run; there is nothing to resume"
+    if not (d / "profile.toml").is_file() or not (d / "wire.log").is_file():
+        return f"--resume: {d} lacks profile.toml or wire.log; it cannot be continued"
+    st = prior.get("settings") or {}
+    args.profile = str(d / "profile.toml")
+    args.time_scale = float(st.get("time_scale", 1.0))
+    args.select = st.get("select") or None
+    args.examples = st.get("examples")
+    args.seed = st.get("seed")
+    args.strict = bool(st.get("strict", False))
+    args.hypothesis_profile = st.get("hypothesis_profile")
+    return ""
 
 
 def _at_a_terminal() -> bool:

@@ -47,12 +47,12 @@ class TesterLink:
     """A synchronous backseat link that records everything. See the module docstring."""
 
     def __init__(self, link: Link, profile: Profile, recorder: Recorder, *,
-                 guard: Optional[BenchGuard] = None, clock=time.monotonic):
+                 guard: Optional[BenchGuard] = None, clock=time.monotonic, start_at: float = 0.0):
         self.link = link
         self.profile = profile
         self.rec = recorder
         self.clock = clock
-        self.t0 = clock()
+        self.t0 = clock() - start_at  #: ``start_at``: the record's time now (a resumed run goes on)
         self.guard = guard if guard is not None else BenchGuard(profile)
         self.framer = Framer(max(4096, 4 * profile.max_line_bytes))
         self.inbox: deque[Rx] = deque()

@@ -50,6 +50,7 @@ from .interpreter import run_case
 from .link import TesterLink
 from .progress import Progress
 from .restore import Custodian, written_settings
+from .resume import Resumed, resume_into
 from .safety import BenchSafetyRefused
 from .session import Session, frame
 
@@ -85,6 +86,9 @@ class Options:
     log_opener: Optional[Callable[[Path], IO[str]]] = None
     #: a person at a terminal can be told to trip a sensor (``violation_trigger = "operator"``)
     operator: bool = False
+    #: continue the interrupted run in ``report_dir`` (:mod:`.resume`): its record is replayed
+    #: into the observer, its wire log appended to, its completed cases not run again
+    resume: bool = False
 
 
 @dataclass
@@ -141,6 +145,9 @@ class Run:
         self.stats: dict = {}
         self.child = None  #: the vehicle under test, when helmcheck started it (a Launcher)
         self.custodian = Custodian(written_settings(select_cases(opts.select, self.p)))
+        self.resumed: Optional[Resumed] = None
+        if opts.resume:
+            self.resumed = resume_into(self)
 
     # ------------------------------------------------------------------ results
     def save(self, final: bool = False) -> None:
@@ -177,7 +184,8 @@ class Run:
             r["restore"] = self.custodian.record()
         if self.session is not None:
             self.stats["forced_wait_s"] = round(self.session.forced_wait, 3)
-        self.stats["wall_s"] = round(time.monotonic() - self.t_start, 3)
+        self.stats["wall_s"] = round(time.monotonic() - self.t_start
+                                     + (self.resumed.wall_s if self.resumed is not None else 0.0), 3)
         r["stats"] = self.stats
         if final:
             R.finish(r, partial=self.partial, strict=self.o.strict, duration_s=self.stats["wall_s"])
@@ -193,7 +201,7 @@ class Run:
     def open(self) -> None:
         wire_path = self.dir / R.WIRE_LOG_NAME
         wire = (self.o.log_opener(wire_path) if self.o.log_opener is not None
-                else open(wire_path, "w", encoding="utf-8"))
+                else open(wire_path, "a" if self.resumed is not None else "w", encoding="utf-8"))
         try:
             prepare()  # before the first byte: reading a malformed line must not stall the clock
             if self.o.exec_cmd:
@@ -211,8 +219,15 @@ class Run:
         meta = [f"started {time.strftime('%Y-%m-%dT%H:%M:%SZ', time.gmtime())}  port "
                 f"{getattr(raw, 'name', None) or self.o.port}  baud {self.p.baud}  time_scale {self.k:g}",
                 f"helmcheck {__version__} certify vehicle; profile {self.p.name}"]
-        self.recorder = Recorder(wire, meta, [self.observer])
-        self.link = TesterLink(raw, self.p, self.recorder)
+        if self.resumed is not None:  # the record goes on after a gap of a second
+            lines, last_t = self.resumed.lines, self.resumed.last_t
+            self.recorder = Recorder(wire, observers=[self.observer], after=(lines, last_t))
+            self.link = TesterLink(raw, self.p, self.recorder, start_at=last_t + 1.0)
+            self.link.note(f"run resumed: {time.strftime('%Y-%m-%dT%H:%M:%SZ', time.gmtime())}, "
+                           f"{self.resumed.done} case(s) already run")
+        else:
+            self.recorder = Recorder(wire, meta, [self.observer])
+            self.link = TesterLink(raw, self.p, self.recorder)
         try:
             ser = getattr(raw, "ser", None)
             if ser is not None:
@@ -317,11 +332,13 @@ class Run:
                 gone = self.child_gone(settle_s=1.0)
                 if gone:  # the vehicle under test died: not a link fault
                     self.aborted = gone
-                    entry.update(verdict="not-tested", reason=gone, wall_s=round(time.monotonic() - t0, 3))
+                    entry.update(verdict="not-tested", reason=gone, wall_s=round(time.monotonic() - t0, 3),
+                                 cut=True)
                     self.results["cases"].append(entry)
                     self.progress.step(case.id, "not finished (the vehicle under test ended)")
                     raise
-                entry.update(verdict="inconclusive", reason=str(e), wall_s=round(time.monotonic() - t0, 3))
+                entry.update(verdict="inconclusive", reason=str(e), wall_s=round(time.monotonic() - t0, 3),
+                             cut=True)
                 self.results["cases"].append(entry)
                 self.progress.step(case.id, "inconclusive (link)")
                 raise
@@ -395,14 +412,18 @@ def certify(opts: Options) -> Outcome:
     """Run a whole certification (module docstring); never raises for vehicle or link faults."""
     run = Run(opts)
     cases = select_cases(opts.select, opts.profile)
-    run.progress.start(len(cases) + (1 if opts.explore else 0))
+    explore_now = opts.explore
+    if run.resumed is not None:
+        cases = [c for c in cases if c.id not in run.resumed.done_ids]
+        explore_now = opts.explore and not run.resumed.explored
+    run.progress.start(len(cases) + (1 if explore_now else 0))
     try:
         run.save()
         try:
             run.open()
             run.probe()
             run.run_cases(cases)
-            if opts.explore and run.aborted is None:
+            if explore_now and run.aborted is None:
                 from .explore import explore
                 explore(run)
                 run.progress.step("exploration", "done")

@@ -205,6 +205,8 @@ class VehicleObserver(Answers):
             self.baud = n.value  # the line's rate as the tester opened it: what transmit times use
         elif n.kind == "aborted":
             self.aborted = n.text
+        elif n.kind == "resumed":
+            self._resume(ev, n.text)
         elif n.kind in ("plant", "fault"):
             if n.kind == "fault":
                 event, v = P.SafetyViolation(n.code), self.v(ev.t)
@@ -379,6 +381,33 @@ class VehicleObserver(Answers):
         for q in self.quiet:
             self._silence_kept(q)
         self.quiet.clear()
+
+    def _resume(self, ev: WireEvent, what: str) -> None:
+        """An interrupted run goes on (``run resumed`` note): what the interruption cut off is not
+        judged (RH-ACK-1 INCONCLUSIVE for a command still inside its ACK window), the vehicle's
+        state is unknown again (taken from the next report that shows it whole, as at the start of
+        a record), and the run is no longer ended early."""
+        t = ev.t
+        self.framers = {TO_VEHICLE: Framer(self.profile.max_line_bytes),  # a line cut by the
+                        FROM_VEHICLE: Framer(max(4096, 4 * self.profile.max_line_bytes))}  # stop is nobody's
+        for p in list(self.pending) + self.dead:
+            self.ledger.inconclusive("RH-ACK-1", f"{text_of(p)}: the run was interrupted before its $ACK could "
+                                                 f"be read ({what})", [p.ev], p.case)
+        for q in self.silent:
+            q.state = "silent"
+        self.pending.clear()
+        self.silent.clear()
+        self.dead.clear()
+        self.quiet.clear()
+        self.gave_up.clear()
+        self.last_osd = None
+        self.after_discard = False
+        self.last_osi = None
+        self.case, self.case_clauses = "", ()
+        self.beliefs = Beliefs(self.profile, self.missions, self.k)
+        self.checks = osichecks.OsiChecks(self)
+        self.aborted = ""
+        self.t = max(self.t, t)
 
     def close(self) -> None:
         """The record ended (at the last event's time)."""
