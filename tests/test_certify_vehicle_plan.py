@@ -23,6 +23,7 @@ from helmcheck.conformance.vehicle.catalogue import select_cases
 from helmcheck.conformance.vehicle.session import frame
 from helmcheck.conformance.vehicle.virtual import VEHICLE_DELAY_S, VirtualLine
 from helmcheck.profile import DEFAULT
+from helmcheck.reports.results import load_results
 
 K = 20.0
 #: The cases the agreement test runs for real (about 35 s at time scale 20).
@@ -43,7 +44,11 @@ def test_plan_total_is_within_20_percent_of_a_real_certification_at_time_scale_2
                          "--select", AGREEMENT_SELECT, "--no-progress", "--report-dir", str(tmp_path / "real")])
         real = time.monotonic() - t0
     capsys.readouterr()
-    assert code == 0, "the real run must pass for its wall time to mean anything"
+    # every case ran to its end (on a loaded machine the timing clauses may be INCONCLUSIVE: the
+    # observer's own uncertainty, not the time the run took)
+    assert code in (0, 2)
+    cases = {c["id"]: c["verdict"] for c in load_results(tmp_path / "real")["cases"]}
+    assert cases and set(cases.values()) == {"pass"}, cases
     plan = _plan(capsys, "--time-scale", str(K), "--examples", "0", "--select", AGREEMENT_SELECT)
     ran = [c for c in plan["cases"] if c["kind"] == "case"]
     assert [c["id"] for c in ran] == [c.id for c in select_cases(AGREEMENT_SELECT.split(","), DEFAULT)]

@@ -31,6 +31,8 @@ __all__ = ["VirtualClock", "VirtualLine", "VEHICLE_DELAY_S"]
 
 #: Seconds from the moment a line's last byte reaches the vehicle to the moment it acts on it.
 VEHICLE_DELAY_S = 0.002
+#: What a wait without a timeout stands for, in virtual seconds.
+FOREVER_S = 86400.0
 
 
 class VirtualClock:
@@ -122,13 +124,13 @@ class VirtualLine(Link):
 
     def wait_readable(self, timeout: Optional[float]) -> bool:
         now = self.clock.t
-        until = math.inf if timeout is None else now + max(0.0, timeout)
-        if until <= now and timeout:
-            until = math.nextafter(now, math.inf)  # a wait too short to move a float still moves
         if self._to_tester and self._to_tester[0][0] <= now:
             return True
-        if until == math.inf and not self._to_vehicle and self.core.next_wakeup() is None:
-            return False  # nothing will ever arrive
+        if timeout is None:  # "for ever": a day of virtual time (the vehicle may never say anything)
+            timeout = FOREVER_S
+        until = now + max(0.0, timeout)
+        if until <= now and timeout:
+            until = math.nextafter(now, math.inf)  # a wait too short to move a float still moves
         return self._run(until)
 
     def poll(self, max_bytes: int = 65536) -> list[LinkEvent]:
