@@ -20,6 +20,7 @@ from helmcheck.conformance.emulator.core import EmulatorCore
 from helmcheck.conformance.emulator.missionfile import builtin_dir
 from helmcheck.conformance.emulator.process import EmulatorProcess
 from helmcheck.conformance.vehicle.catalogue import select_cases
+from helmcheck.conformance.vehicle.plan import OPERATOR_REACTION_S
 from helmcheck.conformance.vehicle.session import frame
 from helmcheck.conformance.vehicle.virtual import VEHICLE_DELAY_S, VirtualLine
 from helmcheck.profile import DEFAULT
@@ -101,7 +102,8 @@ def test_plan_select_shrinks_it(capsys):
 def test_plan_text_shows_every_case_the_exploration_budget_and_the_total(capsys):
     assert cli_main(["certify", "vehicle", "--plan", "--time-scale", "20", "--hypothesis-profile", "patient"]) == 0
     out = capsys.readouterr().out
-    rows = {ln.split()[0] for ln in out.splitlines() if ln[:2] in ("V-", "ex", "to")}
+    rows = {ln.split()[0] for ln in out.splitlines() if ln[:2] in ("V-", "ex", "to", "li", "re")}
+    assert {"link", "explore", "restore", "total"} <= rows
     assert {c.id for c in select_cases(None, DEFAULT)} < rows
     explore = next(ln for ln in out.splitlines() if ln.startswith("explore"))
     assert explore.split()[-3] == "600.0"  # the patient profile's wall budget, as its own line
@@ -138,6 +140,23 @@ def test_plan_stands_in_for_a_mission_it_does_not_have(tmp_path, capsys):
     assert plan["missions"]["stand_ins"] == {"survey-7.mis": "conformance.mis"}
     assert any("survey-7.mis" in a and "stands in" in a for a in plan["assumptions"])
     assert all(x["outcome"] == "ran" for x in plan["cases"])
+
+
+def test_plan_times_the_violation_cases_whatever_raises_the_violation(tmp_path, capsys):
+    """RH-SAF-5: with an operator, the plan waits for their trip; with a mission's own rule, for the
+    rule (the built-in test mission stands in for the profile's violation_mission, with its time)."""
+    (tmp_path / "op.toml").write_text('violation_trigger = "operator"\n')
+    (tmp_path / "rule.toml").write_text('violation_trigger = "mission-rule"\nviolation_mission = "mot.mis"\n'
+                                        'violation_after_s = 60\n')
+    sel = ("--time-scale", "20", "--examples", "0", "--select", "RH-SAF-1")
+    op = _plan(capsys, "--profile", str(tmp_path / "op.toml"), *sel)
+    rule = _plan(capsys, "--profile", str(tmp_path / "rule.toml"), *sel)
+    v58 = {name: next(x for x in p["cases"] if x["id"] == "V-58") for name, p in (("op", op), ("rule", rule))}
+    assert v58["op"]["outcome"] == v58["rule"]["outcome"] == "ran", v58
+    assert v58["op"]["wall_s"] > OPERATOR_REACTION_S + DEFAULT.lockout_s / 20  # the trip, then the lockout
+    assert any("trips a sensor" in a for a in op["assumptions"])
+    assert rule["missions"]["stand_ins"] == {"mot.mis": "conformance.mis (max_time_s 60)"}
+    assert v58["rule"]["vehicle_s"] > 60 + DEFAULT.lockout_s  # the rule's 60 s, then the lockout
 
 
 @pytest.mark.parametrize("argv, says", [

@@ -1,15 +1,20 @@
 """``certify vehicle --plan``: how long a certification will take, before it starts.
 
 :func:`estimate` runs the very cases a certification runs — the same catalogue, interpreter,
-session, tester link and vehicle observer — against the reference vehicle (the emulator's
-sans-IO core, in-process) over a line in virtual time (:mod:`.virtual`). Every case's estimate
-therefore comes from the steps that really run: the protocol durations it waits out (vehicle
-seconds ÷ k), its polls and exchanges at the line's baud, and the ACK windows the tester sits out
-for lines the vehicle must discard (wall time, never scaled). No port is opened, nothing is
-written and no real time passes waiting.
+session, tester link, vehicle observer and custodian (:mod:`.restore`) — against the reference
+vehicle (the emulator's sans-IO core, in-process) over a line in virtual time (:mod:`.virtual`).
+Every case's estimate therefore comes from the steps that really run: the protocol durations it
+waits out (vehicle seconds ÷ k), its polls and exchanges at the line's baud, and the ACK windows
+the tester sits out for lines the vehicle must discard (wall time, never scaled). No port is
+opened, nothing is written and no real time passes waiting. The lines follow the runner's
+phases: the link check (with the settings survey of a vehicle found stopped), the cases, the
+exploration, the restore.
 
 What it cannot run in virtual time is the hypothesis exploration: it stops on a wall-clock
 budget, so the plan shows that budget as its own line (it ends sooner when its examples are done).
+A profile whose safety violations an operator raises (``violation_trigger = "operator"``) is
+planned with someone at the terminal who trips the sensor :data:`OPERATOR_REACTION_S` after
+being told.
 
 The estimate assumes the vehicle behaves like the reference model: a vehicle that answers more
 slowly, runs a longer mission or surfaces more slowly takes longer. It uses the profile's
@@ -21,7 +26,6 @@ found in neither is stood in for by the built-in mission of the same role, and t
 
 from __future__ import annotations
 
-import types
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Optional
@@ -36,15 +40,23 @@ from ..recorder import Recorder
 from .catalogue import select_cases
 from .explore import PROFILES as EXPLORE_PROFILES
 from .flow import LinkLost
-from .interpreter import run_case
+from .interpreter import OPERATOR_WAIT_S, run_case
 from .link import TesterLink
-from .session import Session
+from .restore import Custodian, written_settings
+from .session import Session, frame
 from .virtual import VEHICLE_DELAY_S, VirtualLine
 
-__all__ = ["Plan", "PlanLine", "estimate", "render_text", "as_json", "PlanError"]
+__all__ = ["Plan", "PlanLine", "estimate", "render_text", "as_json", "PlanError", "OPERATOR_REACTION_S"]
 
-#: Which built-in mission stands in for each mission the profile names.
-STAND_INS = (("mission", "conformance.mis"), ("end_mission", "short.mis"), ("srp_mission", "srp.mis"))
+#: Which built-in mission stands in for each mission the profile names (``violation_mission``
+#: with the profile's ``violation_after_s`` as its Maximum Operation Time).
+STAND_INS = (("mission", "conformance.mis"), ("end_mission", "short.mis"), ("srp_mission", "srp.mis"),
+             ("violation_mission", "conformance.mis"))
+#: Wall seconds the plan gives an operator, once told, to trip a sensor (``violation_trigger =
+#: "operator"``); the run itself waits up to :data:`.interpreter.OPERATOR_WAIT_S`.
+OPERATOR_REACTION_S = 10.0
+#: The sensor the operator trips in the plan (the emulator's leak sensor, as SIGUSR1 trips it).
+OPERATOR_CODE = "Sle"
 
 
 class PlanError(Failure):
@@ -114,8 +126,9 @@ class _PlanCatalog:
                 continue
             found = builtin.lookup(default)
             if isinstance(found, Mission):
-                self.stand_ins[name] = default
-                self._missions[normalise_name(name)] = Mission(name, found.waypoints)
+                limit = profile.violation_after_s if key == "violation_mission" else found.max_time_s
+                self.stand_ins[name] = default + (f" (max_time_s {limit:g})" if limit else "")
+                self._missions[normalise_name(name)] = Mission(name, found.waypoints, max_time_s=limit or None)
 
     def lookup(self, name: str):
         found = self.inner.lookup(name)
@@ -129,7 +142,8 @@ class _PlanCatalog:
 def estimate(profile: Profile, time_scale: float, *, select: Optional[list] = None,
              examples: Optional[int] = None, hypothesis_profile: str = "fast",
              missions_dir: Optional[Path] = None) -> Plan:
-    """Time the selected cases (and the exploration's budget) at ``time_scale``: module docstring."""
+    """Time the run's phases at ``time_scale`` (module docstring): the link check, the selected
+    cases, the exploration's budget and the restore, in the runner's order."""
     from ..emulator.core import EmulatorCore
 
     k = float(time_scale)
@@ -142,6 +156,11 @@ def estimate(profile: Profile, time_scale: float, *, select: Optional[list] = No
     recorder = Recorder(None, [], [observer])
     link = TesterLink(line, profile, recorder, clock=line.clock)
     session = Session(link, profile, k, observer)
+    cases = select_cases(select, profile)
+    custodian = Custodian(written_settings(cases))
+    session.custodian = custodian
+    if profile.trigger == "operator":
+        session.operator = _operator(line, core)
     plan = Plan(profile=profile.name, protocol=profile.protocol, time_scale=k, baud=profile.baud,
                 select=list(select or []))
 
@@ -151,10 +170,10 @@ def estimate(profile: Profile, time_scale: float, *, select: Optional[list] = No
         return round(link.now() - t0, 3), round(session.forced_wait - w0, 3)
 
     try:
-        wall, _ = timed(lambda: _probe(link, profile, observer))
+        wall, _ = timed(lambda: _link_check(session, custodian))
         plan.lines.append(PlanLine("link", "setup", "check that the vehicle answers ($OSD,S)", wall,
                                    round(wall * k, 3)))
-        for case in select_cases(select, profile):
+        for case in cases:
             got: list = []
             wall, wait = timed(lambda: got.append(run_case(session, case)))
             outcome, reason = got[0]
@@ -166,31 +185,66 @@ def estimate(profile: Profile, time_scale: float, *, select: Optional[list] = No
                 state, note = "stopped", f"{outcome} on the reference model: {reason}"
             plan.lines.append(PlanLine(case.id, "case", case.title, wall, round(wall * k, 3), wait,
                                        tuple(case.clauses), state, note))
+        n, _steps, budget = EXPLORE_PROFILES.get(hypothesis_profile, EXPLORE_PROFILES["fast"])
+        if examples is not None:
+            n = examples
+        if n > 0:
+            plan.lines.append(PlanLine("explore", "exploration",
+                                       f"hypothesis exploration: {n} examples ({hypothesis_profile})",
+                                       float(budget), round(budget * k, 3), outcome="budget",
+                                       note=f"its wall budget ({hypothesis_profile} profile)"))
+            custodian.touched = True  # it sends commands
+        if custodian.needed:
+            wall, wait = timed(lambda: custodian.restore(session))
+            plan.lines.append(PlanLine("restore", "setup", "leave the vehicle as it was found", wall,
+                                       round(wall * k, 3), wait))
     except LinkLost as e:
         raise PlanError(f"the reference vehicle stopped answering in the virtual run: {e}") from None
     finally:
         recorder.close()
         observer.close()
-
-    n, _steps, budget = EXPLORE_PROFILES.get(hypothesis_profile, EXPLORE_PROFILES["fast"])
-    if examples is not None:
-        n = examples
-    if n > 0:
-        plan.lines.append(PlanLine("explore", "exploration",
-                                   f"hypothesis exploration: {n} examples ({hypothesis_profile})",
-                                   float(budget), round(budget * k, 3), outcome="budget",
-                                   note=f"its wall budget ({hypothesis_profile} profile)"))
     plan.missions = {"directories": [str(d) for d in catalog.dirs], "given": missions_dir is not None,
                      "stand_ins": dict(catalog.stand_ins)}
     plan.assumptions = _assumptions(plan, profile, catalog, missions_dir, n, budget, hypothesis_profile)
     return plan
 
 
-def _probe(link: TesterLink, profile: Profile, observer: VehicleObserver) -> None:
-    """The runner's own link check (:meth:`.runner.Run.probe`), on the virtual line."""
-    from .runner import Run
-    shim = types.SimpleNamespace(link=link, p=profile, observer=observer, o=types.SimpleNamespace(port="virtual"))
-    Run.probe(shim)  # type: ignore[arg-type]
+def _link_check(session: Session, custodian: Custodian) -> None:
+    """The runner's link check (:meth:`.runner.Run.probe`): ``$OSD,S`` until the vehicle answers,
+    then what it was found in (its settings read when found in ``S``, :mod:`.restore`)."""
+    link, obs = session.link, session.obs
+    link.sleep(0.05)
+    link.drain()
+    for _ in range(2):
+        link.send(frame("OSD,S"))
+        end = link.now() + session.profile.ack_window_s + 0.5
+        while link.next(end) is not None:
+            if obs.alive_t is not None:
+                link.sleep(0.1)
+                link.drain()
+                custodian.found(obs.last_osi)
+                if obs.last_osi is not None and obs.last_osi.mode == "S":
+                    stop, session.stop_on_fail = session.stop_on_fail, False
+                    try:
+                        custodian.survey(session)
+                    finally:
+                        session.stop_on_fail = stop
+                return
+    raise PlanError("the reference vehicle did not answer $OSD,S in the virtual run")
+
+
+def _operator(line: VirtualLine, core):
+    """``violation_trigger = "operator"``: told to trip a sensor, the operator does so
+    :data:`OPERATOR_REACTION_S` later (on the in-process vehicle, off the wire)."""
+    pending: list = []
+
+    def told(text: str) -> None:
+        now = line.clock()
+        if core.lockout_active or any(t > now for t in pending):
+            return  # the thanks after the code was seen, or a trip already on its way
+        pending.append(now + OPERATOR_REACTION_S)
+        line.at(now + OPERATOR_REACTION_S, lambda t: core.inject_fault(OPERATOR_CODE, t, "operator (plan)"))
+    return told
 
 
 def _assumptions(plan: Plan, profile: Profile, catalog: _PlanCatalog, missions_dir: Optional[Path],
@@ -208,6 +262,9 @@ def _assumptions(plan: Plan, profile: Profile, catalog: _PlanCatalog, missions_d
                    "--missions DIR gives the vehicle's own mission files")
     for name, builtin in catalog.stand_ins.items():
         out.append(f"the profile's {name} is not among them: the built-in {builtin} stands in for it")
+    if profile.trigger == "operator":
+        out.append(f"someone at the terminal trips a sensor {OPERATOR_REACTION_S:g} s after being told (the run "
+                   f"waits up to {OPERATOR_WAIT_S:g} s for it)")
     if examples > 0:
         out.append(f"the exploration is counted at its wall budget of {budget:g} s ({hp} profile, "
                    f"{examples} examples): it ends sooner when its examples are done, and starts none "
@@ -248,11 +305,11 @@ def render_text(plan: Plan) -> str:
     out.append(f"{'total':<8} {'':<{width}} {plan.total_vehicle_s:>10.1f} {plan.total_wall_s:>9.1f}"
                f"  ({_hms(plan.total_wall_s)} of wall time)")
     out.append("")
-    cases_wall = sum(x.wall_s for x in plan.lines if x.kind != "exploration")
-    if cases_wall > 0:
-        out.append(f"Of the cases' {cases_wall:.1f} s, {plan.wait_s:.1f} s wait out protocol durations "
-                   f"(they shrink as --time-scale grows); the rest is exchanges, line time and ACK windows "
-                   f"(they do not).")
+    timed_wall = sum(x.wall_s for x in plan.lines if x.kind != "exploration")
+    if timed_wall > 0:
+        out.append(f"Of the {timed_wall:.1f} s besides the exploration, {plan.wait_s:.1f} s wait out protocol "
+                   f"durations (they shrink as --time-scale grows); the rest is exchanges, line time and ACK "
+                   f"windows (they do not).")
     for reason, ids in not_run.items():
         out.append(f"Not run (the profile does not let them): {', '.join(ids)}: {reason}")
     for x in plan.lines:

@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import heapq
 import math
-from typing import Optional
+from typing import Callable, Optional
 
 from ..transport import Link, LinkEvent
 
@@ -67,6 +67,7 @@ class VirtualLine(Link):
         self._seq = 0
         self._to_vehicle: list[tuple[float, int, bytes]] = []  #: (when the vehicle acts, order, bytes)
         self._to_tester: list[tuple[float, int, bytes]] = []  #: (when the tester has them, order, bytes)
+        self._off_wire: list[tuple[float, int, Callable[[float], bytes]]] = []  #: (when, order, action)
         self._line_free = self.clock.t  #: when the tester → vehicle direction is free again
         self._core_t = self.clock.t  #: the last time given to the core (never goes back)
         self.closed = False
@@ -80,8 +81,16 @@ class VirtualLine(Link):
         if out:
             self._push(self._to_tester, now + len(out) * self.per_byte, out)
 
+    def at(self, t: float, action: Callable[[float], bytes]) -> None:
+        """Something that happens on the vehicle off the wire at virtual time ``t`` (a sensor an
+        operator trips): ``action(now)`` calls the core and returns the bytes it sends now."""
+        self._seq += 1
+        heapq.heappush(self._off_wire, (t, self._seq, action))
+
     def _next_core_event(self) -> float:
         t = self._to_vehicle[0][0] if self._to_vehicle else math.inf
+        if self._off_wire:
+            t = min(t, max(self._off_wire[0][0], self._core_t))
         w = self.core.next_wakeup()
         if w is not None:
             t = min(t, max(w, self._core_t))
@@ -90,6 +99,11 @@ class VirtualLine(Link):
     def _step_core(self, t: float) -> None:
         """Run the core's next event, due at ``t``."""
         t = max(t, self._core_t)
+        if self._off_wire and self._off_wire[0][0] <= t:
+            _, _, action = heapq.heappop(self._off_wire)
+            self._core_t = t
+            self._from_core(action(t), t)
+            return
         if self._to_vehicle and self._to_vehicle[0][0] <= t:
             _, _, data = heapq.heappop(self._to_vehicle)
             self._core_t = t
