@@ -249,9 +249,9 @@ def _operator(line: VirtualLine, core):
 
 def _assumptions(plan: Plan, profile: Profile, catalog: _PlanCatalog, missions_dir: Optional[Path],
                  examples: int, budget: float, hp: str) -> list[str]:
-    out = [f"the vehicle behaves and answers like the reference model (the built-in emulator), which "
-           f"these times come from: the cases were run on it in virtual time; a vehicle slower to answer, "
-           f"with longer missions or slower to surface takes longer",
+    out = ["the vehicle behaves and answers like the reference model (the built-in emulator), which "
+           "these times come from: the cases were run on it in virtual time; a vehicle slower to answer, "
+           "with longer missions or slower to surface takes longer",
            f"the line: {plan.baud} baud 8N1 both ways (every byte's transmit time), the vehicle acting "
            f"{VEHICLE_DELAY_S * 1000:g} ms after a line's last byte; the tester's own computing time is not "
            f"counted"]
