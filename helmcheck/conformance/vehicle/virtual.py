@@ -16,7 +16,8 @@ The line model (both directions 8N1 at ``baud``, 10 bits a byte):
 * vehicle → tester: the vehicle's own pacing (:class:`~helmcheck.conformance.transport.LinePacer`)
   decides when a sentence starts; it reaches the tester once its last byte has crossed.
 
-``baud = 0`` carries bytes in no time. Nothing here knows a case or a clause.
+``baud = 0`` carries bytes in no time. What happens on the vehicle off the wire (a sensor an
+operator trips) is scheduled with :meth:`VirtualLine.at`. Nothing here knows a case or a clause.
 """
 
 from __future__ import annotations
