@@ -44,16 +44,17 @@ def test_plan_total_is_within_20_percent_of_a_real_certification_at_time_scale_2
                          "--select", AGREEMENT_SELECT, "--no-progress", "--report-dir", str(tmp_path / "real")])
         real = time.monotonic() - t0
     capsys.readouterr()
-    # every case ran to its end (on a loaded machine the timing clauses may be INCONCLUSIVE: the
-    # observer's own uncertainty, not the time the run took)
-    assert code in (0, 2)
-    cases = {c["id"]: c["verdict"] for c in load_results(tmp_path / "real")["cases"]}
-    assert cases and set(cases.values()) == {"pass"}, cases
+    assert code in (0, 2)  # on a busy machine a timing clause may be INCONCLUSIVE: not the time taken
     plan = _plan(capsys, "--time-scale", str(K), "--examples", "0", "--select", AGREEMENT_SELECT)
-    ran = [c for c in plan["cases"] if c["kind"] == "case"]
-    assert [c["id"] for c in ran] == [c.id for c in select_cases(AGREEMENT_SELECT.split(","), DEFAULT)]
-    assert all(c["outcome"] == "ran" for c in ran), ran
-    est = plan["total_wall_s"]
+    planned = {c["id"]: c for c in plan["cases"] if c["kind"] == "case"}
+    assert list(planned) == [c.id for c in select_cases(AGREEMENT_SELECT.split(","), DEFAULT)]
+    assert all(c["outcome"] == "ran" for c in planned.values()), planned
+    done = {c["id"]: c["wall_s"] for c in load_results(tmp_path / "real")["cases"] if c["verdict"] == "pass"}
+    if len(done) == len(planned):  # every case ran to its end: the command's wall time against the total
+        est = plan["total_wall_s"]
+    else:  # a case a busy machine cut short: the cases that ran to their end, one by one
+        est, real = sum(planned[x]["wall_s"] for x in done), sum(done.values())
+        assert est >= 0.6 * sum(c["wall_s"] for c in planned.values()), f"too little ran to its end: {done}"
     assert abs(est - real) <= 0.2 * real, f"plan {est:.1f} s, real {real:.1f} s"
 
 
