@@ -457,7 +457,7 @@ OPTIONS = {
     "emulate": ["--port", "--baud", "--profile", "--time-scale", "--missions", "--log", "--main-log", "--settings",
                 "--no-fault-injection"],
     "certify vehicle": ["--port", "--profile", "--time-scale", "--baud", "--report-dir", "--select", "--examples",
-                        "--seed", "--strict", "--wire-log", "--overwrite", "--no-progress"],
+                        "--seed", "--strict", "--wire-log", "--overwrite", "--no-progress", "--json", "--missions"],
     "certify backseat": ["--port", "--profile", "--duration", "--time-scale", "--scenario", "--report-dir",
                          "--strict", "--wire-log", "--connect-timeout", "--baud", "--overwrite"],
     "replay": ["--port", "--profile", "--time-scale", "--wire-log"],

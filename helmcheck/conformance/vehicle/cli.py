@@ -3,6 +3,7 @@
 ``add_arguments(parser)`` and ``run(args) -> int`` are what
 :mod:`helmcheck.commands.certify_cmd` dispatches to; :data:`EPILOG` is the ``--help`` epilog.
 Exit status: 0 pass (or non-strict without ``--strict``), 1 fail, 2 inconclusive, 64 usage.
+``--plan`` (:mod:`.plan`) estimates the run instead, and opens no port and writes no file.
 The port is opened here, once, before anything is written (``helmcheck.commands.ports``: one
 that cannot be opened is exit 64); the report directory is checked first and cleared with
 ``--overwrite`` (:mod:`helmcheck.outputs`); the reports are rendered and ``--wire-log`` copied
@@ -59,6 +60,13 @@ is K. Its output goes to DIR/vehicle.stdout.log and DIR/vehicle.stderr.log; at t
 SIGTERM, then SIGKILL after --exec-grace. A vehicle that exits or dies before the end fails the
 run (results.json "process", its last output quoted).
 
+plan: --plan prints every selected case with its estimated vehicle and wall time at time scale K,
+  and the total, without opening a port or writing anything (--json: one JSON object). The cases
+  are run on the reference vehicle in virtual time, so the estimate includes the protocol's waits
+  and the ACK windows sat out for discarded lines; the exploration counts at its wall budget.
+  --missions DIR names the vehicle's mission files (default: the emulator's built-in ones).
+  helmcheck certify vehicle --plan --time-scale 1 --profile iver3.toml
+
 certificate: a run that judges every vehicle clause is a certificate; --select runs and runs with a
   NOT-TESTED or INCONCLUSIVE clause say "partial: N of 60 claimed clauses judged; not a certificate".
   --sign-key KEY signs the run (helmcheck keygen); helmcheck verify DIR checks it.
@@ -111,6 +119,14 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--overwrite", action="store_true",
                    help="replace an earlier run in --report-dir (its results, wire log, reports and "
                         "replays are removed first); without it such a directory is refused")
+    plan = p.add_argument_group("plan (no port opened, nothing written)")
+    plan.add_argument("--plan", action="store_true",
+                      help="print each selected case with its estimated vehicle and wall time at the time "
+                           "scale, and the total, then exit; --port is not needed")
+    plan.add_argument("--json", action="store_true",
+                      help="with --plan: one JSON object (cases, total_wall_s, total_vehicle_s, assumptions)")
+    plan.add_argument("--missions", metavar="DIR",
+                      help="with --plan: the vehicle's mission files (default: the emulator's built-in ones)")
 
 
 def _usage(msg: str) -> int:
@@ -138,6 +154,8 @@ def run(args: argparse.Namespace) -> int:  # noqa: C901 - argument checks, then 
             return _usage(f"--baud must be one of {', '.join(map(str, BAUD_RATES))}")
         profile = profile.replace(baud=args.baud)
     profile = profile.replace(time_scale=float(k))
+    if args.plan or args.json or args.missions is not None:
+        return _plan(args, profile, k)
     if args.exec_cmd is not None:
         from ..launcher import check_command
         why = check_command(args.exec_cmd)
@@ -155,17 +173,7 @@ def run(args: argparse.Namespace) -> int:  # noqa: C901 - argument checks, then 
     if spec.kind == "pty" and args.exec_cmd is None:
         return _usage("--port pty creates a new pseudo-terminal; give the vehicle's port (e.g. /dev/pts/N) "
                       "or --exec CMD to start the vehicle on it")
-    select = None
-    if args.select:
-        select = [x.strip() for item in args.select for x in item.split(",") if x.strip()]
-        from fnmatch import fnmatchcase
-        from ...clauses import vehicle_clauses
-        ids = [c.id for c in vehicle_clauses()]
-        bad = [p for p in select if not any(fnmatchcase(cid, p) for cid in ids)]
-        if bad:
-            return _usage(f"--select: {', '.join(bad)} match no vehicle clause (e.g. RH-SRV-*, RH-ACK-2)")
-    if args.examples is not None and args.examples < 0:
-        return _usage("--examples must be 0 or more")
+    select = _selection(args)
     from ...commands.certificate_opts import DeclarationError, declaration
     try:
         cert = declaration(args, "vehicle")
@@ -192,7 +200,7 @@ def run(args: argparse.Namespace) -> int:  # noqa: C901 - argument checks, then 
             wire.append(OutputStream(f, path, stop=False, what="wire log"))
             return wire[-1]
 
-        hp = args.hypothesis_profile or ("fast" if k > 1 else "patient")
+        hp = _hypothesis_profile(args, k)
         command = "helmcheck certify vehicle " + shlex.join(sys.argv[3:] if len(sys.argv) > 3 else [])
         opts = Options(port=args.port, profile=profile, time_scale=float(k), report_dir=report_dir,
                        select=select, examples=args.examples, seed=args.seed, strict=args.strict,
@@ -261,6 +269,48 @@ def _at_a_terminal() -> bool:
         return sys.stdin.isatty() and sys.stderr.isatty()
     except (AttributeError, ValueError):
         return False
+
+
+def _selection(args: argparse.Namespace):
+    """``--select`` as a list of IDs and globs (``None``: every case); checks ``--examples`` too."""
+    select = None
+    if args.select:
+        select = [x.strip() for item in args.select for x in item.split(",") if x.strip()]
+        from fnmatch import fnmatchcase
+        from ...clauses import vehicle_clauses
+        ids = [c.id for c in vehicle_clauses()]
+        bad = [p for p in select if not any(fnmatchcase(cid, p) for cid in ids)]
+        if bad:
+            _usage(f"--select: {', '.join(bad)} match no vehicle clause (e.g. RH-SRV-*, RH-ACK-2)")
+    if args.examples is not None and args.examples < 0:
+        _usage("--examples must be 0 or more")
+    return select
+
+
+def _hypothesis_profile(args: argparse.Namespace, k: float) -> str:
+    return args.hypothesis_profile or ("fast" if k > 1 else "patient")
+
+
+def _plan(args: argparse.Namespace, profile, k: float) -> int:
+    """``--plan``: the estimate (:mod:`.plan`) on standard output; no port, no file touched."""
+    import json
+
+    if not args.plan:
+        return _usage(f"{'--json' if args.json else '--missions'} goes with --plan")
+    select = _selection(args)
+    missions = None
+    if args.missions is not None:
+        missions = Path(args.missions)
+        if not missions.is_dir():
+            return _usage(f"--missions: {args.missions} is not a directory")
+    from .plan import estimate, render_text, as_json
+    plan = estimate(profile, k, select=select, examples=args.examples,
+                    hypothesis_profile=_hypothesis_profile(args, k), missions_dir=missions)
+    if args.json:
+        print(json.dumps(as_json(plan), indent=1))
+    else:
+        print(render_text(plan))
+    return exitcodes.OK
 
 
 def _finish_outputs(report_dir: Path, wire: list, wire_copy) -> None:
