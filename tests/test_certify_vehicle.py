@@ -17,7 +17,6 @@ from pathlib import Path
 import pytest
 
 from helmcheck.cli import main as cli_main
-from helmcheck.conformance.emulator.process import EmulatorProcess
 from helmcheck.conformance.transport import PtyLink
 from helmcheck.conformance.vehicle import runner as runner_mod
 from helmcheck.conformance.vehicle.runner import Options, certify
