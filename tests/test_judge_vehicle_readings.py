@@ -182,6 +182,19 @@ def test_the_first_report_of_a_record_gives_the_state_it_starts_in(tmp_path):
     assert verdict(v, "RH-OUT-4") == "pass"
 
 
+def test_RH_SRV_3_a_servo_that_ends_on_its_first_timeout_after_a_refresh_blames_the_refresh(tmp_path):
+    """An $OMS refreshed 6 s into its 10 s timeout, and the vehicle back in N at 11 s: the refresh
+    did not restart the timeout (RH-SRV-3). No safety code is shown, so it is not RH-SAF-1."""
+    rec = start() + [(1.0, ">", "OMS,90,2,20,0.5,10"), (1.01, "<", "ACK,9,0,0")]
+    rec += poll(1.5, mode="A")
+    rec += [(7.0, ">", "OMS,90,2,20,0.5,10"), (7.01, "<", "ACK,9,0,0")]
+    rec += poll(7.5, mode="A")
+    rec += poll(12.0, mode="N", dist=150.0, speed=2.0)
+    v = judge(tmp_path, rec)
+    assert verdict(v, "RH-SRV-3") == "fail", v.get("RH-SRV-3")
+    assert verdict(v, "RH-SAF-1") != "fail"
+
+
 # ------------------------------------------------------------------------- timing brackets
 
 @pytest.mark.parametrize("early", [0.0, 0.003, 0.3])
