@@ -195,6 +195,20 @@ def test_RH_SRV_3_a_servo_that_ends_on_its_first_timeout_after_a_refresh_blames_
     assert verdict(v, "RH-SAF-1") != "fail"
 
 
+def test_RH_INT_3_a_park_back_just_before_the_observers_deadline_is_blamed_on_the_park(tmp_path):
+    """$OPK, then $OMS (10 s): the vehicle shows the park again 0.2 s before the observer's own
+    deadline (its ACK left a little before it was read), within the timeout's tolerance. The
+    servo may have ended there; what the vehicle did wrong is to bring the interrupted park back."""
+    rec = start() + [(1.0, ">", f"OPK,{LAT:.6f},{LON:.6f},5,0.5"), (1.01, "<", "ACK,11,0,0")]
+    rec += poll(1.5, mode="mP", park=300)
+    rec += [(2.0, ">", "OMS,90,2,20,0.5,10"), (2.01, "<", "ACK,9,0,0")]
+    rec += poll(2.5, mode="A")
+    rec += poll(11.6, mode="A")
+    rec += poll(11.8, mode="mP", park=300)
+    v = judge(tmp_path, rec)
+    assert verdict(v, "RH-INT-3") == "fail", v.get("RH-INT-3")
+
+
 # ------------------------------------------------------------------------- timing brackets
 
 @pytest.mark.parametrize("early", [0.0, 0.003, 0.3])

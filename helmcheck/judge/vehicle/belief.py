@@ -281,9 +281,19 @@ class Beliefs:
                     setters += [row for row in p.refresh if row not in setters]
                 setters += opened
                 rows = setters + [row for row in rows if row not in setters]
+            # a timer due within the report's uncertainty may have run on the vehicle: what it does
+            # is blamed too, last (a release reported a little before the observer's deadline)
+            ahead = []
+            due = p.model.timer()
+            if due is not None and due[0] <= v + tolerance(due[1], slack):
+                t = p.clone()
+                t.model.advance(due[0])
+                t.drain()
+                ahead = [row for row in t.pending if row not in p.pending]
             causes = [c for row in rows for c in row.clauses]
             causes += [c for tt in p.timed for c in tt.row.clauses]
-            released = any("RH-INT-2" in row.clauses for row in p.pending)
+            causes += [c for row in ahead for c in row.clauses]
+            released = any("RH-INT-2" in row.clauses for row in p.pending + ahead)
             if released and "opk" in p.abandoned:
                 causes.insert(0, "RH-INT-3")  # the interrupted park came back: not abandoned
             if released and "queue" in p.abandoned:
