@@ -182,6 +182,33 @@ def test_the_first_report_of_a_record_gives_the_state_it_starts_in(tmp_path):
     assert verdict(v, "RH-OUT-4") == "pass"
 
 
+def test_RH_SRV_3_a_servo_that_ends_on_its_first_timeout_after_a_refresh_blames_the_refresh(tmp_path):
+    """An $OMS refreshed 6 s into its 10 s timeout, and the vehicle back in N at 11 s: the refresh
+    did not restart the timeout (RH-SRV-3). No safety code is shown, so it is not RH-SAF-1."""
+    rec = start() + [(1.0, ">", "OMS,90,2,20,0.5,10"), (1.01, "<", "ACK,9,0,0")]
+    rec += poll(1.5, mode="A")
+    rec += [(7.0, ">", "OMS,90,2,20,0.5,10"), (7.01, "<", "ACK,9,0,0")]
+    rec += poll(7.5, mode="A")
+    rec += poll(12.0, mode="N", dist=150.0, speed=2.0)
+    v = judge(tmp_path, rec)
+    assert verdict(v, "RH-SRV-3") == "fail", v.get("RH-SRV-3")
+    assert verdict(v, "RH-SAF-1") != "fail"
+
+
+def test_RH_INT_3_a_park_back_just_before_the_observers_deadline_is_blamed_on_the_park(tmp_path):
+    """$OPK, then $OMS (10 s): the vehicle shows the park again 0.2 s before the observer's own
+    deadline (its ACK left a little before it was read), within the timeout's tolerance. The
+    servo may have ended there; what the vehicle did wrong is to bring the interrupted park back."""
+    rec = start() + [(1.0, ">", f"OPK,{LAT:.6f},{LON:.6f},5,0.5"), (1.01, "<", "ACK,11,0,0")]
+    rec += poll(1.5, mode="mP", park=300)
+    rec += [(2.0, ">", "OMS,90,2,20,0.5,10"), (2.01, "<", "ACK,9,0,0")]
+    rec += poll(2.5, mode="A")
+    rec += poll(11.6, mode="A")
+    rec += poll(11.8, mode="mP", park=300)
+    v = judge(tmp_path, rec)
+    assert verdict(v, "RH-INT-3") == "fail", v.get("RH-INT-3")
+
+
 # ------------------------------------------------------------------------- timing brackets
 
 @pytest.mark.parametrize("early", [0.0, 0.003, 0.3])

@@ -234,7 +234,9 @@ class Session:
     def settle(self, timer: Optional[str] = None, probe: Optional[bytes] = None,
                clause: Optional[str] = None) -> s.OSI:
         """Poll across the deadline of a model timer until the vehicle has left the state before
-        it (the observer brackets the transition, RH-TIM-1)."""
+        it (the observer brackets the transition, RH-TIM-1). The lockout's end shows in no
+        ``$OSI``: with a ``probe`` (a command only the lockout refuses) it is left when the probe
+        is answered without err 26 (RH-SAF-1), so what follows is judged after it for certain."""
         dl = self.obs.deadline(timer)
         if dl is None:
             self._budget(f"the {timer or 'next'} timer", 0.0, clause,
@@ -245,17 +247,22 @@ class Session:
         cap = self._cap(max(0.0, due_wall - t0) + 2 * tol_wall + 5.0)
         before = self.obs.state().mode
         phase_before = self.obs.state().phase
-        # quietly until close to the deadline, then poll closely
-        while self.now() < due_wall - tol_wall - 2 * self.poll_gap:
-            self.link.sleep(min(self.poll_gap * 4, max(0.0, due_wall - tol_wall - self.now())))
+        # quietly until close to the deadline, then poll closely: over the tolerance and over the
+        # last quarter of the duration, where a clock off by tens of percent ends it (RH-TIM-2)
+        close = max(tol_wall + 2 * self.poll_gap, dur / 4 / self.k)
+        while self.now() < due_wall - close:
+            self.link.sleep(min(self.poll_gap * 4, max(0.0, due_wall - close - self.now())))
             self.poll() if probe is None else self.exchange(probe)
+        answered = None
         while True:
             if probe is not None:
-                self.exchange(probe)
+                answered = self.exchange(probe)
             osi = self.poll()
             st = self.obs.state()
             armed = st.timers.armed(name)
             left = (osi.mode != before) if name != "lockout" else (st.phase != phase_before)
+            if name == "lockout" and probe is not None:
+                left = left and answered is not None and answered.ack is not None and answered.ack.err != 26
             if not armed and left and self.now() > due_wall:
                 break
             if self.now() - t0 > cap:

@@ -270,14 +270,30 @@ class Beliefs:
                 # what the vehicle got wrong (a lockout's start or end changes no mode)
                 setters = [row for row in reversed(rows) if row.target != STAY]
                 # then an internal transition open to the model now that gives the reported mode
-                # under another guard (at the surface: park instead of the SRP, RH-SAF-4)
+                # under another guard (at the surface: park instead of the SRP, RH-SAF-4); not a
+                # violation when field 8 shows no new code (it always shows it, RH-SAF-1)
                 m = p.model
-                setters += [row for ev in INTERNAL_EVENTS for row in rows_for(m.mode, m.phase, ev)
-                            if row.target == osi.mode and row not in setters]
+                opened = [row for ev in INTERNAL_EVENTS for row in rows_for(m.mode, m.phase, ev)
+                          if row.target == osi.mode and row not in setters
+                          and (ev != "violation" or osi.error_state != m.error_state)]
+                # a control left early after it was updated: the restart the update owed (RH-RD-3)
+                if opened:
+                    setters += [row for row in p.refresh if row not in setters]
+                setters += opened
                 rows = setters + [row for row in rows if row not in setters]
+            # a timer due within the report's uncertainty may have run on the vehicle: what it does
+            # is blamed too, last (a release reported a little before the observer's deadline)
+            ahead = []
+            due = p.model.timer()
+            if due is not None and due[0] <= v + tolerance(due[1], slack):
+                t = p.clone()
+                t.model.advance(due[0])
+                t.drain()
+                ahead = [row for row in t.pending if row not in p.pending]
             causes = [c for row in rows for c in row.clauses]
             causes += [c for tt in p.timed for c in tt.row.clauses]
-            released = any("RH-INT-2" in row.clauses for row in p.pending)
+            causes += [c for row in ahead for c in row.clauses]
+            released = any("RH-INT-2" in row.clauses for row in p.pending + ahead)
             if released and "opk" in p.abandoned:
                 causes.insert(0, "RH-INT-3")  # the interrupted park came back: not abandoned
             if released and "queue" in p.abandoned:

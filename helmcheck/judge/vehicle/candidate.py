@@ -15,6 +15,9 @@ A :class:`Candidate` wraps a :class:`~helmcheck.model.vehicle.VehicleModel` (wit
   confirmed release shows whether it was really abandoned (RH-INT-3, RH-OMW-5);
 * ``s_cause`` — the clause whose transition put the vehicle in ``S`` (``$OMSTOP``: RH-MSN-3,
   a primitive timeout from ``S``: RH-PRM-4), for the neutral fins-and-motor check;
+* ``refresh`` — the rows that updated the present remote control (RH-RD-3: set-points replaced,
+  the timeout or countdown restarted, a waypoint appended) since it began: a report that shows
+  the control ended early blames them too (RH-SRV-3);
 * ``refused_locked`` — a command was refused during the lockout; the first ``$OSI`` confirmed
   after the lockout shows it had no effect (RH-SAF-2);
 * ``seen_v`` / ``seen_mode`` / ``seen_at`` / ``locked_v`` — the latest observations that tell a
@@ -74,7 +77,7 @@ class Candidate:
 
     __slots__ = ("model", "events", "story", "extra_v", "window", "pending", "timed", "abandoned",
                  "s_cause", "refused_locked", "seen_v", "seen_mode", "seen_at", "locked_v", "code_unknown",
-                 "_mode", "_phase")
+                 "refresh", "_mode", "_phase")
 
     def __init__(self, model: VehicleModel):
         if model.trace is None:
@@ -88,6 +91,7 @@ class Candidate:
         self.timed: list[Timed] = []
         self.abandoned: set[str] = set()
         self.s_cause = ""
+        self.refresh: tuple[Row, ...] = ()
         self.refused_locked = False
         self.seen_v: Optional[float] = None
         self.seen_mode = ""
@@ -105,7 +109,7 @@ class Candidate:
         c.pending = list(self.pending)
         c.timed = [Timed(**vars(t)) for t in self.timed]
         c.abandoned = set(self.abandoned)
-        c.s_cause, c.refused_locked = self.s_cause, self.refused_locked
+        c.s_cause, c.refused_locked, c.refresh = self.s_cause, self.refused_locked, self.refresh
         c.seen_v, c.seen_mode, c.locked_v = self.seen_v, self.seen_mode, self.locked_v
         c.seen_at = dict(self.seen_at)
         c.code_unknown = self.code_unknown
@@ -156,6 +160,11 @@ class Candidate:
             return
         if row.target != STAY or row.phase_to is not None:
             self.pending.append(row)  # a row that changes nothing visible passes at its ACK
+        if "RH-RD-3" in row.clauses:
+            if row not in self.refresh:
+                self.refresh += (row,)
+        elif row.target not in (STAY, before_mode) or row.phase_to is not None:
+            self.refresh = ()
         ev = row.event
         if ev in ("OMSTOP", "OMSTART", "OJW", "violation"):
             self.abandoned.clear()
