@@ -153,33 +153,38 @@ class Custodian:
             session.stop_on_fail = stop
 
     def _stop(self, session: Any) -> Optional[str]:
-        """``$OMSTOP,0`` (waiting out a lockout) and an ``$OSI`` showing ``S`` after it; why not."""
+        """``$OMSTOP,0`` until an ``$OSI`` after it shows ``S``; why not. A refusal in the lockout
+        (err 26) is waited out, and so is a vehicle that accepts the stop but goes on under remote
+        control until that control times out: at most the longest remote timeout plus one and a
+        half lockouts and a minute of vehicle time."""
         from .flow import CaseStop
 
         p = session.profile
         if "OMSTOP" not in p.commands:
             return "the profile does not claim $OMSTOP"
-        end = session.now() + (p.lockout_s * 1.5 + 60.0) / session.k + 5.0
+        end = session.now() + (p.timeout_range[1] + p.lockout_s * 1.5 + 60.0) / session.k + 5.0
+        why = "no answer"
         while True:
             sent = session.exchange(_frame("OMSTOP,0"))
             if sent is not None and sent.accepted:
-                break
-            if sent is not None and sent.ack is not None and sent.ack.err == 26 and session.now() < end:
-                session.link.sleep(max(0.05, session.poll_gap))
-                continue
-            ack = sent.ack if sent is not None else None
-            return f"$OMSTOP,0 was answered {'nothing' if ack is None else f'$ACK,{ack.type},{ack.status},{ack.err}'}"
-        t = session.now()
-        try:
-            session.poll()
-        except CaseStop:
-            pass  # the report itself is what counts, whatever else was wrong with the answer
-        obs = session.obs
-        if obs.last_osi is None or obs.last_osi_t < t - 1e-6:
-            return "no $OSI came after $OMSTOP,0"
-        if obs.last_osi.mode != "S":
-            return f"after $OMSTOP,0 the vehicle reports {obs.last_osi.mode}"
-        return None
+                t = session.now()
+                try:
+                    session.poll()
+                except CaseStop:
+                    pass  # the report itself is what counts, whatever else was wrong with the answer
+                obs = session.obs
+                if obs.last_osi is not None and obs.last_osi_t >= t - 1e-6 and obs.last_osi.mode == "S":
+                    return None
+                why = ("no $OSI came after $OMSTOP,0" if obs.last_osi is None or obs.last_osi_t < t - 1e-6
+                       else f"after $OMSTOP,0 the vehicle reports {obs.last_osi.mode}")
+            else:
+                ack = sent.ack if sent is not None else None
+                why = f"$OMSTOP,0 was answered {'nothing' if ack is None else f'$ACK,{ack.type},{ack.status},{ack.err}'}"
+                if ack is None or ack.err != 26:
+                    return why
+            if session.now() >= end:
+                return why
+            session.link.sleep(max(0.1, 4 * session.poll_gap))
 
     def _read(self, session: Any, name: str) -> Optional[list[str]]:
         sent = session.exchange(_frame(f"ORWSET,{name},R"))
