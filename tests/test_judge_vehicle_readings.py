@@ -156,6 +156,19 @@ def test_any_answer_to_a_line_that_must_be_discarded_fails_its_discard_clause(tm
     assert verdict(v, clause) == "fail"
 
 
+def test_RH_FRM_6_data_answering_an_overlong_osd_fails_the_discard_not_RH_ACK_5(tmp_path):
+    """A 257-byte $OSD,S the vehicle must discard, answered with its $OSI and $ACK,8: the data is
+    an answer to the discarded line (RH-FRM-6), not a data sentence without a request (RH-ACK-5)."""
+    body = "OSD,S" + "," * (DEFAULT.max_line_bytes + 1 - len("$OSD,S*hh\r\n"))
+    assert len(f"${body}*{checksum_hex(body)}\r\n") == DEFAULT.max_line_bytes + 1
+    rec = start() + [(1.0, ">", body), (1.01, "<", osi(mode="N", dist=150.0)), (1.02, "<", "ACK,8,0,0")]
+    rec += poll(2.0, mode="N", dist=150.0)
+    v = judge(tmp_path, rec)
+    assert verdict(v, "RH-FRM-6") == "fail"
+    assert "answered $OSI" in v["RH-FRM-6"]["reason"]
+    assert verdict(v, "RH-ACK-5") != "fail"
+
+
 def test_RH_OSD_2_a_letter_outside_the_alphabet_is_judged_under_its_own_clause(tmp_path):
     rec = start() + [(1.0, ">", "OSD,Q"), (1.01, "<", "ACK,8,1,27")]
     v = judge(tmp_path, rec)
