@@ -169,6 +169,15 @@ def test_RH_FRM_6_data_answering_an_overlong_osd_fails_the_discard_not_RH_ACK_5(
     assert verdict(v, "RH-ACK-5") != "fail"
 
 
+@pytest.mark.parametrize("compass", ["C90.0,P0.00,R0.00,T20.0,D0.00", "C90.0R0.00P0.00T20.0D0.00"])
+def test_RH_FRM_8_a_compass_sentence_out_of_its_form_fails_RH_FRM_8(tmp_path, compass):
+    """$C with commas, or its letter fields out of order, breaks the $C form of RH-FRM-8."""
+    rec = start() + [(1.0, ">", "OSD,C"), (1.005, "<", compass), (1.01, "<", "ACK,8,0,0")]
+    v = judge(tmp_path, rec)
+    assert verdict(v, "RH-FRM-8") == "fail"
+    assert "$C" in v["RH-FRM-8"]["reason"]
+
+
 def test_RH_OSD_2_a_letter_outside_the_alphabet_is_judged_under_its_own_clause(tmp_path):
     rec = start() + [(1.0, ">", "OSD,Q"), (1.01, "<", "ACK,8,1,27")]
     v = judge(tmp_path, rec)

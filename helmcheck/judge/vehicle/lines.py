@@ -7,7 +7,7 @@ discard silently, with the clause that says so), or nothing because it is the ``
 extension (RH-SAF-5). A command the profile does not claim is an unknown ID (RH-FRM-5).
 
 :class:`OutputJudge` judges every line the vehicle sends on its own (RH-FRM-1/2/3/6/8,
-RH-OUT-1/2/3) into the ledger. Bytes from the vehicle that frame into no sentence cannot be
+RH-OUT-1/2/3) into the ledger; a ``$C`` that does not follow its form fails RH-FRM-8. Bytes from the vehicle that frame into no sentence cannot be
 attributed (line noise looks the same) and are INCONCLUSIVE for RH-FRM-1 — except the same bytes
 before reply after reply (a modem or vehicle prefix), which is an RH-FRM-1 FAIL quoting them.
 """
@@ -119,7 +119,11 @@ class OutputJudge:
         if sent is None:
             err = d.error
             clause = _OUT_CLAUSE.get(err.clause, err.clause) if err is not None else "RH-FRM-1"
-            led.failed(clause, f"the vehicle sent an invalid {d.sentence_id or 'line'}: {err}", [ev], case)
+            why = str(err)
+            if d.sentence_id == "C" and clause == "RH-OUT-2":
+                clause = "RH-FRM-8"  # the $C form is RH-FRM-8's: no commas, letters in order
+                why = f"{err.message} (the form is $C<hdg>P<pitch>R<roll>T<temp>D<depth>, no commas)"
+            led.failed(clause, f"the vehicle sent an invalid {d.sentence_id or 'line'}: {why}", [ev], case)
             return None
         if isinstance(sent, s.Command):
             led.failed("RH-FRM-1", f"the vehicle sent a command sentence ${sent.ID}", [ev], case)
