@@ -15,6 +15,7 @@ import pytest
 
 from helmcheck.conformance.checklog.checker import check_log
 from helmcheck.grammar import checksum_hex
+from helmcheck.grammar.capture import escape
 from helmcheck.profile import DEFAULT
 
 PROFILE = DEFAULT  # no $OXFLT: a violation can only come from the vehicle itself
@@ -176,6 +177,23 @@ def test_RH_FRM_8_a_compass_sentence_out_of_its_form_fails_RH_FRM_8(tmp_path, co
     v = judge(tmp_path, rec)
     assert verdict(v, "RH-FRM-8") == "fail"
     assert "$C" in v["RH-FRM-8"]["reason"]
+
+
+def test_RH_FRM_9_sentences_with_a_parity_bit_fail_RH_FRM_9_not_RH_FRM_1(tmp_path):
+    """A vehicle whose UART is set to 7E1: read as 8N1, bit 7 of each byte is its even parity
+    (CR becomes 0x8D). The sentences under it are fine; the serial settings are not."""
+    def seven_e1(body: str) -> str:
+        line = f"${body}*{checksum_hex(body)}\r\n".encode()
+        return escape(bytes(b | (0x80 if bin(b).count("1") % 2 else 0) for b in line))
+
+    rec = [(0.0, ">", "OSD,S"), (0.01, "<~", seven_e1(osi(mode="S"))), (0.02, "<~", seven_e1("ACK,8,0,0"))]
+    v = judge(tmp_path, rec)
+    assert verdict(v, "RH-FRM-9") == "fail"
+    assert "7E1" in v["RH-FRM-9"]["reason"]
+    assert verdict(v, "RH-FRM-1") != "fail"
+    hit = "$ACK,8,0,0*5D".replace("8", "\\xb8", 1) + "\\r\\n"  # one byte hit by noise: not a UART setting
+    v = judge(tmp_path, [(0.0, ">", "OSD,S"), (0.01, "<", osi(mode="S")), (0.02, "<~", hit)])
+    assert verdict(v, "RH-FRM-9") != "fail"
 
 
 def test_RH_OSD_2_a_letter_outside_the_alphabet_is_judged_under_its_own_clause(tmp_path):
