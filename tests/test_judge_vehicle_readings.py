@@ -123,6 +123,16 @@ def test_RH_OUT_4_a_waypoint_jump_nothing_explains_is_caught(tmp_path):
     assert verdict(v, "RH-OUT-4") == "fail"
 
 
+def test_RH_OUT_4_a_waypoint_then_a_mission_park_between_two_polls_is_adopted(tmp_path):
+    """Between two polls 200 s apart the vehicle reached waypoint 0, went on to waypoint 1 and
+    began its mission park there (not known yet): a conforming sequence, not a FAIL; the park
+    then counts down from what was shown."""
+    rec = start() + poll(200.0, mode="P", wp=1, park=273, dist=2.0) + poll(210.0, mode="P", wp=1, park=263, dist=2.0)
+    v = judge(tmp_path, rec)
+    assert no_fail(v) == []
+    assert verdict(v, "RH-OUT-4") == "pass"
+
+
 def test_RH_INT_1_a_waypoint_reached_just_before_a_takeover_is_accepted(tmp_path):
     """The vehicle reached waypoint 0 unseen just before the $OMS: A with the frozen waypoint 1."""
     rec = start() + [(1.0, ">", "OMS,90,2,20,0.5,10"), (1.01, "<", "ACK,9,0,0")]
