@@ -127,7 +127,8 @@ def test_RH_OUT_4_a_waypoint_then_a_mission_park_between_two_polls_is_adopted(tm
     """Between two polls 200 s apart the vehicle reached waypoint 0, went on to waypoint 1 and
     began its mission park there (not known yet): a conforming sequence, not a FAIL; the park
     then counts down from what was shown."""
-    rec = start() + poll(200.0, mode="P", wp=1, park=273, dist=2.0) + poll(210.0, mode="P", wp=1, park=263, dist=2.0)
+    rec = start() + poll(200.0, mode="P", wp=1, park=273, dist=2.0)
+    rec += poll(210.0, mode="P", wp=1, park=263, dist=2.0)
     v = judge(tmp_path, rec)
     assert no_fail(v) == []
     assert verdict(v, "RH-OUT-4") == "pass"

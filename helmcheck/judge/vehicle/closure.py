@@ -202,8 +202,8 @@ def _park_and_end(c: Candidate, osi: s.OSI, tp: float, gap: float, catalog) -> l
                     return None
                 t.model.plant(WaypointReached(), tp)
             return t
-        out.append(("a mission park (learnt)" if not j else f"{j} mission waypoint(s) reached, then a mission park",
-                    build_p, j + 1, None if j else learn_p))
+        name = "a mission park (learnt)" if not j else f"{j} mission waypoint(s) reached, then a mission park"
+        out.append((name, build_p, j + 1, None if j else learn_p))
     if m.mode == "N" and not entry.park_known(wp):
         if osi.mode == "N" and osi.next_waypoint == wp + 1:
             def learn_0():

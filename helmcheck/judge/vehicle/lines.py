@@ -8,9 +8,10 @@ extension (RH-SAF-5). A command the profile does not claim is an unknown ID (RH-
 
 :class:`OutputJudge` judges every line the vehicle sends on its own (RH-FRM-1/2/3/6/8,
 RH-OUT-1/2/3) into the ledger; a ``$C`` that does not follow its form fails RH-FRM-8, and a line
-that is a sentence with a parity bit in bit 7 of every byte fails RH-FRM-9 (not 8N1). Bytes from the vehicle that frame into no sentence cannot be
-attributed (line noise looks the same) and are INCONCLUSIVE for RH-FRM-1 — except the same bytes
-before reply after reply (a modem or vehicle prefix), which is an RH-FRM-1 FAIL quoting them.
+that is a sentence with a parity bit in bit 7 of every byte fails RH-FRM-9 (not 8N1). Bytes from
+the vehicle that frame into no sentence cannot be attributed (line noise looks the same) and are
+INCONCLUSIVE for RH-FRM-1 — except the same bytes before reply after reply (a modem or vehicle
+prefix), which is an RH-FRM-1 FAIL quoting them.
 """
 
 from __future__ import annotations
@@ -151,7 +152,7 @@ class OutputJudge:
         byte has the same parity over all eight bits, and with bit 7 cleared the line is a valid
         sentence. Line noise does not do that; a UART set to 7 data bits with parity does."""
         raw = d.raw
-        if not any(b & 0x80 for b in raw):
+        if raw.isascii():
             return False
         low = bytes(b & 0x7F for b in raw)
         ones = {bin(b).count("1") % 2 for b in raw}
