@@ -15,6 +15,7 @@ import pytest
 
 from helmcheck.conformance.checklog.checker import check_log
 from helmcheck.grammar import checksum_hex
+from helmcheck.grammar.capture import escape
 from helmcheck.profile import DEFAULT
 
 PROFILE = DEFAULT  # no $OXFLT: a violation can only come from the vehicle itself
@@ -122,6 +123,17 @@ def test_RH_OUT_4_a_waypoint_jump_nothing_explains_is_caught(tmp_path):
     assert verdict(v, "RH-OUT-4") == "fail"
 
 
+def test_RH_OUT_4_a_waypoint_then_a_mission_park_between_two_polls_is_adopted(tmp_path):
+    """Between two polls 200 s apart the vehicle reached waypoint 0, went on to waypoint 1 and
+    began its mission park there (not known yet): a conforming sequence, not a FAIL; the park
+    then counts down from what was shown."""
+    rec = start() + poll(200.0, mode="P", wp=1, park=273, dist=2.0)
+    rec += poll(210.0, mode="P", wp=1, park=263, dist=2.0)
+    v = judge(tmp_path, rec)
+    assert no_fail(v) == []
+    assert verdict(v, "RH-OUT-4") == "pass"
+
+
 def test_RH_INT_1_a_waypoint_reached_just_before_a_takeover_is_accepted(tmp_path):
     """The vehicle reached waypoint 0 unseen just before the $OMS: A with the frozen waypoint 1."""
     rec = start() + [(1.0, ">", "OMS,90,2,20,0.5,10"), (1.01, "<", "ACK,9,0,0")]
@@ -154,6 +166,45 @@ def test_any_answer_to_a_line_that_must_be_discarded_fails_its_discard_clause(tm
     rec = start() + [(1.0, ">", line), (1.01, "<", "ACK,1,1,28")] + poll(2.0, mode="N", dist=150.0)
     v = judge(tmp_path, rec)
     assert verdict(v, clause) == "fail"
+
+
+def test_RH_FRM_6_data_answering_an_overlong_osd_fails_the_discard_not_RH_ACK_5(tmp_path):
+    """A 257-byte $OSD,S the vehicle must discard, answered with its $OSI and $ACK,8: the data is
+    an answer to the discarded line (RH-FRM-6), not a data sentence without a request (RH-ACK-5)."""
+    body = "OSD,S" + "," * (DEFAULT.max_line_bytes + 1 - len("$OSD,S*hh\r\n"))
+    assert len(f"${body}*{checksum_hex(body)}\r\n") == DEFAULT.max_line_bytes + 1
+    rec = start() + [(1.0, ">", body), (1.01, "<", osi(mode="N", dist=150.0)), (1.02, "<", "ACK,8,0,0")]
+    rec += poll(2.0, mode="N", dist=150.0)
+    v = judge(tmp_path, rec)
+    assert verdict(v, "RH-FRM-6") == "fail"
+    assert "answered $OSI" in v["RH-FRM-6"]["reason"]
+    assert verdict(v, "RH-ACK-5") != "fail"
+
+
+@pytest.mark.parametrize("compass", ["C90.0,P0.00,R0.00,T20.0,D0.00", "C90.0R0.00P0.00T20.0D0.00"])
+def test_RH_FRM_8_a_compass_sentence_out_of_its_form_fails_RH_FRM_8(tmp_path, compass):
+    """$C with commas, or its letter fields out of order, breaks the $C form of RH-FRM-8."""
+    rec = start() + [(1.0, ">", "OSD,C"), (1.005, "<", compass), (1.01, "<", "ACK,8,0,0")]
+    v = judge(tmp_path, rec)
+    assert verdict(v, "RH-FRM-8") == "fail"
+    assert "$C" in v["RH-FRM-8"]["reason"]
+
+
+def test_RH_FRM_9_sentences_with_a_parity_bit_fail_RH_FRM_9_not_RH_FRM_1(tmp_path):
+    """A vehicle whose UART is set to 7E1: read as 8N1, bit 7 of each byte is its even parity
+    (CR becomes 0x8D). The sentences under it are fine; the serial settings are not."""
+    def seven_e1(body: str) -> str:
+        line = f"${body}*{checksum_hex(body)}\r\n".encode()
+        return escape(bytes(b | (0x80 if bin(b).count("1") % 2 else 0) for b in line))
+
+    rec = [(0.0, ">", "OSD,S"), (0.01, "<~", seven_e1(osi(mode="S"))), (0.02, "<~", seven_e1("ACK,8,0,0"))]
+    v = judge(tmp_path, rec)
+    assert verdict(v, "RH-FRM-9") == "fail"
+    assert "7E1" in v["RH-FRM-9"]["reason"]
+    assert verdict(v, "RH-FRM-1") != "fail"
+    hit = "$ACK,8,0,0*5D".replace("8", "\\xb8", 1) + "\\r\\n"  # one byte hit by noise: not a UART setting
+    v = judge(tmp_path, [(0.0, ">", "OSD,S"), (0.01, "<", osi(mode="S")), (0.02, "<~", hit)])
+    assert verdict(v, "RH-FRM-9") != "fail"
 
 
 def test_RH_OSD_2_a_letter_outside_the_alphabet_is_judged_under_its_own_clause(tmp_path):

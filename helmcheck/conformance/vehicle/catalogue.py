@@ -110,8 +110,9 @@ CASES: tuple[Case, ...] = (
        "each letter the profile serves returns its sentence, in the order requested", "S",
        Send("OSD,I,T,D,Y,P,S,C,G")),
     _c("V-19", "RH-OUT-3", "Numeric fields within physical ranges",
-       "headings [0,360), pitch/roll [-90,90], positions, percent, speeds ≥ 0 in every sentence", "N",
-       Send("OSD,G,C,S,P,Y,D,T,I"), Wait(20.0)),
+       "headings [0,360), pitch/roll [-90,90], positions, percent, speeds ≥ 0 in every sentence, "
+       "at the start and again under way 20 s later", "N",
+       Send("OSD,G,C,S,P,Y,D,T,I"), Wait(20.0), Send("OSD,G,C,S,P,Y,D,T,I")),
     _c("V-20", "RH-OUT-4", "$OSI agrees with the model over time",
        "mode, next waypoint, park time and error state match the model within tolerance", "N",
        Wait(40.0)),

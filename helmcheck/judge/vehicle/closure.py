@@ -19,7 +19,8 @@ the candidate's mode, and keeps the first that explains the ``$OSI``:
                        with ``surface`` after it when the window also covers the lockout
 ``waypoint`` ×n        mode ``N``: the next mission waypoint(s) reached, up to
                        :data:`MAX_WAYPOINTS` (legs of any length)
-``mission park``       a mission park at a waypoint whose park time is not known yet (learnt)
+``mission park``       a mission park at a waypoint whose park time is not known yet, maybe
+                       after waypoints passed (learnt when none passed)
 ``mission end``        ``S`` where only the end of a mission of unknown length explains it
 ``on station``         ``mP``: the ``$OPK`` countdown starts; ``W``: the queued waypoint is
                        reached (×n for the queue)
@@ -183,19 +184,28 @@ def _park_and_end(c: Candidate, osi: s.OSI, tp: float, gap: float, catalog) -> l
             if getattr(tm, attr) is run:
                 setattr(tm, attr, mission)
 
+    at, j = osi.next_waypoint, osi.next_waypoint - wp
+    if (m.mode == "N" and osi.mode == "P" and 0 <= j < MAX_WAYPOINTS and not entry.park_known(at)
+            and (run.is_open or at <= run.last)):
+        # the park at the report's waypoint, reached after j waypoints passed (RH-OUT-4, RH-RD-5);
+        # its length is learnt only when nothing but the park fills the window (j = 0): after
+        # travel, the window bounds when it ends (what this candidate uses), not how long it is
+        seconds = osi.park_time + gap
+
+        def learn_p():
+            entry.learn_park(at, seconds)
+
+        def build_p(t: Candidate) -> Optional[Candidate]:
+            swap(t, _with_park(run, at, seconds))
+            for _ in range(j + 1):
+                if t.model.mode != "N":
+                    return None
+                t.model.plant(WaypointReached(), tp)
+            return t
+        name = "a mission park (learnt)" if not j else f"{j} mission waypoint(s) reached, then a mission park"
+        out.append((name, build_p, j + 1, None if j else learn_p))
     if m.mode == "N" and not entry.park_known(wp):
-        if osi.mode == "P" and osi.next_waypoint == wp:
-            seconds = osi.park_time + gap
-
-            def learn_p():
-                entry.learn_park(wp, seconds)
-
-            def build_p(t: Candidate) -> Candidate:
-                swap(t, _with_park(run, wp, seconds))
-                t.model.plant(WaypointReached(wp), tp)
-                return t
-            out.append(("a mission park (learnt)", build_p, 1, learn_p))
-        elif osi.mode == "N" and osi.next_waypoint == wp + 1:
+        if osi.mode == "N" and osi.next_waypoint == wp + 1:
             def learn_0():
                 entry.learn_park(wp, 0.0)
 

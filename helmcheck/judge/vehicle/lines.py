@@ -7,9 +7,11 @@ discard silently, with the clause that says so), or nothing because it is the ``
 extension (RH-SAF-5). A command the profile does not claim is an unknown ID (RH-FRM-5).
 
 :class:`OutputJudge` judges every line the vehicle sends on its own (RH-FRM-1/2/3/6/8,
-RH-OUT-1/2/3) into the ledger. Bytes from the vehicle that frame into no sentence cannot be
-attributed (line noise looks the same) and are INCONCLUSIVE for RH-FRM-1 — except the same bytes
-before reply after reply (a modem or vehicle prefix), which is an RH-FRM-1 FAIL quoting them.
+RH-OUT-1/2/3) into the ledger; a ``$C`` that does not follow its form fails RH-FRM-8, and a line
+that is a sentence with a parity bit in bit 7 of every byte fails RH-FRM-9 (not 8N1). Bytes from
+the vehicle that frame into no sentence cannot be attributed (line noise looks the same) and are
+INCONCLUSIVE for RH-FRM-1 — except the same bytes before reply after reply (a modem or vehicle
+prefix), which is an RH-FRM-1 FAIL quoting them.
 """
 
 from __future__ import annotations
@@ -18,7 +20,7 @@ import re
 from dataclasses import dataclass
 from typing import Optional
 
-from ...grammar import Decoded
+from ...grammar import Decoded, decode
 from ...grammar import sentences as s
 from ...grammar.capture import escape
 from ...grammar.errors import SentenceError
@@ -110,6 +112,8 @@ class OutputJudge:
         """Judge one vehicle line; returns the sentence when it is valid."""
         led = self.ledger
         self._prefix(ev, case)
+        if self._parity(d, ev, case):
+            return None
         if d.terminator != "\r\n":
             led.failed("RH-FRM-1", "the vehicle ended a sentence without CR LF", [ev], case)
         for f in d.findings:
@@ -119,7 +123,11 @@ class OutputJudge:
         if sent is None:
             err = d.error
             clause = _OUT_CLAUSE.get(err.clause, err.clause) if err is not None else "RH-FRM-1"
-            led.failed(clause, f"the vehicle sent an invalid {d.sentence_id or 'line'}: {err}", [ev], case)
+            why = str(err)
+            if d.sentence_id == "C" and clause == "RH-OUT-2":
+                clause = "RH-FRM-8"  # the $C form is RH-FRM-8's: no commas, letters in order
+                why = f"{err.message} (the form is $C<hdg>P<pitch>R<roll>T<temp>D<depth>, no commas)"
+            led.failed(clause, f"the vehicle sent an invalid {d.sentence_id or 'line'}: {why}", [ev], case)
             return None
         if isinstance(sent, s.Command):
             led.failed("RH-FRM-1", f"the vehicle sent a command sentence ${sent.ID}", [ev], case)
@@ -138,6 +146,23 @@ class OutputJudge:
             if isinstance(sent, s.Compass):
                 led.passed("RH-FRM-8", "$C has no commas", [ev], case)
         return sent
+
+    def _parity(self, d: Decoded, ev: Evidence, case: str) -> bool:
+        """RH-FRM-9: a line whose bytes carry a parity bit in bit 7 (7E1 or 7O1 read as 8N1): every
+        byte has the same parity over all eight bits, and with bit 7 cleared the line is a valid
+        sentence. Line noise does not do that; a UART set to 7 data bits with parity does."""
+        raw = d.raw
+        if raw.isascii():
+            return False
+        low = bytes(b & 0x7F for b in raw)
+        ones = {bin(b).count("1") % 2 for b in raw}
+        if len(ones) != 1 or not decode(low, self.profile).valid:
+            return False
+        kind = "odd" if ones == {1} else "even"
+        self.ledger.failed("RH-FRM-9", f"bit 7 of every byte is the {kind} parity of the other seven: the "
+                                       f"vehicle sends 7{kind[0].upper()}1, not 8N1 (bit 7 cleared, the line "
+                                       f"reads {escape(low.rstrip(bytes((13, 10))))[:80]})", [ev], case)
+        return True
 
     def _prefix(self, ev: Evidence, case: str) -> None:
         """RH-FRM-1: the same bytes before reply after reply are the vehicle's (or a modem's)."""

@@ -292,6 +292,14 @@ class VehicleObserver(Answers):
         if p is not None:
             self._processed(p, t)
         if p is None:
+            q = next((q for q in reversed(self.silent) if q.kind.kind == "discard" and q.kind.would_be == 8), None)
+            if q is not None:  # RH-FRM-2/4/5/6/7: the data answers an $OSD line it must discard
+                if q.state == "silent":
+                    q.state = "answered-discard"
+                    self.book("fail", (q.kind.clause,), f"{text_of(q)} must be discarded silently "
+                                                        f"({q.kind.clause}); the vehicle answered ${cls}",
+                              [q.ev, evd], at=q)
+                return
             last = self.last_osd
             if self.first_command_t is None:
                 self.ledger.inconclusive("RH-ACK-5", "a data sentence before the first command of the "
@@ -332,7 +340,7 @@ class VehicleObserver(Answers):
     def _silence_kept(self, q: Sent) -> None:
         """RH-FRM-2/4/5/6/7: no answer within the window — passed once the vehicle is seen to be
         listening (it answers something after the line)."""
-        if q.kind.kind == "oxflt":
+        if q.kind.kind == "oxflt" or q.state == "answered-discard":
             return
         if self.alive_t is not None and self.alive_t >= q.t:
             self.ledger.passed(q.kind.clause, f"{text_of(q)} was discarded silently ({q.kind.clause})",
