@@ -27,7 +27,8 @@ HERE = Path(__file__).resolve().parent
 PY = shlex.quote(sys.executable)
 GOOD = shlex.quote(str(HERE / "backseats" / "good_backseat.py"))
 FAULTY = shlex.quote(str(HERE / "backseats" / "faulty_backseat.py"))
-EMU_TOML = 'fault_injection = "oxflt"\nbaud = 115200\ntime_scale = 25.0\n'
+EMU_TOML = ('fault_injection = "oxflt"\nbaud = 115200\ntime_scale = 25.0\n'
+            'end_mission = "short.mis"\nsrp_mission = "srp.mis"\n')  # the emulator's missions
 VEHICLE_IDS = [c.id for c in vehicle_clauses()]
 BACKSEAT_IDS = [c.id for c in backseat_clauses()]
 
