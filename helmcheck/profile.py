@@ -46,7 +46,7 @@ from typing import Any
 
 __all__ = ["Profile", "BenchSafety", "ProfileError", "load_profile", "profile_from_dict", "DEFAULT", "PROTOCOLS",
            "OSI_FIELD_RANGE", "COMMAND_IDS", "SAFETY_CODES", "emulator_profile", "EMULATOR_PROFILE",
-           "profile_keys"]
+           "profile_keys", "key_rule"]
 
 PROTOCOLS = ("rh5", "rh4", "rh3", "paper")
 #: Allowed $OSI field counts per protocol (RH-OUT-1; public-evidence §2.2.1).
@@ -99,7 +99,7 @@ class Profile:
     documentation (:func:`_key`)."""
 
     protocol: str = _key("rh5", "protocol generation the vehicle speaks", group="protocol", clause="RH-OUT-1")
-    depth_unit: str = _key("m", "depth unit of the vehicle's sentences (rh4 and older: ft)", group="protocol",
+    depth_unit: str = _key("m", "depth unit of the vehicle's sentences; rh4 and older: ft", group="protocol",
                            clause="§4")
     ack_window_s: float = _key(1.0, "wall seconds within which every $ACK must come", group="protocol",
                                clause="RH-ACK-2")
@@ -109,10 +109,10 @@ class Profile:
                                           group="protocol", clause="RH-SRV-2, RH-PRM-2, RH-DVL-1")
     max_depth_m: float = _key(100.0, "the vehicle's depth ceiling, metres", group="protocol", clause="RH-SRV-2")
     max_speed_kn: float = _key(4.5, "the vehicle's speed ceiling, knots", group="protocol", clause="RH-SRV-2")
-    osi_fields: int = _key(21, "$OSI field count (rh5: 21; rh4/rh3/paper: 11-17)", group="protocol",
+    osi_fields: int = _key(21, "$OSI field count: rh5 21, rh4/rh3/paper 11 to 17", group="protocol",
                            clause="RH-OUT-1")
-    osd_letters: str = _key("GCSPYDTI", "the $OSD letters the vehicle serves (G gives $GPRMC, also read to "
-                            "check the time scale)", group="protocol", clause="RH-OSD-1, RH-OSD-2",
+    osd_letters: str = _key("GCSPYDTI", "the $OSD letters the vehicle serves; G gives $GPRMC, whose time is "
+                            "also read to check the time scale", group="protocol", clause="RH-OSD-1, RH-OSD-2",
                             fill="leave out the letters of sensors the vehicle lacks")
     commands: tuple[str, ...] = _key(COMMAND_IDS, "the commands the vehicle claims; one left out is an "
                                      "unknown ID to it", group="protocol", clause="RH-FRM-5",
@@ -122,22 +122,24 @@ class Profile:
                         fill="the name of the test mission on the vehicle")
     mission_waypoints: int = _key(4, "waypoints in the test mission", group="missions", clause="§10",
                                   fill="the test mission's waypoint count")
-    fault_injection: str = _key("none", "oxflt: the vehicle accepts the $OXFLT test extension, which raises a "
-                                "safety violation at once", group="safety", clause="RH-SAF-5")
+    fault_injection: str = _key("none", "whether the vehicle accepts the $OXFLT test extension (oxflt), which "
+                                "raises a safety violation at once", group="safety", clause="RH-SAF-5")
     violation_trigger: str = _key("", "how the tester gets a safety violation to judge §7: none (§7 NOT-TESTED), "
                                   "oxflt (needs fault_injection = \"oxflt\"), mission-rule (violation_mission trips "
                                   "its own rule violation_after_s after its start), operator (someone trips a "
                                   "sensor on the bench); left out: oxflt with fault_injection = \"oxflt\", else none",
                                   group="safety", clause="RH-SAF-5", real="none")
-    violation_mission: str = _key("", "mission-rule: a mission on the vehicle whose own safety rule trips",
+    violation_mission: str = _key("", "for violation_trigger mission-rule: a mission on the vehicle whose own "
+                                  "safety rule trips",
                                   group="safety", clause="RH-SAF-5")
-    violation_after_s: float = _key(0.0, "mission-rule: vehicle seconds after its start at which the rule trips",
+    violation_after_s: float = _key(0.0, "for violation_trigger mission-rule: vehicle seconds after the start of "
+                                    "violation_mission at which its rule trips",
                                     group="safety", clause="RH-SAF-5")
     reaction_s: float = _key(0.25, "backseat judging: time a backseat gets to act on a state report",
                              group="backseat", clause="RH-BS-3, RH-BS-5")
-    time_scale: float = _key(1.0, "how many times faster than wall time the vehicle's clock runs (>1 only "
-                             "for emulators; --time-scale overrides it)", group="link", clause="RH-TIM-2")
-    baud: int = _key(19200, "line rate, 8N1 (--baud overrides it)", group="link", clause="RH-FRM-9",
+    time_scale: float = _key(1.0, "how many times faster than wall time the vehicle's clock runs: above 1 "
+                             "only for emulators; --time-scale overrides it", group="link", clause="RH-TIM-2")
+    baud: int = _key(19200, "line rate, 8N1; --baud overrides it", group="link", clause="RH-FRM-9",
                      fill="the serial line's baud rate")
     bench_safety: BenchSafety = _key(doc="enforced by the tester while the vehicle is out of the water",
                                      group="safety", factory=BenchSafety)
@@ -145,7 +147,7 @@ class Profile:
     max_line_bytes: int = _key(256, "longest line, bytes, CR LF included", group="protocol", clause="RH-FRM-6")
     lowercase_checksum_in: bool = _key(True, "the vehicle accepts lower-case checksum hex", group="protocol",
                                        clause="RH-FRM-3")
-    waypoint_base: int = _key(0, "number of the first waypoint (0 or 1)", group="protocol", clause="RH-JW-1")
+    waypoint_base: int = _key(0, "number of the first waypoint", group="protocol", clause="RH-JW-1")
     omw_clear_keywords: tuple[str, ...] = _key(("Clr", "CLEAR", "STOP"), "$OMW keywords that clear the queue",
                                                group="protocol", clause="RH-OMW-3, RH-RD-4")
     safety_action: str = _key("park", "the vehicle's SafetyAction setting at the surface after a violation",
@@ -213,6 +215,37 @@ _AT_MOST = {"ack_window_s": 60.0, "lockout_s": 3600.0, "time_scale": 1000.0, "ma
             "opk_max_distance_m": 100000.0, "violation_after_s": 86400.0, "max_line_bytes": 65536,
             "mission_waypoints": 100000, "osi_fields": 64}
 _BAUDS = (9600, 19200, 38400, 57600, 115200)
+
+
+def key_rule(key: str) -> str:
+    """The values ``key`` (``bench_safety.max_motor_byte`` for the table's) may take, in words,
+    from the same tables :func:`profile_from_dict` checks them with (for documentation)."""
+    name = key.rpartition(".")[2]
+    if key in _CHOICES:
+        return "one of " + " | ".join(repr(c).replace("'", '"') for c in _CHOICES[key] if c)
+    if key == "baud":
+        return "one of " + " | ".join(map(str, _BAUDS))
+    if key == "waypoint_base":
+        return "0 or 1"
+    if key == "osd_letters":
+        return "letters of GCSPYDTI"
+    if key == "commands":
+        return "any of " + ", ".join(COMMAND_IDS)
+    if key == "timeout_range":
+        return "[low, high] integers, 0 <= low <= high"
+    if key == "bench_safety.max_motor_byte":
+        return "0x00..0xFF"
+    low = {"max_line_bytes": "at least 16", "mission_waypoints": "at least 1"}.get(key)
+    if low is None:
+        owner = BenchSafety if key.startswith("bench_safety.") else Profile
+        default = next((f.default for f in dataclasses.fields(owner) if f.name == name), None)
+        number = isinstance(default, (int, float)) and not isinstance(default, bool)
+        low = "> 0" if name in _POSITIVE else (">= 0" if number else "")
+    limit = _AT_MOST.get(key)
+    parts = [low] if low else []
+    if limit is not None:
+        parts.append(f"at most {limit:g}")
+    return ", ".join(parts)
 
 
 def _check(where: str, key: str, value: Any, default: Any) -> Any:
