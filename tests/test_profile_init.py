@@ -159,3 +159,15 @@ def test_init_emulator_is_the_emulators_profile_with_every_key(tmp_path, capsys)
     text = path.read_text()
     assert "FILL IN" not in text
     assert load_profile(path).replace(name="x") == emulator_profile().replace(name="x")
+
+
+def test_the_readme_profiles_table_names_every_key():
+    """The README's table of keys is the one hand-written list: it must not drift either."""
+    from pathlib import Path
+
+    readme = (Path(__file__).resolve().parents[1] / "README.md").read_text(encoding="utf-8")
+    section = readme.split("\n## Profiles\n", 1)[1].split("\n## ", 1)[0]
+    rows = "\n".join(ln for ln in section.splitlines() if ln.startswith("| `"))
+    missing = [f.name for f in [*profile_keys(), *dataclasses.fields(BenchSafety)] 
+               if f"`{f.name}`" not in rows and f"`[{f.name}]`" not in rows]
+    assert not missing, f"README.md, Profiles table: no row for {missing}"
