@@ -122,7 +122,7 @@ def test_the_settings_record_the_interval():
     assert json.loads(json.dumps(s)) == s
 
 
-@settings(max_examples=300, deadline=None)
+@settings(max_examples=150, deadline=None)
 @given(rate=st.floats(0.05, 1000.0), step=st.sampled_from([0.001, 0.01, 0.1, 1.0, 2.0]),
        stale=st.floats(0.0, 1.0), n=st.integers(2, 40), start=st.floats(0.0, 80000.0),
        gaps=st.lists(st.floats(0.001, 0.3), min_size=40, max_size=40),
