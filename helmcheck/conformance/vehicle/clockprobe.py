@@ -34,7 +34,8 @@ from .session import frame
 
 __all__ = ["check_clock", "ClockMismatch", "MAX_WALL_S", "GAP_S"]
 
-#: Wall seconds the check may spend at most (it usually decides much sooner).
+#: Wall seconds the check may spend reading (it usually decides much sooner); the last answer
+#: is awaited 0.5 s more at most.
 MAX_WALL_S = 2.0
 #: Wall seconds from one request to the next, at least.
 GAP_S = 0.05
@@ -50,10 +51,11 @@ class ClockMismatch(Exception):
         self.check = check
 
 
-def _reading(link, profile) -> tuple[Optional[Sample], str]:
-    """One ``$OSD,G``: the sample, or why there is none (waits for its ``$ACK`` or the window)."""
+def _reading(link, profile, hard_end: float) -> tuple[Optional[Sample], str]:
+    """One ``$OSD,G``: the sample, or why there is none (waits for its ``$ACK`` or the window,
+    never past ``hard_end``)."""
     sent = link.send(frame("OSD,G"))
-    end = sent + profile.ack_window_s + 0.5
+    end = min(sent + profile.ack_window_s + 0.5, hard_end)
     got: Optional[Sample] = None
     why = "no answer to $OSD,G"
     while True:
@@ -92,10 +94,11 @@ def measure_clock(link, profile, declared: float, max_wall_s: float = MAX_WALL_S
     samples: list[Sample] = []
     misses, why = 0, ""
     start = link.now()
+    hard_end = start + max_wall_s + 0.5  # the last reading's answer may come this late
     check: Optional[ClockCheck] = None
     while link.now() - start < max_wall_s:
         t0 = link.now()
-        got, why = _reading(link, profile)
+        got, why = _reading(link, profile, hard_end)
         if got is None:
             misses += 1
             if misses >= MISSES:
@@ -120,6 +123,7 @@ def check_clock(run, enabled: bool = True) -> ClockCheck:
     :class:`ClockMismatch` when the run must stop."""
     if enabled:
         check = measure_clock(run.link, run.p, run.k)
+        run.link.drain()  # an answer the check stopped waiting for is not left to the first case
     else:
         check = not_measured(run.k, "the check was turned off (--no-clock-check)")
     run.link.note(check.note())

@@ -13,10 +13,15 @@ start-up time-scale check (:mod:`.clockprobe` drives the wire):
 first byte) answered by a ``$GPRMC`` read at ``recv`` (stamped after its last): the vehicle
 read its clock at some instant in ``[sent, recv]`` and wrote time ``T``. A vehicle may write its
 time in steps (the resolution of the text, or a clock that only moves when a GPS fix arrives),
-so ``T`` is the true time to within one step ``q``; ``q`` is taken as the larger of the text's
-resolution and the largest step seen between two successive different readings (every change
-of a stepped clock is at least one step). From the first sample (1) and the last (n), with
-``dT = T_n - T_1``::
+so ``T`` is the true time to within one step ``q``. Every change of a stepped clock is at least
+one step, so ``q`` is the larger of the text's resolution and:
+
+* the largest change between two successive readings, when some successive readings are equal
+  (a clock seen to stand still moves in steps of its own, maybe irregular ones);
+* the smallest change, when every reading moved (the steps are no coarser than that: this keeps
+  the interval narrow when the host is slow to read, and readings are far apart).
+
+From the first sample (1) and the last (n), with ``dT = T_n - T_1``::
 
     rate >= max(0, dT - q) / (recv_n - sent_1)
     rate <= (dT + q) / (sent_n - recv_1)          (unbounded when sent_n <= recv_1)
@@ -83,6 +88,7 @@ class Rate:
         return _nice(self.lo, self.hi)
 
     def text(self) -> str:
+        """``×19.6–×20.4``: the interval."""
         hi = "∞" if math.isinf(self.hi) else f"×{_g(self.hi)}"
         return f"×{_g(self.lo)}–{hi}"
 
@@ -159,10 +165,13 @@ def _nice(lo: float, hi: float) -> Optional[float]:
 
 
 def rate_text(r: Rate) -> str:
-    """``×20`` when the interval is narrow, ``between ×0.5 and ×1.5``, or ``at most ×2.5``."""
+    """``×20`` when the interval is narrow; ``about ×19`` (its central estimate) when the
+    interval is bounded but wider; ``at most ×2.5`` or ``at least ×3`` when one side is open."""
     nice = _nice(r.lo, r.hi)
     if nice is not None:
         return f"×{_g(nice)}"
+    if r.lo > 0 and math.isfinite(r.hi) and r.lo <= r.central <= r.hi:
+        return f"about ×{_g(r.central)}"
     if r.lo <= 0:
         return "faster than any bound" if math.isinf(r.hi) else f"at most ×{_g(r.hi)}"
     if math.isinf(r.hi):
@@ -220,7 +229,8 @@ def measure(samples: Sequence[Sample]) -> Rate | str:
     if not moved:
         return (f"the vehicle's time did not change in {last.recv - first.sent:.2f} s "
                 f"({len(samples)} readings; a time held from the last fix?)")
-    q = max([s.resolution for s in samples] + moved)
+    stood_still = len(moved) < len(steps)
+    q = max([s.resolution for s in samples] + [max(moved) if stood_still else min(moved)])
     dt = times[-1] - times[0]
     outer = last.recv - first.sent
     inner = last.sent - first.recv
