@@ -41,6 +41,8 @@ MAX_WALL_S = 2.0
 GAP_S = 0.05
 #: Requests in a row that may go unanswered before the check gives up.
 MISSES = 2
+#: Wall seconds a reading waits for the ``$ACK`` once its ``$GPRMC`` is in.
+ACK_AFTER_S = 0.25
 
 
 class ClockMismatch(Exception):
@@ -52,8 +54,10 @@ class ClockMismatch(Exception):
 
 
 def _reading(link, profile, hard_end: float) -> tuple[Optional[Sample], str]:
-    """One ``$OSD,G``: the sample, or why there is none (waits for its ``$ACK`` or the window,
-    never past ``hard_end``)."""
+    """One ``$OSD,G``: the sample, or why there is none. Waits for its ``$ACK`` or the ACK
+    window, never past ``hard_end``, and at most :data:`ACK_AFTER_S` after the ``$GPRMC`` (a
+    vehicle that does not acknowledge ``$OSD`` is still read at the pace of its data)."""
+    link.drain()  # a late answer to the previous request is not taken for this one's
     sent = link.send(frame("OSD,G"))
     end = min(sent + profile.ack_window_s + 0.5, hard_end)
     got: Optional[Sample] = None
@@ -71,6 +75,7 @@ def _reading(link, profile, hard_end: float) -> tuple[Optional[Sample], str]:
                 why = f"the $GPRMC carries no time ({sentence.time!r})"
             else:
                 got = Sample(sent, rx.t, clock[0], clock[1])
+                end = min(end, rx.t + ACK_AFTER_S)
         elif isinstance(sentence, s.ACK) and sentence.type == 8:
             if got is None and why == "no answer to $OSD,G":
                 why = "$OSD,G was answered without a $GPRMC"
