@@ -4,9 +4,9 @@
 that something answers (a link that carries nothing, or only garbage, is INCONCLUSIVE with the
 reason), checks that the vehicle's clock runs at the declared time scale (:mod:`.clockprobe`: a
 clear mismatch stops the run INCONCLUSIVE, naming both rates), runs the selected clause cases
-in order (:mod:`.interpreter`), then the hypothesis exploration (:mod:`.explore`), and writes ``DIR/results.json`` after every case — atomically, so a
-crash or Ctrl-C leaves a valid partial report marked ``partial`` — plus ``DIR/wire.log`` and, at
-the end, every report format.
+in order (:mod:`.interpreter`), then the hypothesis exploration (:mod:`.explore`), and writes
+``DIR/results.json`` after every case — atomically, so a crash or Ctrl-C leaves a valid partial
+report marked ``partial`` — plus ``DIR/wire.log`` and, at the end, every report format.
 
 Every byte and note goes through one :class:`~helmcheck.conformance.recorder.Recorder`: to the
 wire log and to the one vehicle observer (:class:`~helmcheck.judge.vehicle.VehicleObserver`),
