@@ -26,11 +26,11 @@ sys.path.insert(0, str(ROOT))
 
 from helmcheck.conformance.emulator.process import EmulatorProcess  # noqa: E402
 from helmcheck.conformance.vehicle.runner import Options, certify  # noqa: E402
-from helmcheck.profile import DEFAULT  # noqa: E402
+from helmcheck.profile import emulator_profile  # noqa: E402
 
 
 def full_run(k: float, examples) -> dict:
-    profile = DEFAULT.replace(fault_injection="oxflt", baud=115200, time_scale=k)
+    profile = emulator_profile().replace(baud=115200, time_scale=k)
     with tempfile.TemporaryDirectory() as d, EmulatorProcess(time_scale=k, baud=115200) as emu:
         t0 = time.monotonic()
         out = certify(Options(port=emu.port, profile=profile, time_scale=k, report_dir=Path(d),

@@ -43,6 +43,7 @@ SUBCOMMANDS = {
     "matrix": ("helmcheck.commands.matrix_cmd", "one overview of several runs: clauses x implementations"),
     "verify": ("helmcheck.commands.verify_cmd", "check a results directory against its evidence and signature"),
     "keygen": ("helmcheck.commands.keygen_cmd", "make an Ed25519 key pair for signing results"),
+    "profile": ("helmcheck.commands.profile_cmd", "write a commented profile for a vehicle to fill in"),
     "docs": ("helmcheck.commands.docs_cmd", "regenerate the generated documentation"),
 }
 
@@ -61,6 +62,7 @@ Typical use:
   helmcheck matrix out/a out/b --out out/          # several runs side by side, clause by clause
   helmcheck verify reports/demo                    # re-judge the wire log; check the signature
   helmcheck parse wire.log                         # validate a capture line by line
+  helmcheck profile init iver3.toml                # a commented profile for a vehicle to fill in
 
 Exit codes: 0 conformant, 1 non-conformant, 2 inconclusive or tester error, 64 usage error.
 Run 'helmcheck COMMAND --help' for each command's options.

@@ -1,9 +1,10 @@
 """``make demo``: certify the built-in emulator end to end and write every report format.
 
-Starts ``helmcheck emulate`` on a pty at time scale 40 as a subprocess (the profile declares the
-``$OXFLT`` test extension the emulator honours, so the lockout clauses are judged too), runs
-``helmcheck certify vehicle`` against it, writes ``reports/demo/{results.json, wire.log,
-report.html, junit.xml, report.md}``, stops the emulator, and prints the one-line verdict and
+Starts ``helmcheck emulate`` on a pty at time scale 40 as a subprocess, runs
+``helmcheck certify vehicle`` against it with the emulator's own profile
+(``helmcheck/profiles/emulator.toml``: the ``$OXFLT`` test extension, so the lockout clauses
+are judged too, and the missions it ships for RH-MSN-4 and the SRP branch of RH-SAF-4), writes
+``reports/demo/{results.json, wire.log, report.html, junit.xml, report.md}``, stops the emulator, and prints the one-line verdict and
 the report's path. Exit status is the certification's.
 """
 
@@ -15,7 +16,7 @@ from pathlib import Path
 
 from .conformance.emulator.process import EmulatorProcess
 from .conformance.vehicle.runner import Options, certify
-from .profile import DEFAULT
+from .profile import EMULATOR_PROFILE, emulator_profile
 
 TIME_SCALE = 40.0
 BAUD = 115200
@@ -26,7 +27,7 @@ def main(argv: list[str] | None = None) -> int:
     if out.exists():
         shutil.rmtree(out)
     out.mkdir(parents=True)
-    profile = DEFAULT.replace(fault_injection="oxflt", baud=BAUD, time_scale=TIME_SCALE)
+    profile = emulator_profile().replace(baud=BAUD, time_scale=TIME_SCALE)
     print(f"demo: starting the reference emulator on a pty (time scale {TIME_SCALE:g}, {BAUD} baud)…",
           flush=True)
     emu = EmulatorProcess(["--log", str(out / "emulator-wire.log")], time_scale=TIME_SCALE, baud=BAUD)
@@ -36,7 +37,8 @@ def main(argv: list[str] | None = None) -> int:
         res = certify(Options(port=emu.port, profile=profile, time_scale=TIME_SCALE, report_dir=out,
                               examples=10, seed=1, progress=sys.stderr.isatty(),
                               command=f"helmcheck certify vehicle --port {emu.port} --time-scale {TIME_SCALE:g} "
-                                      f"--baud {BAUD} --examples 10 --seed 1 --report-dir {out}"))
+                                      f"--baud {BAUD} --profile helmcheck/{EMULATOR_PROFILE} --examples 10 --seed 1 "
+                                      f"--report-dir {out}"))
     finally:
         emu.stop()
     print(f"{res.verdict.upper()}: {res.reason}")

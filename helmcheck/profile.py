@@ -5,7 +5,10 @@ never a constant in code. A key left out takes the ``rh5`` default. ``load_profi
 a TOML file and rejects unknown keys and bad values with a :class:`ProfileError` that names the
 file, the key and what was wrong.
 
-Keys beyond §10 (each a ``[D]`` of the profile, documented in the README):
+Each field's documentation is its metadata (:func:`_key`: what it is, its clauses, whether a
+real vehicle's file must fill it in, and a safe starting value); ``helmcheck profile init``
+writes a commented file from it (:mod:`helmcheck.profile_template`). Keys beyond §10 (each a
+``[D]`` of the profile, documented in the README):
 
 - ``max_line_bytes`` (RH-FRM-6), ``lowercase_checksum_in`` (RH-FRM-3),
 - ``waypoint_base`` (RH-JW-1), ``omw_clear_keywords`` (RH-OMW-3, RH-RD-4),
@@ -13,10 +16,11 @@ Keys beyond §10 (each a ``[D]`` of the profile, documented in the README):
 - ``gps_fix_depth_m`` (RH-RD-10), ``opk_max_distance_m`` (RH-PK-1, RH-RD-9),
 - ``vehicle_name``: the name the emulator reports in ``$OSI`` field 18,
 - ``end_mission`` (RH-MSN-4): a short mission present on the vehicle whose end a run can wait
-  for (default ``short.mis``, shipped by the emulator); ``""`` = none, RH-MSN-4 NOT-TESTED,
+  for; default ``""`` = none, RH-MSN-4 NOT-TESTED,
 - ``srp_mission`` (RH-SAF-4, RH-RD-6): an SRP mission present on the vehicle, given at start so
-  that ``SafetyAction = srp`` can be exercised (default ``srp.mis``, shipped by the emulator);
-  ``""`` = none, the ``srp`` branch NOT-TESTED,
+  that ``SafetyAction = srp`` can be exercised; default ``""`` = none, the ``srp`` branch
+  NOT-TESTED. (A real vehicle is not assumed to hold any mission but the test mission; the
+  built-in emulator's profile, :func:`emulator_profile`, names the ones it ships.)
 - ``vehicle_serial``, ``uvc_version``: what the implementation under test is (identity in the
   report; never judged).
 
@@ -41,7 +45,8 @@ from pathlib import Path
 from typing import Any
 
 __all__ = ["Profile", "BenchSafety", "ProfileError", "load_profile", "profile_from_dict", "DEFAULT", "PROTOCOLS",
-           "OSI_FIELD_RANGE", "COMMAND_IDS", "SAFETY_CODES"]
+           "OSI_FIELD_RANGE", "COMMAND_IDS", "SAFETY_CODES", "emulator_profile", "EMULATOR_PROFILE",
+           "profile_keys", "key_rule"]
 
 PROTOCOLS = ("rh5", "rh4", "rh3", "paper")
 #: Allowed $OSI field counts per protocol (RH-OUT-1; public-evidence §2.2.1).
@@ -56,54 +61,117 @@ class ProfileError(ValueError):
     """A profile file or value that cannot be used; the message names file, key and problem."""
 
 
+_MISSING = object()
+
+
+def _key(default: Any = _MISSING, doc: str = "", *, group: str, clause: str = "", fill: str = "",
+         real: Any = _MISSING, factory: Any = None, hexa: bool = False) -> Any:
+    """A profile key: its default and its documentation, the one source ``helmcheck profile init``
+    writes a commented file from (:mod:`helmcheck.profile_template`).
+
+    *doc* says what the key is; *clause* the clauses it serves; *group* the template section;
+    *fill* (non-empty) marks a key a real vehicle's file must be given a value for, and says
+    which; *real* is the value a new file for a real vehicle starts with when it is not the
+    default (a safe one: nothing raised, nothing assumed on the vehicle); *hexa* writes an
+    integer in hexadecimal."""
+    meta = {"doc": doc, "group": group, "clause": clause, "fill": fill, "hex": hexa}
+    if real is not _MISSING:
+        meta["real"] = real
+    if factory is not None:
+        return field(default_factory=factory, metadata=meta)
+    return field(default=default, metadata=meta)
+
+
 @dataclass(frozen=True)
 class BenchSafety:
     """Limits the tester enforces while the vehicle is out of the water (issue: certify vehicle)."""
 
-    in_water: bool = False
-    max_motor_byte: int = 0x90
-    max_speed_kn: float = 0.5
+    in_water: bool = _key(False, "true only when the vehicle is in the water: then no bench limit is enforced",
+                          group="safety")
+    max_motor_byte: int = _key(0x90, "$OMP motor byte ceiling on the bench (0x80 = stop)", group="safety",
+                               hexa=True)
+    max_speed_kn: float = _key(0.5, "$OMS / $OPK / $OMW speed ceiling on the bench, knots", group="safety")
 
 
 @dataclass(frozen=True)
 class Profile:
-    """A conformance profile. Field names are the TOML keys (§10)."""
+    """A conformance profile. Field names are the TOML keys (§10); each field's metadata is its
+    documentation (:func:`_key`)."""
 
-    protocol: str = "rh5"
-    depth_unit: str = "m"
-    ack_window_s: float = 1.0
-    lockout_s: float = 20.0
-    timeout_range: tuple[int, int] = (1, 120)
-    max_depth_m: float = 100.0
-    max_speed_kn: float = 4.5
-    osi_fields: int = 21
-    osd_letters: str = "GCSPYDTI"
-    commands: tuple[str, ...] = COMMAND_IDS
-    mission: str = "conformance.mis"
-    mission_waypoints: int = 4
-    fault_injection: str = "none"
-    violation_trigger: str = ""  #: "" = derived from fault_injection (see :attr:`trigger`)
-    violation_mission: str = ""
-    violation_after_s: float = 0.0
-    reaction_s: float = 0.25
-    time_scale: float = 1.0
-    baud: int = 19200
-    bench_safety: BenchSafety = field(default_factory=BenchSafety)
+    protocol: str = _key("rh5", "protocol generation the vehicle speaks", group="protocol", clause="RH-OUT-1")
+    depth_unit: str = _key("m", "depth unit of the vehicle's sentences; rh4 and older: ft", group="protocol",
+                           clause="§4")
+    ack_window_s: float = _key(1.0, "wall seconds within which every $ACK must come", group="protocol",
+                               clause="RH-ACK-2")
+    lockout_s: float = _key(20.0, "safety lockout after a violation, vehicle seconds", group="protocol",
+                            clause="RH-SAF-1")
+    timeout_range: tuple[int, int] = _key((1, 120), "[low, high] timeout seconds for $OMS / $OMP / $ODVL",
+                                          group="protocol", clause="RH-SRV-2, RH-PRM-2, RH-DVL-1")
+    max_depth_m: float = _key(100.0, "the vehicle's depth ceiling, metres", group="protocol", clause="RH-SRV-2")
+    max_speed_kn: float = _key(4.5, "the vehicle's speed ceiling, knots", group="protocol", clause="RH-SRV-2")
+    osi_fields: int = _key(21, "$OSI field count: rh5 21, rh4/rh3/paper 11 to 17", group="protocol",
+                           clause="RH-OUT-1")
+    osd_letters: str = _key("GCSPYDTI", "the $OSD letters the vehicle serves; G gives $GPRMC, whose time is "
+                            "also read to check the time scale", group="protocol", clause="RH-OSD-1, RH-OSD-2",
+                            fill="leave out the letters of sensors the vehicle lacks")
+    commands: tuple[str, ...] = _key(COMMAND_IDS, "the commands the vehicle claims; one left out is an "
+                                     "unknown ID to it", group="protocol", clause="RH-FRM-5",
+                                     fill="leave out commands the vehicle does not implement")
+    mission: str = _key("conformance.mis", "the test mission, present on the vehicle and started by name: "
+                        "at least 4 waypoints, a mission park on one of the first", group="missions", clause="§10",
+                        fill="the name of the test mission on the vehicle")
+    mission_waypoints: int = _key(4, "waypoints in the test mission", group="missions", clause="§10",
+                                  fill="the test mission's waypoint count")
+    fault_injection: str = _key("none", "whether the vehicle accepts the $OXFLT test extension (oxflt), which "
+                                "raises a safety violation at once", group="safety", clause="RH-SAF-5")
+    violation_trigger: str = _key("", "how the tester gets a safety violation to judge §7: none (§7 NOT-TESTED), "
+                                  "oxflt (needs fault_injection = \"oxflt\"), mission-rule (violation_mission trips "
+                                  "its own rule violation_after_s after its start), operator (someone trips a "
+                                  "sensor on the bench); left out: oxflt with fault_injection = \"oxflt\", else none",
+                                  group="safety", clause="RH-SAF-5", real="none")
+    violation_mission: str = _key("", "for violation_trigger mission-rule: a mission on the vehicle whose own "
+                                  "safety rule trips",
+                                  group="safety", clause="RH-SAF-5")
+    violation_after_s: float = _key(0.0, "for violation_trigger mission-rule: vehicle seconds after the start of "
+                                    "violation_mission at which its rule trips",
+                                    group="safety", clause="RH-SAF-5")
+    reaction_s: float = _key(0.25, "backseat judging: time a backseat gets to act on a state report",
+                             group="backseat", clause="RH-BS-3, RH-BS-5")
+    time_scale: float = _key(1.0, "how many times faster than wall time the vehicle's clock runs: above 1 "
+                             "only for emulators; --time-scale overrides it", group="link", clause="RH-TIM-2")
+    baud: int = _key(19200, "line rate, 8N1; --baud overrides it", group="link", clause="RH-FRM-9",
+                     fill="the serial line's baud rate")
+    bench_safety: BenchSafety = _key(doc="enforced by the tester while the vehicle is out of the water",
+                                     group="safety", factory=BenchSafety)
     # [D] keys beyond the §10 example
-    max_line_bytes: int = 256
-    lowercase_checksum_in: bool = True
-    waypoint_base: int = 0
-    omw_clear_keywords: tuple[str, ...] = ("Clr", "CLEAR", "STOP")
-    safety_action: str = "park"
-    on_station_m: float = 3.0
-    gps_fix_depth_m: float = 0.25
-    opk_max_distance_m: float = 16093.0
-    vehicle_name: str = "IVER3-EMU"
-    end_mission: str = "short.mis"
-    srp_mission: str = "srp.mis"
-    vehicle_serial: str = ""
-    uvc_version: str = ""
-    name: str = "rh5"  #: where the profile came from (file name or "rh5"); not a TOML key
+    max_line_bytes: int = _key(256, "longest line, bytes, CR LF included", group="protocol", clause="RH-FRM-6")
+    lowercase_checksum_in: bool = _key(True, "the vehicle accepts lower-case checksum hex", group="protocol",
+                                       clause="RH-FRM-3")
+    waypoint_base: int = _key(0, "number of the first waypoint", group="protocol", clause="RH-JW-1")
+    omw_clear_keywords: tuple[str, ...] = _key(("Clr", "CLEAR", "STOP"), "$OMW keywords that clear the queue",
+                                               group="protocol", clause="RH-OMW-3, RH-RD-4")
+    safety_action: str = _key("park", "the vehicle's SafetyAction setting at the surface after a violation",
+                              group="safety", clause="RH-SAF-4")
+    on_station_m: float = _key(3.0, "metres within which the vehicle is on station", group="protocol",
+                               clause="RH-RD-5")
+    gps_fix_depth_m: float = _key(0.25, "depth at or above which the vehicle is at the surface, metres",
+                                  group="protocol", clause="RH-RD-10")
+    opk_max_distance_m: float = _key(16093.0, "farthest $OPK position accepted, metres", group="protocol",
+                                     clause="RH-PK-1, RH-RD-9")
+    vehicle_name: str = _key("IVER3-EMU", "the vehicle's name, as it reports in $OSI field 18 (identity in "
+                             "the report; the emulator reports this one)", group="identity",
+                             fill="the vehicle's name", real="")
+    end_mission: str = _key("", "a short mission present on the vehicle whose end a run can wait for; \"\" = "
+                            "none, RH-MSN-4 NOT-TESTED", group="missions", clause="RH-MSN-4",
+                            fill="a short mission on the vehicle, or \"\"")
+    srp_mission: str = _key("", "an SRP mission present on the vehicle, given at start so that SafetyAction "
+                            "srp is exercised; \"\" = none, that branch NOT-TESTED", group="missions",
+                            clause="RH-SAF-4, RH-RD-6", fill="an SRP mission on the vehicle, or \"\"")
+    vehicle_serial: str = _key("", "the vehicle's serial number (identity in the report; never judged)",
+                               group="identity", fill="the vehicle's serial number")
+    uvc_version: str = _key("", "the UVC software version (identity in the report; never judged)",
+                            group="identity", fill="the UVC version the vehicle runs")
+    name: str = field(default="rh5", metadata={"not_a_key": True})  #: where the profile came from; not a TOML key
 
     @property
     def max_depth(self) -> float:
@@ -147,6 +215,37 @@ _AT_MOST = {"ack_window_s": 60.0, "lockout_s": 3600.0, "time_scale": 1000.0, "ma
             "opk_max_distance_m": 100000.0, "violation_after_s": 86400.0, "max_line_bytes": 65536,
             "mission_waypoints": 100000, "osi_fields": 64}
 _BAUDS = (9600, 19200, 38400, 57600, 115200)
+
+
+def key_rule(key: str) -> str:
+    """The values ``key`` (``bench_safety.max_motor_byte`` for the table's) may take, in words,
+    from the same tables :func:`profile_from_dict` checks them with (for documentation)."""
+    name = key.rpartition(".")[2]
+    if key in _CHOICES:
+        return "one of " + " | ".join(repr(c).replace("'", '"') for c in _CHOICES[key] if c)
+    if key == "baud":
+        return "one of " + " | ".join(map(str, _BAUDS))
+    if key == "waypoint_base":
+        return "0 or 1"
+    if key == "osd_letters":
+        return "letters of GCSPYDTI"
+    if key == "commands":
+        return "any of " + ", ".join(COMMAND_IDS)
+    if key == "timeout_range":
+        return "[low, high] integers, 0 <= low <= high"
+    if key == "bench_safety.max_motor_byte":
+        return "0x00..0xFF"
+    low = {"max_line_bytes": "at least 16", "mission_waypoints": "at least 1"}.get(key)
+    if low is None:
+        owner = BenchSafety if key.startswith("bench_safety.") else Profile
+        default = next((f.default for f in dataclasses.fields(owner) if f.name == name), None)
+        number = isinstance(default, (int, float)) and not isinstance(default, bool)
+        low = "> 0" if name in _POSITIVE else (">= 0" if number else "")
+    limit = _AT_MOST.get(key)
+    parts = [low] if low else []
+    if limit is not None:
+        parts.append(f"at most {limit:g}")
+    return ", ".join(parts)
 
 
 def _check(where: str, key: str, value: Any, default: Any) -> Any:
@@ -264,6 +363,24 @@ def _check_trigger(where: str, kw: dict[str, Any]) -> None:
         if not kw.get("violation_after_s", 0.0) > 0:
             raise ProfileError(f"{where}: key 'violation_trigger': 'mission-rule' needs violation_after_s > 0, "
                                f"the vehicle seconds after its start at which the rule trips")
+
+
+#: The built-in emulator's profile, package data (``helmcheck/profiles/emulator.toml``).
+EMULATOR_PROFILE = "profiles/emulator.toml"
+
+
+def emulator_profile() -> Profile:
+    """What ``helmcheck emulate`` claims (its ``$OXFLT`` extension and the missions it ships):
+    the profile every certification of the built-in emulator uses (``make demo``, the tests)."""
+    from importlib import resources
+
+    text = resources.files("helmcheck").joinpath(EMULATOR_PROFILE).read_text(encoding="utf-8")
+    return profile_from_dict(tomllib.loads(text), where=f"helmcheck/{EMULATOR_PROFILE}")
+
+
+def profile_keys() -> list[dataclasses.Field]:
+    """The TOML keys of a profile, in file order (every :class:`Profile` field but ``name``)."""
+    return [f for f in dataclasses.fields(Profile) if not f.metadata.get("not_a_key")]
 
 
 def load_profile(path: str | Path | None) -> Profile:

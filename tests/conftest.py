@@ -116,17 +116,21 @@ def full_emulator_run(tmp_path_factory):
     """One full, signed certification of the built-in emulator (``helmcheck emulate`` on a pty,
     time scale 25, 5 explored sequences, seed 2), shared by the tests that read it. Returns
     ``(root, exit_code, emulator_alive)``: ``root/full`` is the run, ``root/lab.key``/``.pub`` and
-    ``root/other.*`` two key pairs, ``root/emu.toml`` the profile given; ``emulator_alive`` says the
+    ``root/other.*`` two key pairs, ``root/emu.toml`` the profile given (the shipped emulator
+    profile, ``helmcheck/profiles/emulator.toml``, plus baud and identity); ``emulator_alive`` says the
     emulator was still running when the certification ended."""
+    from importlib import resources
+
     from helmcheck.cli import main as cli_main
     from helmcheck.conformance.emulator.process import EmulatorProcess
+    from helmcheck.profile import EMULATOR_PROFILE
 
     root = tmp_path_factory.mktemp("full-run")
     assert cli_main(["keygen", "--out", str(root / "lab")]) == 0
     assert cli_main(["keygen", "--out", str(root / "other")]) == 0
     prof = root / "emu.toml"
-    prof.write_text('fault_injection = "oxflt"\nbaud = 115200\nvehicle_serial = "EMU-0001"\n'
-                    'uvc_version = "emulator 0.1.0"\n')
+    shipped = resources.files("helmcheck").joinpath(EMULATOR_PROFILE).read_text(encoding="utf-8")
+    prof.write_text(shipped + 'baud = 115200\nvehicle_serial = "EMU-0001"\nuvc_version = "emulator 0.1.0"\n')
     with EmulatorProcess(time_scale=FULL_RUN_K, baud=115200) as emu:
         code = cli_main(["certify", "vehicle", "--port", emu.port, "--time-scale", str(FULL_RUN_K),
                          "--profile", str(prof), "--examples", "5", "--seed", "2", "--no-progress",

@@ -56,9 +56,10 @@ def test_rh4_defaults_to_feet_and_shorter_osi(tmp_path):
 
 
 def test_end_and_srp_missions_are_string_keys(tmp_path):
-    """RH-MSN-4 ``end_mission`` and RH-SAF-4 ``srp_mission``: the emulator's missions by default,
-    any name or empty (none) in a file, and refused when not a string."""
-    assert (DEFAULT.end_mission, DEFAULT.srp_mission) == ("short.mis", "srp.mis")
+    """RH-MSN-4 ``end_mission`` and RH-SAF-4 ``srp_mission``: none by default (a real vehicle is not
+    assumed to hold the emulator's missions), any name or empty (none) in a file, and refused when
+    not a string."""
+    assert (DEFAULT.end_mission, DEFAULT.srp_mission) == ("", "")
     p = load_profile(_write(tmp_path, "end_mission = 'sub/end.mis'\nsrp_mission = ''"))
     assert (p.end_mission, p.srp_mission) == ("sub/end.mis", "")
     for key in ("end_mission", "srp_mission"):
@@ -66,14 +67,32 @@ def test_end_and_srp_missions_are_string_keys(tmp_path):
             load_profile(_write(tmp_path, f"{key} = 3"))
 
 
+def test_the_emulator_profile_names_what_the_emulator_ships():
+    """``helmcheck/profiles/emulator.toml``: the ``$OXFLT`` extension and the missions the emulator
+    ships, every one of them present in its built-in catalogue."""
+    from helmcheck.conformance.emulator.missionfile import builtin_dir
+    from helmcheck.profile import emulator_profile
+
+    emu = emulator_profile()
+    assert (emu.fault_injection, emu.trigger) == ("oxflt", "oxflt")
+    assert (emu.end_mission, emu.srp_mission) == ("short.mis", "srp.mis")
+    for name in (emu.mission, emu.end_mission, emu.srp_mission):
+        assert (builtin_dir() / name).is_file(), name
+    assert emu.replace(name="x") == DEFAULT.replace(name="x", fault_injection="oxflt", violation_trigger="oxflt",
+                                                    end_mission="short.mis", srp_mission="srp.mis")
+
+
 def test_empty_end_or_srp_mission_makes_its_case_not_tested():
     from helmcheck.conformance.vehicle.catalogue import CASES, unmet_need
+    from helmcheck.profile import emulator_profile
     end = next(c for c in CASES if c.subject == "RH-MSN-4")
     srp = next(c for c in CASES if c.subject == "RH-SAF-4" and "srp_mission" in c.needs)
-    emu = DEFAULT.replace(fault_injection="oxflt")
+    emu = emulator_profile()
     assert unmet_need(end, emu) is None and unmet_need(srp, emu) is None
     assert "end_mission" in unmet_need(end, emu.replace(end_mission=""))
     assert "srp_mission" in unmet_need(srp, emu.replace(srp_mission=""))
+    assert "end_mission" in unmet_need(end, DEFAULT) and "srp_mission" in unmet_need(srp, DEFAULT.replace(
+        fault_injection="oxflt"))
 
 
 # ---------------------------------------------------------------------------- non-finite numbers

@@ -27,7 +27,8 @@ HERE = Path(__file__).resolve().parent
 PY = shlex.quote(sys.executable)
 GOOD = shlex.quote(str(HERE / "backseats" / "good_backseat.py"))
 FAULTY = shlex.quote(str(HERE / "backseats" / "faulty_backseat.py"))
-EMU_TOML = 'fault_injection = "oxflt"\nbaud = 115200\ntime_scale = 25.0\n'
+EMU_TOML = ('fault_injection = "oxflt"\nbaud = 115200\ntime_scale = 25.0\n'
+            'end_mission = "short.mis"\nsrp_mission = "srp.mis"\n')  # the emulator's missions
 VEHICLE_IDS = [c.id for c in vehicle_clauses()]
 BACKSEAT_IDS = [c.id for c in backseat_clauses()]
 
@@ -126,9 +127,12 @@ def test_emulator_with_k_selection_passes_and_is_certified_once(pytester):
     assert "helmcheck vehicle" in result.stdout.str() and "PASS: All" in result.stdout.str()
 
 
-def _served_mutant(name: str):
+def _served_mutant(name: str, k: float = 25.0):
+    """The mutant served at ``k``, the time scale ``EMU_TOML`` declares (a vehicle at another
+    scale stops the run at its clock check)."""
     m = next(m for m in MUTANTS if m.name == name)
-    return serve(lambda start: make_core(m, m.time_scales[0], start))
+    assert k in m.time_scales, (name, m.time_scales)
+    return serve(lambda start: make_core(m, k, start))
 
 
 def test_faulty_vehicle_fails_its_clause_with_reason_and_evidence(pytester):

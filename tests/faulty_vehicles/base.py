@@ -21,12 +21,13 @@ from helmcheck.conformance.emulator.server import Server
 from helmcheck.conformance.transport import PtyLink
 from helmcheck.grammar import checksum_hex
 from helmcheck.model.vehicle import VehicleModel
-from helmcheck.profile import DEFAULT, Profile
+from helmcheck.profile import Profile, emulator_profile
 
 __all__ = ["Mutant", "serve", "make_core", "EMU_PROFILE", "reframe", "body", "Model", "TIME_SCALES", "TIMED_SCALES"]
 
-#: The profile the emulators run (and the tester is given): $OXFLT declared.
-EMU_PROFILE = DEFAULT.replace(fault_injection="oxflt", baud=115200)
+#: The profile the emulators run (and the tester is given): the built-in emulator's own ($OXFLT
+#: declared, its end and SRP missions named), at 115200 baud.
+EMU_PROFILE = emulator_profile().replace(baud=115200)
 #: Every mutant is certified at two time scales (the judges must not depend on one).
 TIME_SCALES = (25.0, 50.0)
 #: For mutants whose selection holds a 10 s timer (RH-SRV-4, RH-PRM-4): at k = 50 the observer's

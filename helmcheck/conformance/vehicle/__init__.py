@@ -12,6 +12,8 @@ Modules, one concern each:
 * :mod:`.session` — runs steps against a vehicle: verified reset, send, poll, timed waits.
 * :mod:`.explore` — hypothesis sequences of valid and invalid commands, shrunk on failure.
 * :mod:`.replay` — version-independent replay files: write, read, re-drive.
+* :mod:`.clockrate` — the vehicle's clock rate from ``$GPRMC`` readings, and whether it is the
+  declared time scale (sans-IO); :mod:`.clockprobe` reads the clock at start.
 * :mod:`.runner` — one certification run: cases, exploration, results and reports.
 * :mod:`.progress` — the progress display (rich on a terminal, plain lines otherwise).
 * :mod:`.cli` — ``add_arguments``/``run`` for ``helmcheck certify vehicle``.

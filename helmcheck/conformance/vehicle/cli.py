@@ -31,6 +31,10 @@ how it works:
   max(0.5 s, 5 %) widened by the measured slack. Then hypothesis sends random valid and invalid
   command sequences and shrinks any failure to a replay file (helmcheck replay FILE --port URL).
 
+time scale: before the cases, the vehicle's $GPRMC times are read against wall time for up to 2 s;
+  a vehicle whose clock clearly does not run at K (the measured interval beyond 1.5x either way)
+  stops the run INCONCLUSIVE, naming both rates. --no-clock-check skips it.
+
 verdicts: pass, non-strict (a SHOULD missed), fail, inconclusive (link fault, noisy timing),
   not-tested (the profile does not claim it). A link fault is never a fail.
 
@@ -116,6 +120,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--resume", metavar="DIR",
                    help="continue the interrupted run in DIR from its last completed case, into the same "
                         "report (its profile, selection, time scale and seed are the run's own)")
+    p.add_argument("--no-clock-check", dest="clock_check", action="store_false",
+                   help="do not measure the vehicle's clock rate ($GPRMC times) against --time-scale at start "
+                        "(for a vehicle whose $GPRMC time is not its own clock)")
     p.add_argument("--overwrite", action="store_true",
                    help="replace an earlier run in --report-dir (its results, wire log, reports and "
                         "replays are removed first); without it such a directory is refused")
@@ -208,7 +215,7 @@ def run(args: argparse.Namespace) -> int:  # noqa: C901 - argument checks, then 
                        progress=not args.no_progress, command=command.strip(), render=False,
                        link=link, log_opener=open_wire_log, exec_cmd=args.exec_cmd,
                        exec_grace_s=args.exec_grace, exec_ready_s=args.exec_ready, certificate=cert,
-                       operator=_at_a_terminal(), resume=resume)
+                       operator=_at_a_terminal(), resume=resume, clock_check=args.clock_check)
         out = certify(opts)
     finally:
         if link is not None:

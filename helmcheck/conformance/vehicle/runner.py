@@ -2,10 +2,11 @@
 
 :func:`certify` opens the port, records a ``link:`` note (the line's settings, RH-FRM-9), checks
 that something answers (a link that carries nothing, or only garbage, is INCONCLUSIVE with the
-reason), runs the selected clause cases in order (:mod:`.interpreter`), then the hypothesis
-exploration (:mod:`.explore`), and writes ``DIR/results.json`` after every case — atomically, so a
-crash or Ctrl-C leaves a valid partial report marked ``partial`` — plus ``DIR/wire.log`` and, at
-the end, every report format.
+reason), checks that the vehicle's clock runs at the declared time scale (:mod:`.clockprobe`: a
+clear mismatch stops the run INCONCLUSIVE, naming both rates), runs the selected clause cases
+in order (:mod:`.interpreter`), then the hypothesis exploration (:mod:`.explore`), and writes
+``DIR/results.json`` after every case — atomically, so a crash or Ctrl-C leaves a valid partial
+report marked ``partial`` — plus ``DIR/wire.log`` and, at the end, every report format.
 
 Every byte and note goes through one :class:`~helmcheck.conformance.recorder.Recorder`: to the
 wire log and to the one vehicle observer (:class:`~helmcheck.judge.vehicle.VehicleObserver`),
@@ -45,6 +46,7 @@ from ..recorder import Recorder
 from ...reports.certificate import RunDeclaration, finish_run
 from ..transport import open_link
 from .catalogue import select_cases
+from .clockprobe import ClockMismatch, check_clock
 from .flow import LinkLost, LinkSilent
 from .interpreter import run_case
 from .link import TesterLink
@@ -79,6 +81,7 @@ class Options:
     exec_grace_s: float = 5.0  #: SIGTERM → SIGKILL when stopping it
     exec_ready_s: float = 30.0  #: how long it may take to open (or listen on) the port
     certificate: Optional[RunDeclaration] = None  #: identity and signing key (helmcheck.reports.certificate)
+    clock_check: bool = True  #: measure the vehicle's clock rate at start (:mod:`.clockprobe`)
     # Command-line hooks (helmcheck.conformance.vehicle.cli): the link the command already
     # opened (a port that cannot be opened is a usage error there), and how to open wire.log
     # (a stream that remembers a write error for the command to report).
@@ -122,6 +125,7 @@ class Run:
         self.observer = VehicleObserver(self.p, self.ledger, time_scale=self.k, baud=self.p.baud)
         self.progress = Progress(enabled=opts.progress)
         self.aborted: Optional[str] = None
+        self.stopped: Optional[str] = None  #: a start-up check stopped the run: leads the verdict reason
         self.partial = False
         self.t_start = time.monotonic()
         settings = {"time_scale": self.k, "strict": opts.strict, "hypothesis_profile": opts.hypothesis_profile,
@@ -189,8 +193,9 @@ class Run:
         r["stats"] = self.stats
         if final:
             R.finish(r, partial=self.partial, strict=self.o.strict, duration_s=self.stats["wall_s"])
-            if self.partial and self.aborted:
-                r["verdict_reason"] = f"{self.aborted[:1].upper()}{self.aborted[1:]}. {r['verdict_reason']}"
+            lead = self.aborted if self.partial else self.stopped
+            if lead:
+                r["verdict_reason"] = f"{lead[:1].upper()}{lead[1:]}. {r['verdict_reason']}"
         else:
             r["partial"] = True
             r["verdict"] = R.run_verdict([c["verdict"] for c in r["clauses"]], strict=self.o.strict, partial=True)
@@ -422,11 +427,15 @@ def certify(opts: Options) -> Outcome:
         try:
             run.open()
             run.probe()
+            check_clock(run, opts.clock_check)
             run.run_cases(cases)
             if explore_now and run.aborted is None:
                 from .explore import explore
                 explore(run)
                 run.progress.step("exploration", "done")
+        except ClockMismatch as e:  # the declared time scale is clearly wrong: INCONCLUSIVE
+            run.aborted = run.stopped = str(e)
+            run.progress.note(f"stopped: {e}")
         except LinkLost as e:
             run.aborted = run.aborted or f"link fault: {e}"
             run.progress.note(f"link fault: {e}")
