@@ -11,9 +11,11 @@ from __future__ import annotations
 
 import json
 import time
+from pathlib import Path
 
 import pytest
 
+import helmcheck
 from helmcheck.cli import main as cli_main
 from helmcheck.conformance.emulator.core import EmulatorCore
 from helmcheck.conformance.emulator.missionfile import builtin_dir
@@ -22,12 +24,14 @@ from helmcheck.conformance.vehicle.catalogue import select_cases
 from helmcheck.conformance.vehicle.plan import OPERATOR_REACTION_S
 from helmcheck.conformance.vehicle.session import frame
 from helmcheck.conformance.vehicle.virtual import VEHICLE_DELAY_S, VirtualLine
-from helmcheck.profile import DEFAULT
+from helmcheck.profile import DEFAULT, EMULATOR_PROFILE, emulator_profile
 from helmcheck.reports.results import load_results
 
 K = 20.0
 #: The cases the agreement test runs for real (about 35 s at time scale 20).
 AGREEMENT_SELECT = "RH-FRM-2,RH-FRM-4,RH-ACK-3,RH-SRV-3,RH-SRV-4,RH-PK-3,RH-MSN-4,RH-TIM-1"
+#: The emulator's own profile (it names the end mission RH-MSN-4's case waits for).
+EMU = str(Path(helmcheck.__file__).parent / EMULATOR_PROFILE)
 
 
 def _plan(capsys, *args) -> dict:
@@ -41,13 +45,14 @@ def test_plan_total_is_within_20_percent_of_a_real_certification_at_time_scale_2
     with EmulatorProcess(time_scale=K) as emu:
         t0 = time.monotonic()
         code = cli_main(["certify", "vehicle", "--port", emu.port, "--time-scale", str(K), "--examples", "0",
-                         "--select", AGREEMENT_SELECT, "--no-progress", "--report-dir", str(tmp_path / "real")])
+                         "--profile", EMU, "--select", AGREEMENT_SELECT, "--no-progress",
+                         "--report-dir", str(tmp_path / "real")])
         real = time.monotonic() - t0
     capsys.readouterr()
     assert code in (0, 2)  # on a busy machine a timing clause may be INCONCLUSIVE: not the time taken
-    plan = _plan(capsys, "--time-scale", str(K), "--examples", "0", "--select", AGREEMENT_SELECT)
+    plan = _plan(capsys, "--profile", EMU, "--time-scale", str(K), "--examples", "0", "--select", AGREEMENT_SELECT)
     planned = {c["id"]: c for c in plan["cases"] if c["kind"] == "case"}
-    assert list(planned) == [c.id for c in select_cases(AGREEMENT_SELECT.split(","), DEFAULT)]
+    assert list(planned) == [c.id for c in select_cases(AGREEMENT_SELECT.split(","), emulator_profile())]
     assert all(c["outcome"] == "ran" for c in planned.values()), planned
     done = {c["id"]: c["wall_s"] for c in load_results(tmp_path / "real")["cases"] if c["verdict"] == "pass"}
     if len(done) == len(planned):  # every case ran to its end: the command's wall time against the total
@@ -125,8 +130,8 @@ def test_plan_uses_the_missions_given(tmp_path, capsys):
     """RH-MSN-4's case runs the end mission to its end: a longer park in it is a longer case."""
     (tmp_path / "short.mis").write_text((builtin_dir() / "short.mis").read_text().replace(
         "1.0      2.0       30", "1.0      2.0       330"))
-    base = _plan(capsys, "--time-scale", "20", "--examples", "0", "--select", "RH-MSN-4")
-    given = _plan(capsys, "--time-scale", "20", "--examples", "0", "--select", "RH-MSN-4",
+    base = _plan(capsys, "--profile", EMU, "--time-scale", "20", "--examples", "0", "--select", "RH-MSN-4")
+    given = _plan(capsys, "--profile", EMU, "--time-scale", "20", "--examples", "0", "--select", "RH-MSN-4",
                   "--missions", str(tmp_path))
     v47 = {p["missions"]["given"]: next(x for x in p["cases"] if x["id"] == "V-47") for p in (base, given)}
     assert v47[True]["vehicle_s"] - v47[False]["vehicle_s"] == pytest.approx(300.0, abs=15.0)
