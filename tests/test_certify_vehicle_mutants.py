@@ -31,7 +31,8 @@ def test_mutant_fails_on_its_clause(mutant, k, tmp_path):
     with serve(lambda start: make_core(mutant, k, start)) as port:
         out = _certify(port, tmp_path, mutant.select, k)
     failed = {c["id"]: c for c in out.results["clauses"] if c["verdict"] == "fail"}
-    assert out.verdict == "fail", out.reason
+    assert out.verdict == "fail", (out.reason, [(c["id"], c["verdict"], c["reason"]) for c in out.results["clauses"]
+                                                if c["verdict"] != "pass"])
     assert out.exit_code == 1
     assert mutant.clause in failed, f"failed {sorted(failed)}: {out.reason}"
     entry = failed[mutant.clause]

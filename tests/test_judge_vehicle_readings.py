@@ -94,14 +94,18 @@ def test_RH_PK_2_on_station_without_counting_fails(tmp_path):
     assert verdict(v, "RH-PK-2") == "fail"  # the park time a vehicle on station shows is counting
 
 
-def test_RH_MSN_4_at_the_last_waypoint_without_ending_fails(tmp_path):
-    """The profile's test mission has 4 waypoints; the vehicle reports itself 1 m from the last
-    one, in N, for 10 s: a conforming vehicle has reached it and ended the mission."""
+@pytest.mark.parametrize("dist,want", [(1.0, "fail"), (PROFILE.on_station_m, "fail"),
+                                       (PROFILE.on_station_m + 0.01, "not fail")])
+def test_RH_MSN_4_at_the_last_waypoint_without_ending_fails(tmp_path, dist, want):
+    """The profile's test mission has 4 waypoints; the vehicle reports itself ``dist`` from the
+    last one, in N, for 10 s: within ``on_station_m`` (inclusive, RH-RD-5: a vehicle that stopped
+    2.996 m away reports 3.00) a conforming vehicle has reached it and ended the mission; just
+    outside it the vehicle has not arrived, and nothing is proven."""
     rec = start() + [(1.0, ">", "OJW,3"), (1.01, "<", "ACK,7,0,0")]
     for t in (2.0, 4.0, 6.0, 8.0, 10.0, 12.0):
-        rec += poll(t, mode="N", wp=3, dist=1.0, speed=2.0)
+        rec += poll(t, mode="N", wp=3, dist=dist, speed=0.0)
     v = judge(tmp_path, rec)
-    assert verdict(v, "RH-MSN-4") == "fail"
+    assert (verdict(v, "RH-MSN-4") == "fail") == (want == "fail"), v["RH-MSN-4"]
 
 
 def test_RH_SAF_1_a_violation_the_vehicle_raises_by_itself_is_adopted_not_failed(tmp_path):

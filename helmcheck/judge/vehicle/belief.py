@@ -394,17 +394,21 @@ class Beliefs:
 
         ``pass`` — the before-state was seen close enough before the deadline and the after-state
         close enough after it (within half the duration, RH-TIM-1's last sentence, widened by the
-        tolerance); ``inconclusive`` — the observer's own uncertainty (timestamp step, jitter,
-        the arming command's round trip, an adopted event's window) is already too large;
-        ``not-tested`` — the transition was seen but not sampled near its deadline, so its timing
-        was not exercised (a later, closer observation may time it).
+        tolerance); ``inconclusive`` — the observer's own measuring uncertainty (timestamp step,
+        jitter, the arming command's round trip) is already too large; ``not-tested`` — the timer
+        started with an unseen event placed within a window too wide to time it (nobody set it
+        going where it could be timed), or the transition was seen but not sampled near its
+        deadline, so its timing was not exercised (a later, closer observation may time it).
         """
         tol = tolerance(tt.duration)
         own = slack_v + tt.extra_v
         what = f"the {tt.duration:g} s {_name(tt)}"
-        if not judgeable(tt.duration, own):
-            return (tt, "inconclusive", f"the observer's own uncertainty of {own:.1f} s of vehicle time "
+        if not judgeable(tt.duration, slack_v):
+            return (tt, "inconclusive", f"the observer's own uncertainty of {slack_v:.1f} s of vehicle time "
                                         f"cannot bound {what} (RH-TIM-1)")
+        if not judgeable(tt.duration, own):
+            return (tt, "not-tested", f"{what} started with an unseen event placed within {tt.extra_v:.1f} s of "
+                                      f"vehicle time, too wide to time it: its timing was not exercised")
         if tt.t_old is None:
             return (tt, "not-tested", f"{what} ended, but the state before it was not observed after it "
                                       f"started, so its timing was not exercised")

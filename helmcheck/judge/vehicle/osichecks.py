@@ -248,7 +248,10 @@ class OsiChecks:
         prof = o.profile
         key = None
         d = float(osi.distance)
-        near = d < prof.on_station_m  # RH-RD-5: on station means within on_station_m
+        # RH-RD-5: on station means within on_station_m, inclusive, judged on field 7 as reported (a
+        # vehicle that stopped 2.996 m away reports 3.00 and is on station; one still approaching
+        # does not sit at that distance long enough to be watched)
+        near = d <= prof.on_station_m
         depth = osi_depth_m(osi, prof.depth_unit)
         if m.phase == "ascent" and depth is not None and depth <= prof.gps_fix_depth_m:
             key = ("surface", osi.mode)
