@@ -230,6 +230,20 @@ def test_exploration_shrinks_and_replays(tmp_path, capsys):
         assert code == 0, capsys.readouterr().out
 
 
+def test_exploration_counts_only_the_sequences_that_ran(tmp_path):
+    """A spent wall budget ends exploration: the report counts the sequences that really ran
+    (each one's reset is on the wire), never the examples hypothesis asked for afterwards."""
+    with serve(lambda start: make_core(None, K, start)) as port:
+        out = certify(_opts(port, tmp_path, select=["RH-ACK-1"], examples=500, explore_budget_s=1.0, seed=3))
+    ex = out.results["stats"]["explore"]
+    assert ex["budget_spent"] is True, ex
+    assert 0 < ex["ran"] < 500, ex
+    notes = [r.note for r in read_records(open(tmp_path / "r" / "wire.log", encoding="utf-8")) if r.is_note]
+    assert any(f"exploration: {ex['ran']} sequence(s) ran; the 1 s budget was spent" in n for n in notes), notes
+    stops = sum(1 for raw in _sent_lines(tmp_path / "r" / "wire.log") if raw.startswith(b"$OMSTOP,0*"))
+    assert stops >= ex["ran"], (stops, ex)  # every counted sequence began with its reset
+
+
 # ---------------------------------------------------------------------------- command line
 
 @pytest.mark.parametrize("argv", [

@@ -19,10 +19,11 @@ the first enabled transition in document order, both regions pick the row
 Guard atoms are read from the ``ctx`` keyword argument of ``send`` (any object with the
 boolean attributes of :data:`~helmcheck.model.transitions.GUARD_ATOMS`).
 
-The chart is the authoritative *structure* (docs, validation); the model dispatches through the
-table's index, because the library's ``send`` costs about 0.2 ms, too slow for the ≥50 000
-commands/s the model must take. ``tests/test_model_chart.py`` checks that both agree for every
-mode, phase, event and guard valuation.
+The table is the one source of behaviour; the chart is that table as a statechart (for the
+generated diagrams and for validation). The model dispatches through the table's index, because
+the library's ``send`` costs about 0.2 ms, too slow for the ≥50 000 commands/s the model must
+take. ``tests/test_model_table.py`` checks that chart and index agree for every mode, phase,
+event and guard valuation.
 """
 
 from __future__ import annotations
