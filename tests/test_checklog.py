@@ -239,3 +239,31 @@ def test_rh_bs_6_refresh_within_the_rh_tim_1_tolerance_is_in_time(tmp_path):
     out = check_log(_log(tmp_path, recs), profile=PROFILE, role="backseat")
     v = verdicts(out)
     assert v["RH-BS-6"]["verdict"] == "pass", v["RH-BS-6"]
+
+
+DEMO = Path(__file__).resolve().parent.parent / "reports" / "demo"
+
+
+def test_the_committed_demo_log_gets_the_verdicts_certify_gave_it(tmp_path, capsys):
+    """One judge per role: the demo's wire log, checked offline with the profile it was
+    certified with, gets every clause verdict ``certify vehicle`` wrote into results.json."""
+    live = {c["id"]: c["verdict"] for c in json.loads((DEMO / "results.json").read_text())["clauses"]}
+    code = cli_main(["check-log", str(DEMO / "wire.log"), "--role", "vehicle", "--profile",
+                     str(DEMO / "profile.toml"), "--report-dir", str(tmp_path / "with"), "--no-render"])
+    offline = {c["id"]: c["verdict"] for c in json.loads((tmp_path / "with" / "results.json").read_text())["clauses"]}
+    assert code == 0, capsys.readouterr().out
+    assert {c: v for c, v in offline.items() if c in live} == {c: v for c, v in live.items() if c in offline}
+    assert set(live) - set(offline) == set(), set(live) - set(offline)
+
+
+def test_the_demo_log_without_its_profile_fails_nothing_and_says_where_the_profile_is(tmp_path, capsys):
+    """Under the default profile the observer lacks the run's mission names: what depends on
+    them is not judged (never failed), and the command points at the run's profile."""
+    code = cli_main(["check-log", str(DEMO / "wire.log"), "--role", "vehicle",
+                     "--report-dir", str(tmp_path / "without"), "--no-render"])
+    out = capsys.readouterr().out
+    assert code in (0, 2), out
+    res = json.loads((tmp_path / "without" / "results.json").read_text())
+    assert not [c["id"] for c in res["clauses"] if c["verdict"] in ("fail", "non-strict")]
+    if code == 2:
+        assert f"--profile {DEMO / 'profile.toml'}" in out

@@ -128,6 +128,7 @@ def run(args: argparse.Namespace) -> int:  # noqa: C901 - argument checks, then 
                 raise OutputLost(f"cannot write {e.filename or rdir}: {e.strerror or e}") from None
             raise OutputLost(f"report not written: {e}") from None
         _summary(f, out, res, rdir)
+        _hint_run_profile(f, args, res)
         worst = max(worst, R.exit_code(res["verdict"], args.strict), key=_rank)
     return worst
 
@@ -151,6 +152,15 @@ def _summary(f: Path, out, res: dict, rdir: Path) -> None:
             lines = ", ".join(map(str, c.get("lines", [])[:8]))
             print(f"  {c['id']} {c['verdict']}: lines {lines}")
     print(f"  report: {rdir}")
+
+
+def _hint_run_profile(f: Path, args: argparse.Namespace, res: dict) -> None:
+    """A log from a ``certify`` results directory is judged with the default profile unless told;
+    when that left something unjudged, say where the run's own profile is."""
+    prof = f.parent / "profile.toml"
+    if args.profile is None and res["verdict"] != "pass" and prof.is_file():
+        print(f"  hint: {f} sits beside the profile it was certified with: --profile {prof} judges it "
+              f"with that profile (helmcheck verify {f.parent} re-judges the whole run)")
 
 
 class _progress:
