@@ -256,14 +256,10 @@ def test_the_committed_demo_log_gets_the_verdicts_certify_gave_it(tmp_path, caps
     assert set(live) - set(offline) == set(), set(live) - set(offline)
 
 
-def test_the_demo_log_without_its_profile_fails_nothing_and_says_where_the_profile_is(tmp_path, capsys):
-    """Under the default profile the observer lacks the run's mission names: what depends on
-    them is not judged (never failed), and the command points at the run's profile."""
+def test_the_demo_log_passes_even_without_its_profile(tmp_path, capsys):
+    """Under the default profile the observer has none of the run's mission names; the vehicle's
+    own reports (each started mission seen running under its name) decide what they were needed
+    for, so the demo still passes (RH-MSN-2)."""
     code = cli_main(["check-log", str(DEMO / "wire.log"), "--role", "vehicle",
                      "--report-dir", str(tmp_path / "without"), "--no-render"])
-    out = capsys.readouterr().out
-    assert code in (0, 2), out
-    res = json.loads((tmp_path / "without" / "results.json").read_text())
-    assert not [c["id"] for c in res["clauses"] if c["verdict"] in ("fail", "non-strict")]
-    if code == 2:
-        assert f"--profile {DEMO / 'profile.toml'}" in out
+    assert code == 0, capsys.readouterr().out

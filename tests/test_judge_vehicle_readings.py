@@ -108,6 +108,19 @@ def test_RH_MSN_4_at_the_last_waypoint_without_ending_fails(tmp_path, dist, want
     assert (verdict(v, "RH-MSN-4") == "fail") == (want == "fail"), v["RH-MSN-4"]
 
 
+@pytest.mark.parametrize("shown,want", [("other.mis", "pass"), ("conformance.mis", "inconclusive"),
+                                        (None, "inconclusive")])
+def test_RH_MSN_2_a_start_by_an_unknown_name_is_judged_by_the_mission_seen_running(tmp_path, shown, want):
+    """The observer has no file named other.mis: accepting its start is right only if the
+    vehicle has it. The vehicle's later report running other.mis (field 12) shows it has; a
+    report showing another mission, or none before the record ends, proves nothing."""
+    rec = poll(0.0, mode="S") + [(0.1, ">", "OMSTART,0,0,0,0,other.mis,"), (0.11, "<", "ACK,3,0,0")]
+    if shown is not None:
+        rec += poll(0.3, mode="N", dist=150.0, speed=2.0, mission=shown)
+    v = judge(tmp_path, rec)
+    assert verdict(v, "RH-MSN-2") == want, v["RH-MSN-2"]
+
+
 def test_RH_SAF_1_a_violation_the_vehicle_raises_by_itself_is_adopted_not_failed(tmp_path):
     """No $OXFLT anywhere: a bench vehicle trips "no forward progress" on its own. The report
     showing the code is explained by that unseen event; the lockout is judged (RH-SAF-1)."""
@@ -288,3 +301,43 @@ def test_RH_PRM_4_a_timeout_far_before_its_deadline_fails(tmp_path):
     rec += poll(7.0, mode="S")
     v = judge(tmp_path, rec)
     assert verdict(v, "RH-OUT-4") == "fail" or verdict(v, "RH-PRM-4") == "fail"
+
+
+# ------------------------------------------------------------------------- prefixed replies
+
+def _prefixed(records: list[tuple], prefix: bytes) -> list[tuple]:
+    """The same session with ``prefix`` in front of every vehicle line (a modem's, say)."""
+    out = []
+    for t, d, body in records:
+        if d == "<":
+            out.append((t, "<raw", escape(prefix + f"${body}*{checksum_hex(body)}".encode())))
+        else:
+            out.append((t, d, body))
+    return out
+
+
+def _write_raw(tmp_path: Path, records: list[tuple]) -> Path:
+    """A wire log whose records are whole lines (the log adds each one's CR LF)."""
+    lines = ["# helmcheck wire-log 1", "# hand-made  baud 19200  time_scale 1"]
+    for t, d, body in records:
+        if d == "<raw":
+            lines.append(f"{t:.6f} < {body}")
+        else:
+            lines.append(f"{t:.6f} {d} ${body}*{checksum_hex(body)}")
+    p = tmp_path / "prefixed.log"
+    p.write_text("\n".join(lines) + "\n")
+    return p
+
+
+@pytest.mark.parametrize("prefix,want", [(b"AT>", "fail"), (b"", "pass")])
+def test_RH_FRM_1_the_same_bytes_before_every_reply_are_a_finding_quoting_them(tmp_path, prefix, want):
+    """Bytes that precede reply after reply the same way are not line noise: an RH-FRM-1 FAIL that
+    quotes them (a vehicle, or a radio modem in between, prefixing its output)."""
+    rec = []
+    for t in (0.0, 1.0, 2.0, 3.0):
+        rec += poll(t, mode="S")
+    out = check_log(_write_raw(tmp_path, _prefixed(rec, prefix)), profile=PROFILE, role="vehicle")
+    v = {c["id"]: c for c in out.clauses}
+    assert verdict(v, "RH-FRM-1") == want, v["RH-FRM-1"]
+    if want == "fail":
+        assert "AT>" in v["RH-FRM-1"]["reason"], v["RH-FRM-1"]["reason"]

@@ -164,9 +164,12 @@ class Answers:
 
     def _matched(self, p: Sent, a: s.ACK, res, cands: tuple[str, ...], ev: list) -> None:
         if res.mission_dependent:
-            self.book("inconclusive", cands, f"{text_of(p)} answered {brief([a])}: the answer depends on the "
-                                             f"vehicle's mission files, which the observer does not have", ev,
-                      at=p)
+            item = p.kind.item
+            if not a.status and isinstance(item, s.OMSTART):
+                names = {item.name} | ({item.srp} if item.srp else set())
+                self.mission_shown.append((p, a, cands, ev, names))  # judged by the reports to come
+                return
+            self._mission_unknown(p, a, cands, ev)
             return
         if res.adopted:
             for cid in cands[:1]:
@@ -182,6 +185,30 @@ class Answers:
             self.passed(passable(cands), f"{text_of(p)} accepted in mode {res.before[0]}", ev)
         elif p.kind.variant:
             self.passed((p.kind.variant,), f"{text_of(p)} read and answered", ev)
+
+    def _mission_unknown(self, p: Sent, a: s.ACK, cands: tuple[str, ...], ev: list, why: str = "") -> None:
+        self.book("inconclusive", cands, f"{text_of(p)} answered {brief([a])}: the answer depends on the "
+                                         f"vehicle's mission files, which the observer does not have{why}", ev,
+                  at=p)
+
+    def _mission_seen(self, osi: s.OSI, evd: Evidence) -> None:
+        """``$OMSTART`` by names the observer has no file for, accepted: the vehicle's own reports
+        decide. Each mission it names seen running under that name (field 12, in any mode but
+        ``S``) was on the vehicle, so accepting the start was right (RH-MSN-2); a start whose names
+        are not all seen by the end of the record stays unjudged (:meth:`_mission_unshown`)."""
+        if osi.mode == "S" or not osi.mission_name:
+            return
+        left = []
+        for p, a, cands, ev, names in self.mission_shown:
+            names = names - {osi.mission_name}
+            if names:
+                left.append((p, a, cands, ev, names))
+                continue
+            ran = " and ".join(sorted({p.kind.item.name} | ({p.kind.item.srp} if p.kind.item.srp else set())))
+            for cid in passable(cands):
+                self.ledger.passed(cid, f"{text_of(p)} accepted, and the vehicle was later seen running {ran} "
+                                        f"(field 12): the mission files are on the vehicle", ev + [evd], p.case)
+        self.mission_shown = left
 
     def _osd_data(self, p: Sent, a: s.ACK, ev: list) -> None:
         """RH-ACK-5, RH-OSD-1, RH-OSD-2 for an answered ``$OSD``."""
@@ -206,6 +233,8 @@ class Answers:
     def _osi(self, osi: s.OSI, p: Sent, t: float, evd: Evidence) -> None:
         """RH-OUT-4 and the clauses of what led to the reported state."""
         ev = [p.ev, evd]
+        if self.mission_shown:
+            self._mission_seen(osi, evd)
         self.last_osi, self.last_osi_t = osi, t
         self.mode_seen(t, osi.mode)
         res = self.beliefs.osi(osi, self.v(p.t), self.v(t), self.slack_v())

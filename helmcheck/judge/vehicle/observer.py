@@ -81,6 +81,7 @@ class VehicleObserver(Answers):
         self.dead: list[Sent] = []  #: missing while the vehicle said nothing at all (yet)
         self.quiet: list[Sent] = []  #: discarded lines waiting for proof the vehicle listens
         self.last_osd: Optional[Sent] = None
+        self.mission_shown: list[tuple] = []  #: $OMSTARTs the reports to come judge (answers.py)
         self.sent: deque[Sent] = deque(maxlen=256)
         self.seq = 0
         self.t = 0.0
@@ -409,6 +410,7 @@ class VehicleObserver(Answers):
         self.quiet.clear()
         self.gave_up.clear()
         self.last_osd = None
+        self._mission_unshown("the run was interrupted")
         self.after_discard = False
         self.last_osi = None
         self.case, self.case_clauses = "", ()
@@ -416,6 +418,11 @@ class VehicleObserver(Answers):
         self.checks = osichecks.OsiChecks(self)
         self.aborted = ""
         self.t = max(self.t, t)
+
+    def _mission_unshown(self, why: str) -> None:
+        for p, a, cands, ev, names in self.mission_shown:
+            self._mission_unknown(p, a, cands, ev, f" ({', '.join(sorted(names))} not seen running: {why})")
+        self.mission_shown = []
 
     def close(self) -> None:
         """The record ended (at the last event's time)."""
@@ -439,6 +446,7 @@ class VehicleObserver(Answers):
             if p.ack is None and p.late_booked and not p.missing_booked:
                 p.missing_booked = True
                 self._book_missing(p)
+        self._mission_unshown("the record ended")
         self.checks.close()
         if self.aborted:
             for cid in self.ledger.order:
