@@ -80,7 +80,7 @@ def main(argv=None) -> int:
               f"overhead {100 * over:.0f} % (targets: < 90 s, overhead < 25 %)")
         if r["explore"]:
             e = r["explore"]
-            print(f"  exploration: {e.get('executions')} sequences in {e.get('wall_s')} s, outcome {e.get('outcome')}")
+            print(f"  exploration: {e.get('ran')} sequences in {e.get('wall_s')} s, outcome {e.get('outcome')}")
         rc |= r["verdict"] != "pass"
     rows = detection(a.time_scale, 1 if a.quick else a.repeat)
     print(f"time to detect each shipped fault (median of {1 if a.quick else a.repeat}, k={a.time_scale:g}):")

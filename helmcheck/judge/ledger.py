@@ -105,6 +105,8 @@ class Ledger:
             return  # a clause outside this ledger (not selected, or the other role)
         lv = e.levels[kind]
         lv.count += 1
+        if lv.evidence and lv.reason and len(lv.lines) >= MAX_LINES and (not case or case in e.cases):
+            return  # everything kept is full: only the count changes (the common, repeated finding)
         if not lv.reason and reason:
             lv.reason = reason
         ev = list(evidence)

@@ -98,6 +98,7 @@ class VehicleObserver(Answers):
         self.events: list[dict] = []
         self.checks = osichecks.OsiChecks(self)
         self._decoded: dict = {}
+        self._escaped: dict = {}  #: a line's evidence text (sessions repeat their lines)
         self.closed = False
         self.aborted = ""
         #: (mode before, command ID) of every accepted control command in a remote mode (coverage)
@@ -184,7 +185,12 @@ class VehicleObserver(Answers):
 
     def _evidence(self, ev: WireEvent, raw: bytes, direction: str) -> Evidence:
         if raw.endswith(b"\r\n") and b"\n" not in raw[:-1]:
-            return Evidence(ev.t, direction, escape(raw[:-2]), ev.lineno)
+            text = self._escaped.get(raw)
+            if text is None:
+                if len(self._escaped) >= 4096:
+                    self._escaped.clear()
+                text = self._escaped[raw] = escape(raw[:-2])
+            return Evidence(ev.t, direction, text, ev.lineno)
         return Evidence(ev.t, direction + "~", escape(raw[:200]), ev.lineno)
 
     def _note(self, ev: WireEvent) -> None:
