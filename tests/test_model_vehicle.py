@@ -710,3 +710,22 @@ def test_missions_need_waypoints():
     with pytest.raises(ValueError):
         Mission("empty.mis", ())
     assert Mission("one.mis", [Waypoint(0, 0)]).last == 0
+
+
+def test_a_clone_and_its_original_keep_their_own_histories():
+    """``clone`` shares the bounded histories until one side writes (copy on write): an
+    ``$OPOS`` or a log row on either side never shows on the other (RH-POS-1, RH-LOG-2)."""
+    m = started()
+    m.receive(opos(), 1.0)
+    c = m.clone()
+    c.receive(opos(), 2.0)
+    m.receive(ologl("a", "b"), 2.0)
+    assert (len(m.opos_records), len(c.opos_records)) == (1, 2)
+    m2 = fresh()
+    m2.receive(ologl("a", "b"), 0.0)
+    m2.receive(omstart(), 0.5)
+    d = m2.clone()
+    d.receive(ologd("1", "2"), 1.0)
+    assert (len(m2.log_rows), len(d.log_rows)) == (0, 1)
+    m2.receive(ologd("3", "4"), 1.0)
+    assert [r for r in m2.log_rows] != [r for r in d.log_rows] and len(m2.log_rows) == 1

@@ -117,6 +117,15 @@ class Ledger:
         if case:
             e.cases[case] = None
 
+    def keeps(self, cid: str, kind: str, case: str = "") -> bool:
+        """Whether a finding of ``kind`` would still keep its reason or evidence (else it only
+        counts): lets a hot path skip formatting a reason nobody will read."""
+        e = self._e.get(cid)
+        if e is None:
+            return False
+        lv = e.levels[kind]
+        return not (lv.evidence and lv.reason and len(lv.lines) >= MAX_LINES and (not case or case in e.cases))
+
     def passed(self, cid: str, reason: str = "", evidence: Iterable[Evidence] = (), case: str = "") -> None:
         """The clause was exercised and met (the first call's reason and evidence are kept)."""
         self._add(cid, "pass", reason, evidence, case)

@@ -192,6 +192,7 @@ def _do_opos(m: VehicleModel, row: Row, c: s.OPOS, now: float) -> list[s.Reply]:
         changes.update(lat=float(c.lat), lon=float(c.lon), speed_kn=float(c.speed))
     if changes:
         m._set_snapshot(m.snapshot.with_(**changes))
+    m._own_history()
     m.opos_records.append(OposRecord(now, c, applied))
     return [_ack(6)]
 

@@ -137,6 +137,7 @@ class VehicleModel:
         self.log_rows: deque[LogRow] = deque(maxlen=self.HISTORY)
         self.log_row_count = 0  #: rows ever written to the main log (monotonic, RH-LOG-2)
         self.opos_records: deque[OposRecord] = deque(maxlen=self.HISTORY)
+        self._history_shared = False  #: ``log_rows``/``opos_records`` shared with a clone (copy on write)
         #: changes whenever the remote-control goal may have changed (see the module docstring)
         self.control_generation = 0
         self.settings = SettingsStore(profile)
@@ -442,8 +443,7 @@ class VehicleModel:
         """An independent copy (for shadows and what-if questions)."""
         new = copy.copy(self)
         new.queue = list(self.queue)
-        new.log_rows = deque(self.log_rows, maxlen=self.HISTORY)
-        new.opos_records = deque(self.opos_records, maxlen=self.HISTORY)
+        self._history_shared = new._history_shared = True  # both copy before their next append
         new.settings = self.settings.copy()
         new.timers = self.timers.copy()
         new._pending = []
@@ -501,8 +501,16 @@ class VehicleModel:
         p = self._snap
         return distance_m(p.lat, p.lon, target[0], target[1])
 
+    def _own_history(self) -> None:
+        """Take a private copy of the bounded histories before changing them (a clone shares them)."""
+        if self._history_shared:
+            self.log_rows = deque(self.log_rows, maxlen=self.HISTORY)
+            self.opos_records = deque(self.opos_records, maxlen=self.HISTORY)
+            self._history_shared = False
+
     def _write_log_row(self, row: LogRow) -> None:
         """RH-LOG-2: keep ``row`` in the bounded history and count it."""
+        self._own_history()
         self.log_rows.append(row)
         self.log_row_count += 1
 

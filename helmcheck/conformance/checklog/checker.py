@@ -134,8 +134,10 @@ class _Backseat:
         self.observer = BackseatObserver(profile, self.ledger, time_scale=scale, baud=baud,
                                          resolution=resolution)
 
-    def chunk(self, c: Chunk) -> None:
-        if c.direction == NOTE:
+    def chunk(self, c: Chunk, we: Optional[WireEvent] = None) -> None:
+        if we is not None:
+            self.observer.feed(we)
+        elif c.direction == NOTE:
             self.observer.feed(WireEvent(c.t, NOTE, b"", c.note, c.lineno))
         elif c.direction == UNREADABLE:
             self.ledger.inconclusive("RH-BS-1", "a log line could not be read; the bytes there are unknown",
@@ -159,8 +161,10 @@ class _Vehicle:
         self.observer = VehicleObserver(profile, self.ledger, time_scale=scale, baud=baud,
                                         resolution=resolution, catalog=catalog)
 
-    def chunk(self, c: Chunk) -> None:
-        if c.direction == NOTE:
+    def chunk(self, c: Chunk, we: Optional[WireEvent] = None) -> None:
+        if we is not None:
+            self.observer.feed(we)
+        elif c.direction == NOTE:
             self.observer.feed(WireEvent(c.t, NOTE, b"", c.note, c.lineno))
         elif c.direction == UNREADABLE:
             self.ledger.inconclusive("RH-FRM-1", "a log line could not be read; the bytes there are unknown",
@@ -216,10 +220,13 @@ class _Checker:
             self.finding_count += 1
             if len(self.findings) < MAX_FINDINGS:
                 self.findings.append({"line": c.lineno, "finding": c.note})
+        we = None
+        if d in (">", "<", NOTE):  # one event for both observers (neither changes it)
+            we = WireEvent(c.t, d, c.data if d != NOTE else b"", c.note if d == NOTE else "", c.lineno)
         if self.vehicle is not None:
-            self.vehicle.chunk(c)
+            self.vehicle.chunk(c, we)
         if self.backseat is not None:
-            self.backseat.chunk(c)
+            self.backseat.chunk(c, we)
 
     def close(self) -> None:
         if self.vehicle is not None:

@@ -227,6 +227,9 @@ class Beliefs:
                             result.timings.append(self._bracket(tt, v, slack_v))
 
     def _keep(self, cands: list[Candidate]) -> None:
+        if len(cands) == 1:
+            self.cands = cands
+            return
         seen: dict = {}
         for c in sorted(cands, key=lambda c: c.events):
             key = c.signature()
