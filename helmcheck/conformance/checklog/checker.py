@@ -123,27 +123,36 @@ class _Hashing:
             yield raw
 
 
-class _Backseat:
+class _Side:
+    """One role's observer and ledger; each record goes to the observer as the live recorder fed
+    it (same times, same line numbers, notes included), so a wire log gets the run's verdicts."""
+
+    unreadable_clause = ""  #: the clause an unreadable log line leaves INCONCLUSIVE
+    ledger: Ledger
+    observer: "BackseatObserver | VehicleObserver"
+
+    def chunk(self, c: Chunk, we: Optional[WireEvent]) -> None:
+        """``we`` is the record as a wire event (``None`` for an unreadable line)."""
+        if we is not None:
+            self.observer.feed(we)
+        elif c.direction == UNREADABLE:
+            self.ledger.inconclusive(self.unreadable_clause, "a log line could not be read; the bytes there "
+                                                             "are unknown",
+                                     [LedgerEvidence(c.t, "!", f"{c.note}: {c.text[:120]}", c.lineno)])
+
+
+class _Backseat(_Side):
     """The backseat side of a check: every record to the backseat observer, its own ledger.
 
     The records are fed exactly as ``certify backseat``'s recorder fed them live (same times,
     same line numbers, notes included), so a wire log gets the verdicts the run got."""
 
+    unreadable_clause = "RH-BS-1"
+
     def __init__(self, profile: Profile, scale: float, resolution: float, baud: int):
         self.ledger = Ledger(BS_CLAUSES)
         self.observer = BackseatObserver(profile, self.ledger, time_scale=scale, baud=baud,
                                          resolution=resolution)
-
-    def chunk(self, c: Chunk, we: Optional[WireEvent] = None) -> None:
-        if we is not None:
-            self.observer.feed(we)
-        elif c.direction == NOTE:
-            self.observer.feed(WireEvent(c.t, NOTE, b"", c.note, c.lineno))
-        elif c.direction == UNREADABLE:
-            self.ledger.inconclusive("RH-BS-1", "a log line could not be read; the bytes there are unknown",
-                                     [LedgerEvidence(c.t, "!", f"{c.note}: {c.text[:120]}", c.lineno)])
-        else:
-            self.observer.feed(WireEvent(c.t, c.direction, c.data, "", c.lineno))
 
     def close(self, t: float, backseat_traffic: bool) -> None:
         if not backseat_traffic:
@@ -152,25 +161,16 @@ class _Backseat:
         self.observer.close(t)
 
 
-class _Vehicle:
+class _Vehicle(_Side):
     """The vehicle side of a check: every record to the vehicle observer, its own ledger — as
     ``certify vehicle``'s recorder fed them live."""
+
+    unreadable_clause = "RH-FRM-1"
 
     def __init__(self, profile: Profile, catalog, scale: float, resolution: float, baud: int):
         self.ledger = Ledger(VEHICLE_CLAUSES)
         self.observer = VehicleObserver(profile, self.ledger, time_scale=scale, baud=baud,
                                         resolution=resolution, catalog=catalog)
-
-    def chunk(self, c: Chunk, we: Optional[WireEvent] = None) -> None:
-        if we is not None:
-            self.observer.feed(we)
-        elif c.direction == NOTE:
-            self.observer.feed(WireEvent(c.t, NOTE, b"", c.note, c.lineno))
-        elif c.direction == UNREADABLE:
-            self.ledger.inconclusive("RH-FRM-1", "a log line could not be read; the bytes there are unknown",
-                                     [LedgerEvidence(c.t, "!", f"{c.note}: {c.text[:120]}", c.lineno)])
-        else:
-            self.observer.feed(WireEvent(c.t, c.direction, c.data, "", c.lineno))
 
     def entries(self, to_vehicle: bool, from_vehicle: bool) -> list:
         if not from_vehicle and not self.observer.aborted:
