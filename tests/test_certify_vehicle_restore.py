@@ -12,7 +12,6 @@ from __future__ import annotations
 import signal
 import subprocess
 import sys
-import time
 from pathlib import Path
 
 from helmcheck.conformance.emulator.process import EmulatorProcess, HelmClient
@@ -21,6 +20,7 @@ from helmcheck.conformance.vehicle.runner import Options, certify
 from helmcheck.grammar import sentences as s
 from helmcheck.reports.results import load_results
 from tests.faulty_vehicles.base import EMU_PROFILE, EmulatorCore, Model, Mutant, make_core, reframe, serve
+from tests.waiting import wait_for_text
 
 K = 40.0
 SETTINGS = ("Sop", "SafetyAction")
@@ -44,14 +44,6 @@ def _read_settings(port: str) -> dict:
         link.close()
 
 
-def _wait_for(path: Path, text: str, timeout: float = 90.0) -> None:
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        if path.exists() and text in path.read_text(errors="replace"):
-            return
-        time.sleep(0.05)
-    raise AssertionError(f"{text!r} never appeared in {path}")
-
 
 def test_sigterm_in_the_middle_of_a_settings_case_leaves_the_settings_as_found(tmp_path):
     rdir = tmp_path / "r"
@@ -64,7 +56,7 @@ def test_sigterm_in_the_middle_of_a_settings_case_leaves_the_settings_as_found(t
                                  "--examples", "0", "--no-progress", "--report-dir", str(rdir)],
                                 stdout=subprocess.PIPE, stderr=subprocess.PIPE, stdin=subprocess.DEVNULL)
         try:
-            _wait_for(rdir / "wire.log", "$ORWSET,SafetyAction,W,1,srp")  # V-63 wrote srp: SIGTERM now
+            wait_for_text(rdir / "wire.log", "$ORWSET,SafetyAction,W,1,srp")  # V-63 wrote srp: SIGTERM now
             proc.send_signal(signal.SIGTERM)
             out, err = proc.communicate(timeout=90)
         finally:

@@ -11,13 +11,13 @@ import re
 import signal
 import subprocess
 import sys
-import time
 from pathlib import Path
 
 from helmcheck.cli import main as cli_main
 from helmcheck.conformance.emulator.process import EmulatorProcess
 from helmcheck.reports.results import load_results
 from tests.judging import not_passed
+from tests.waiting import wait_for_text
 
 K = 25.0
 SELECT = "RH-SRV-*,RH-INT-*,RH-ACK-1"
@@ -28,14 +28,6 @@ def _certify(*args: str) -> subprocess.Popen:
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, stdin=subprocess.DEVNULL)
 
 
-def _wait_for(path: Path, pattern: str, timeout: float = 90.0) -> None:
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        if path.exists() and re.search(pattern, path.read_text(errors="replace")):
-            return
-        time.sleep(0.05)
-    raise AssertionError(f"{pattern!r} never appeared in {path}")
-
 
 def test_an_interrupted_run_resumes_from_its_last_completed_case(tmp_path):
     rdir = tmp_path / "r"
@@ -44,7 +36,7 @@ def test_an_interrupted_run_resumes_from_its_last_completed_case(tmp_path):
     with EmulatorProcess(time_scale=K, baud=115200) as emu:
         first = _certify("--port", emu.port, "--time-scale", str(K), "--profile", str(prof), "--select", SELECT,
                          "--examples", "0", "--report-dir", str(rdir))
-        _wait_for(rdir / "wire.log", r"case V-22 end")  # three cases done, the fourth under way
+        wait_for_text(rdir / "wire.log", "case V-22 end")  # three cases done, the fourth under way
         first.send_signal(signal.SIGTERM)
         first.communicate(timeout=60)
         assert first.returncode == 2

@@ -19,20 +19,13 @@ import pytest
 
 from helmcheck.conformance.emulator.process import EmulatorProcess
 from helmcheck.reports.results import load_results
+from tests.waiting import wait_for_text
 
 HERE = Path(__file__).resolve().parent
 GOOD_BACKSEAT = HERE / "backseats" / "good_backseat.py"
 K = 20.0
 SIGNALS = [pytest.param(signal.SIGTERM, id="SIGTERM"), pytest.param(signal.SIGHUP, id="SIGHUP")]
 
-
-def _wait_for(path: Path, text: str, timeout: float = 60.0) -> None:
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        if path.exists() and text in path.read_text(errors="replace"):
-            return
-        time.sleep(0.1)
-    raise AssertionError(f"{text!r} never appeared in {path}")
 
 
 def _finish(proc: subprocess.Popen, timeout: float = 60.0) -> tuple[str, str]:
@@ -63,7 +56,7 @@ def test_certify_vehicle_signalled_mid_run_writes_partial_results_and_reports(si
                                  "--time-scale", str(K), "--report-dir", str(rdir), "--no-progress",
                                  "--examples", "0"],
                                 stdout=subprocess.PIPE, stderr=subprocess.PIPE, stdin=subprocess.DEVNULL)
-        _wait_for(rdir / "wire.log", "case ")  # the cases have started
+        wait_for_text(rdir / "wire.log", "case ", timeout=60.0)  # the cases have started
         time.sleep(2.0)
         proc.send_signal(sig)
         out, err = _finish(proc)
@@ -85,7 +78,7 @@ def test_certify_backseat_signalled_mid_run_writes_partial_results_and_reports(s
         port = proc.stdout.readline().decode().split(": ", 1)[1].strip()
         backseat = subprocess.Popen([sys.executable, str(GOOD_BACKSEAT), port, "--time-scale", "5"],
                                     stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-        _wait_for(rdir / "wire.log", "scenario nominal starts")
+        wait_for_text(rdir / "wire.log", "scenario nominal starts", timeout=60.0)
         time.sleep(2.0)
         proc.send_signal(sig)
         out, err = _finish(proc)
@@ -125,7 +118,7 @@ def test_a_second_sigterm_while_the_run_ends_does_not_lose_the_results(tmp_path)
                                  "--time-scale", str(K), "--report-dir", str(rdir), "--no-progress",
                                  "--examples", "0"],
                                 stdout=subprocess.PIPE, stderr=subprocess.PIPE, stdin=subprocess.DEVNULL)
-        _wait_for(rdir / "wire.log", "case ")
+        wait_for_text(rdir / "wire.log", "case ", timeout=60.0)
         time.sleep(1.0)
         for _ in range(5):
             proc.send_signal(signal.SIGTERM)
