@@ -18,6 +18,7 @@ from helmcheck.model.plant import (AtSurface, OnStation, PlantSnapshot, QueueWay
 from helmcheck.model.testing import (catalog, odvl, ojw, ologd, ologl, omload, omp, oms, omstart,
                                      omstart_paper, omstop, omw, omw_clear, opk, opos, orwset, osd,
                                      oxflt, oxflt_profile, started)
+from helmcheck.model.data import CLASS_OF_LETTER
 from helmcheck.model.vehicle import VehicleModel
 from helmcheck.profile import DEFAULT, SAFETY_CODES
 
@@ -513,6 +514,23 @@ def test_RH_OSD_1_osd_order_repeats_positional_and_in_lockout():
     out = m.receive(osd("S", "G", "S"), 1.0)
     assert [type(x) for x in out] == [s.OSI, s.GPRMC, s.OSI, s.ACK]
     assert m.receive(osd(), 1.0) == [ack(8)]
+
+
+def test_RH_OSD_1_answers_by_class_name_name_the_classes_sent():
+    """An observer's model answers ``$OSD`` by class name: the names must be those of the
+    sentences a model answering in full sends, letter by letter, with a fix and without."""
+    letters = ("S", "G", "C", "P", "D", "Y", "T", "I")
+    full = VehicleModel(DEFAULT.replace(osd_letters="".join(letters)), catalog())
+    named = VehicleModel(DEFAULT.replace(osd_letters="".join(letters)), catalog())
+    named.data_names = True
+    for m in (full, named):
+        m.receive(omstart(), 0.0)
+    for depth in (0.0, 4.0):  # at the surface (a fix) and submerged
+        for m in (full, named):
+            m.plant(Submerged(depth), 1.0)
+        want = [type(x).__name__ for x in full.receive(osd(*letters), 1.0)[:-1]]
+        assert named.receive(osd(*letters), 1.0)[:-1] == want
+        assert want == [CLASS_OF_LETTER[x].__name__ for x in letters]
 
 
 def test_RH_OSD_2_bad_letter_rejects_missing_sensor_skipped():

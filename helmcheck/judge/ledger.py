@@ -21,7 +21,7 @@ numbers per clause), so a ledger stays small whatever the length of the run.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Iterable, Optional
+from typing import Iterable, NamedTuple, Optional
 
 from ..clauses import catalogue
 
@@ -33,9 +33,9 @@ MAX_LINES = 50
 RANK = {"not-tested": 0, "pass": 1, "inconclusive": 2, "non-strict": 3, "fail": 3}
 
 
-@dataclass(frozen=True, slots=True)
-class Evidence:
-    """One line of wire evidence: time, wire-log direction, text as logged, log line number."""
+class Evidence(NamedTuple):
+    """One line of wire evidence: time, wire-log direction, text as logged, log line number.
+    (A named tuple: immutable, and cheap to make once per line of a long log.)"""
 
     t: float
     dir: str  #: ">" / "<" (a CR LF line), ">~" / "<~" (any other run), "!" (a note)
@@ -67,15 +67,16 @@ class ClauseVerdict:
                 "lines": list(self.lines), "offending_count": self.offending_count, "replay": None}
 
 
-@dataclass
+@dataclass(slots=True)
 class _Level:
     count: int = 0
     reason: str = ""
     evidence: list = field(default_factory=list)
     lines: list = field(default_factory=list)
+    full: bool = False  #: reason, evidence and lines all kept: a further finding only counts
 
 
-@dataclass
+@dataclass(slots=True)
 class _Entry:
     levels: dict = field(default_factory=lambda: {k: _Level() for k in ("pass", "fail", "inconclusive",
                                                                           "not-tested")})
@@ -105,7 +106,7 @@ class Ledger:
             return  # a clause outside this ledger (not selected, or the other role)
         lv = e.levels[kind]
         lv.count += 1
-        if lv.evidence and lv.reason and len(lv.lines) >= MAX_LINES and (not case or case in e.cases):
+        if lv.full and (not case or case in e.cases):
             return  # everything kept is full: only the count changes (the common, repeated finding)
         if not lv.reason and reason:
             lv.reason = reason
@@ -116,6 +117,7 @@ class Ledger:
             lv.evidence = ev[:MAX_EVIDENCE]
         if case:
             e.cases[case] = None
+        lv.full = bool(lv.evidence and lv.reason and len(lv.lines) >= MAX_LINES)
 
     def keeps(self, cid: str, kind: str, case: str = "") -> bool:
         """Whether a finding of ``kind`` would still keep its reason or evidence (else it only
@@ -124,11 +126,32 @@ class Ledger:
         if e is None:
             return False
         lv = e.levels[kind]
-        return not (lv.evidence and lv.reason and len(lv.lines) >= MAX_LINES and (not case or case in e.cases))
+        return not (lv.full and (not case or case in e.cases))
 
     def passed(self, cid: str, reason: str = "", evidence: Iterable[Evidence] = (), case: str = "") -> None:
         """The clause was exercised and met (the first call's reason and evidence are kept)."""
+        e = self._e.get(cid)
+        if e is None:
+            return
+        lv = e.levels["pass"]
+        if lv.full and (not case or case in e.cases):
+            lv.count += 1  # the common, repeated pass: only the count changes
+            return
         self._add(cid, "pass", reason, evidence, case)
+
+    def passed_all(self, passes: Iterable[tuple[str, str]], evidence: Iterable[Evidence] = (),
+                   case: str = "") -> None:
+        """:meth:`passed` for each ``(clause, reason)`` of ``passes``, with the same evidence."""
+        get = self._e.get
+        for cid, reason in passes:
+            e = get(cid)
+            if e is None:
+                continue
+            lv = e.levels["pass"]
+            if lv.full and (not case or case in e.cases):
+                lv.count += 1
+            else:
+                self._add(cid, "pass", reason, evidence, case)
 
     def failed(self, cid: str, reason: str, evidence: Iterable[Evidence] = (), case: str = "") -> None:
         """The clause was violated: ``fail`` for a MUST, ``non-strict`` for a SHOULD."""

@@ -41,7 +41,7 @@ from __future__ import annotations
 import ast
 import re
 from dataclasses import dataclass
-from typing import Any, Optional
+from typing import Any, NamedTuple, Optional
 
 from ..profile import SAFETY_CODES
 
@@ -53,9 +53,9 @@ FROM_VEHICLE = "<"
 NOTE = "!"
 
 
-@dataclass(frozen=True, slots=True)
-class WireEvent:
-    """One record: bytes one way, or a note, at ``t`` wall seconds since the record began."""
+class WireEvent(NamedTuple):
+    """One record: bytes one way, or a note, at ``t`` wall seconds since the record began.
+    (A named tuple: immutable, and cheap to make once per line of a long log.)"""
 
     t: float
     dir: str  #: ">", "<" or "!"

@@ -28,7 +28,7 @@ from ..grammar import sentences as s
 from ..profile import Profile
 from .plant import PlantSnapshot
 
-__all__ = ["DataCache", "dec", "park_seconds"]
+__all__ = ["DataCache", "CLASS_OF_LETTER", "dec", "park_seconds"]
 
 _FT = 0.3048
 
@@ -172,6 +172,9 @@ class DataCache:
 
 _BUILDERS = {"C": DataCache._compass, "G": DataCache._gprmc, "P": DataCache._opi,
              "D": DataCache._dvl, "Y": DataCache._ysi, "T": DataCache._ctd, "I": DataCache._ins}
+#: The sentence class each ``$OSD`` letter is answered with (RH-OSD-1).
+CLASS_OF_LETTER: dict[str, type] = {"S": s.OSI, "C": s.Compass, "G": s.GPRMC, "P": s.OPI, "D": s.DVL,
+                                    "Y": s.OYSI, "T": s.OCTD, "I": s.OINS}
 
 
 def park_seconds(remaining: Optional[float]) -> int:

@@ -55,7 +55,6 @@ Decisions (spec open), besides those in :mod:`~helmcheck.model.transitions`:
 
 from __future__ import annotations
 
-import copy
 from collections import deque
 from typing import NamedTuple, Optional, Union
 
@@ -63,7 +62,7 @@ from ..grammar import sentences as s
 from ..grammar.errors import SentenceError
 from ..profile import DEFAULT, SAFETY_CODES, Profile
 from . import events as ev
-from .data import DataCache, park_seconds
+from .data import CLASS_OF_LETTER, DataCache, park_seconds
 from .geo import distance_m
 from .missions import BadMission, InMemoryCatalog, Mission, MissingMission, MissionCatalog, normalise_name
 from .plant import (NEUTRAL, AtSurface, OnStation, PlantEvent, PlantSnapshot, QueueWaypointReached,
@@ -149,6 +148,9 @@ class VehicleModel:
         self.checkpoints = True
         #: when a list, every table row applied is appended as a :class:`Step` (for observers)
         self.trace: Optional[list] = None
+        #: ``$OSD`` answers carry each data sentence's class name (``"OSI"``), not the sentence:
+        #: for observers that judge which sentences come and in what order, not their values
+        self.data_names = False
         self._firing: Optional[tuple[str, float]] = None
         self._snap = snapshot if snapshot is not None else PlantSnapshot()
         self._data = DataCache(profile, self._snap)
@@ -434,14 +436,18 @@ class VehicleModel:
             mission_name=m.name if m is not None else "", srp_active=self.srp_active)
 
     def data(self, letter: str, now: Optional[float] = None) -> s.Reply:
-        """The data sentence for one ``$OSD`` letter (RH-OSD-1)."""
+        """The data sentence for one ``$OSD`` letter (RH-OSD-1); its class name only when
+        :attr:`data_names` is set."""
+        if self.data_names:
+            return CLASS_OF_LETTER[letter].__name__  # type: ignore[return-value]
         if letter == "S":
             return self.osi(now)
         return self._data.sentence(letter, self.gps_fix)
 
     def clone(self) -> "VehicleModel":
         """An independent copy (for shadows and what-if questions)."""
-        new = copy.copy(self)
+        new = type(self).__new__(type(self))
+        new.__dict__.update(self.__dict__)
         new.queue = list(self.queue)
         self._history_shared = new._history_shared = True  # both copy before their next append
         new.settings = self.settings.copy()

@@ -21,10 +21,11 @@ timeline and events are capped by the observers.
 from __future__ import annotations
 
 import hashlib
+import os
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Callable, Optional
+from typing import BinaryIO, Callable, Optional
 
 from ...clauses import vehicle_clauses
 from ...judge.backseat import BS_CLAUSES, BackseatObserver
@@ -33,13 +34,18 @@ from ...judge.vehicle import VehicleObserver
 from ...judge.wire import WireEvent
 from ...model.missions import MissionCatalog
 from ...profile import DEFAULT, Profile
-from .readers import NOTE, UNREADABLE, Chunk, LogMeta, detect_format, read_chunks, timestamp_resolution
+from .readers import (NOTE, Chunk, LogMeta, detect_format, header_comment, read_chunks,
+                      timestamp_resolution)
+from .sidejob import SideJob, SideJobLost, cores
 
 __all__ = ["check_log", "CheckOutcome", "LogFormatError", "ROLES", "VEHICLE_CLAUSES"]
 
 ROLES = ("vehicle", "backseat", "both")
 HEAD_BYTES = 64 * 1024
 MAX_FINDINGS = 50
+#: From this size on, ``role="both"`` judges the backseat role in a second process (when the
+#: machine has a second core): below it, starting that process costs more than it saves.
+PARALLEL_BYTES = 4 * 1024 * 1024
 VEHICLE_CLAUSES = tuple(c.id for c in vehicle_clauses())
 
 
@@ -71,42 +77,86 @@ class CheckOutcome:
 
 def check_log(path: Path | str, *, profile: Profile = DEFAULT, role: str = "both",
               catalog: Optional[MissionCatalog] = None, time_scale: Optional[float] = None,
-              swap: bool = False, progress: Optional[Callable[[int], None]] = None) -> CheckOutcome:
+              swap: bool = False, progress: Optional[Callable[[int], None]] = None,
+              parallel: Optional[bool] = None) -> CheckOutcome:
     """Check one log file. ``OSError`` if it cannot be read, :class:`LogFormatError` if it is
-    no known log format."""
+    no known log format.
+
+    ``parallel``: judge the backseat role of ``role="both"`` in a second process (the roles are
+    independent; the verdicts are the same either way). ``None`` decides by itself: for a log of
+    at least :data:`PARALLEL_BYTES` on a machine with more than one core."""
     if role not in ROLES:
         raise ValueError(f"role must be one of {ROLES}")
     path = Path(path)
     started = time.monotonic()
     with open(path, "rb") as f:
-        head = f.read(HEAD_BYTES)
-        fmt = detect_format(head)
-        if fmt is None:
-            raise LogFormatError(f"{path}: not a helmcheck wire log, socat -v or socat -x capture")
-        f.seek(0)
-        meta = LogMeta(format=fmt, resolution=timestamp_resolution(head, fmt))
-        for ln in head.split(b"\n")[:16]:
-            if ln.startswith(b"#") and fmt == "wirelog":
-                from .readers import _header_comment
-                _header_comment(ln.decode("utf-8", "replace"), meta)
-        meta.header = meta.header[:8]
+        fmt, meta = _head(f, path)
         scale = time_scale if time_scale is not None else (meta.time_scale or profile.time_scale or 1.0)
         baud = meta.baud or profile.baud
-        checker = _Checker(profile, role, catalog, scale, meta.resolution, baud)
-        sha = hashlib.sha256()
-        f.seek(0)
-
-        def prog(n: int) -> None:
-            if progress is not None:
-                progress(n)
-
-        reader = read_chunks(_Hashing(f, sha), fmt, meta, swap=swap, progress=prog)
-        for chunk in reader:
-            checker.chunk(chunk)
-        checker.close()
-    out = checker.outcome(path, fmt, meta, sha.hexdigest())
+        if parallel is None:
+            parallel = role == "both" and os.fstat(f.fileno()).st_size >= PARALLEL_BYTES and cores() > 1
+        side = None
+        if parallel and role == "both":
+            side = SideJob(_backseat_entries, str(path), fmt, profile, scale, meta.resolution, baud, swap)
+        try:
+            checker = _Checker(profile, role, catalog, scale, meta.resolution, baud,
+                               judge_backseat=side is None)
+            sha = _feed(f, checker, fmt, meta, swap, progress)
+            if side is not None:
+                try:
+                    entries, side_sha = side.result()
+                except SideJobLost:  # judge it here after all
+                    entries, side_sha = _backseat_entries(str(path), fmt, profile, scale, meta.resolution,
+                                                          baud, swap)
+                if side_sha != sha:
+                    raise LogFormatError(f"{path}: the file changed while it was being checked")
+                checker.backseat_entries = entries
+        finally:
+            if side is not None:
+                side.stop()
+    out = checker.outcome(path, fmt, meta, sha)
     out.seconds = time.monotonic() - started
     return out
+
+
+def _head(f: BinaryIO, path: Path) -> tuple[str, LogMeta]:
+    """The format and what the first :data:`HEAD_BYTES` say (timestamp step, header); ``f`` is
+    left at its start."""
+    head = f.read(HEAD_BYTES)
+    fmt = detect_format(head)
+    if fmt is None:
+        raise LogFormatError(f"{path}: not a helmcheck wire log, socat -v or socat -x capture")
+    f.seek(0)
+    meta = LogMeta(format=fmt, resolution=timestamp_resolution(head, fmt))
+    if fmt == "wirelog":
+        for ln in head.split(b"\n")[:16]:
+            if ln.startswith(b"#"):
+                header_comment(ln.decode("utf-8", "replace"), meta)
+    meta.header = meta.header[:8]
+    return fmt, meta
+
+
+def _feed(f: BinaryIO, checker: "_Checker", fmt: str, meta: LogMeta, swap: bool,
+          progress: Optional[Callable[[int], None]]) -> str:
+    """Every record of ``f`` to ``checker``, then close it; returns the SHA-256 of the bytes read."""
+    sha = hashlib.sha256()
+    for chunk in read_chunks(_Hashing(f, sha), fmt, meta, swap=swap, progress=progress):
+        checker.chunk(chunk)
+    checker.close()
+    return sha.hexdigest()
+
+
+def _backseat_entries(path: str, fmt: str, profile: Profile, scale: float, resolution: float, baud: int,
+                      swap: bool) -> tuple[list, str]:
+    """The backseat role of a check on its own (the side job of a parallel check): its ledger
+    entries, and the SHA-256 of the bytes it read."""
+    with open(path, "rb") as f:
+        fmt2, meta = _head(f, Path(path))
+        if fmt2 != fmt:
+            raise LogFormatError(f"{path}: the file changed while it was being checked")
+        checker = _Checker(profile, "backseat", None, scale, resolution, baud)
+        sha = _feed(f, checker, fmt, meta, swap, None)
+    return checker.backseat.ledger.entries(), sha  # type: ignore[union-attr]
 
 
 class _Hashing:
@@ -131,14 +181,11 @@ class _Side:
     ledger: Ledger
     observer: "BackseatObserver | VehicleObserver"
 
-    def chunk(self, c: Chunk, we: Optional[WireEvent]) -> None:
-        """``we`` is the record as a wire event (``None`` for an unreadable line)."""
-        if we is not None:
-            self.observer.feed(we)
-        elif c.direction == UNREADABLE:
-            self.ledger.inconclusive(self.unreadable_clause, "a log line could not be read; the bytes there "
-                                                             "are unknown",
-                                     [LedgerEvidence(c.t, "!", f"{c.note}: {c.text[:120]}", c.lineno)])
+    def unreadable(self, c: Chunk) -> None:
+        """A log line that could not be read: the bytes there are unknown."""
+        self.ledger.inconclusive(self.unreadable_clause, "a log line could not be read; the bytes there "
+                                                         "are unknown",
+                                 [LedgerEvidence(c.t, "!", f"{c.note}: {c.text[:120]}", c.lineno)])
 
 
 class _Backseat(_Side):
@@ -187,11 +234,17 @@ class _Vehicle(_Side):
 
 
 class _Checker:
-    def __init__(self, profile: Profile, role: str, catalog, scale: float, resolution: float, baud: int):
+    def __init__(self, profile: Profile, role: str, catalog, scale: float, resolution: float, baud: int,
+                 judge_backseat: bool = True):
         self.profile = profile
         self.role = role
         self.vehicle = _Vehicle(profile, catalog, scale, resolution, baud) if role in ("vehicle", "both") else None
-        self.backseat = _Backseat(profile, scale, resolution, baud) if role in ("backseat", "both") else None
+        self.backseat = (_Backseat(profile, scale, resolution, baud)
+                         if role in ("backseat", "both") and judge_backseat else None)
+        #: the backseat role's entries when a side job judged it (:func:`check_log`)
+        self.backseat_entries: Optional[list] = None
+        self.sides: list[_Side] = [x for x in (self.vehicle, self.backseat) if x is not None]
+        self.feeds = [x.observer.feed for x in self.sides]
         self.scale = scale
         self.r = resolution
         self.mission_known = catalog is not None
@@ -210,23 +263,24 @@ class _Checker:
         if d == ">":
             st["records_to_vehicle"] += 1
             st["bytes_to_vehicle"] += len(c.data)
+            we = WireEvent(c.t, d, c.data, "", c.lineno)
         elif d == "<":
             st["records_from_vehicle"] += 1
             st["bytes_from_vehicle"] += len(c.data)
+            we = WireEvent(c.t, d, c.data, "", c.lineno)
         elif d == NOTE:
             st["notes"] += 1
-        elif d == UNREADABLE:
+            we = WireEvent(c.t, d, b"", c.note, c.lineno)
+        else:
             st["unreadable"] += 1
             self.finding_count += 1
             if len(self.findings) < MAX_FINDINGS:
                 self.findings.append({"line": c.lineno, "finding": c.note})
-        we = None
-        if d in (">", "<", NOTE):  # one event for both observers (neither changes it)
-            we = WireEvent(c.t, d, c.data if d != NOTE else b"", c.note if d == NOTE else "", c.lineno)
-        if self.vehicle is not None:
-            self.vehicle.chunk(c, we)
-        if self.backseat is not None:
-            self.backseat.chunk(c, we)
+            for side in self.sides:
+                side.unreadable(c)
+            return
+        for feed in self.feeds:  # one event for both observers (neither changes it)
+            feed(we)
 
     def close(self) -> None:
         if self.vehicle is not None:
@@ -253,6 +307,8 @@ class _Checker:
             st["vehicle_discards"] = obs.out.discards
         if self.backseat is not None:
             clauses += self.backseat.ledger.entries()
+        elif self.backseat_entries is not None:
+            clauses += self.backseat_entries
         return CheckOutcome(path=path, format=fmt, role=self.role, clauses=clauses, meta=meta,
                             time_scale=self.scale, resolution=self.r, stats=dict(st),
                             findings=list(self.findings), timeline=timeline, events=events, sha256=sha,

@@ -98,7 +98,7 @@ class Chunk:
     lineno: int
     note: str = ""
     complete: bool = False
-    text: str = ""  #: the payload as written in the log (for evidence)
+    text: str = ""  #: an unreadable line's text as written (for evidence)
 
 
 @dataclass
@@ -128,7 +128,9 @@ _SOCAT_HEADER = re.compile(
     rb"([<>]) (\d{4})/(\d\d)/(\d\d) (\d\d):(\d\d):(\d\d)(?:\.(\d+))?\s+length=(\d+) from=(\d+) to=(-?\d+)\s*$")
 _SOCAT_HEADER_ANYWHERE = re.compile(
     rb"([<>]) (\d{4})/(\d\d)/(\d\d) (\d\d):(\d\d):(\d\d)(?:\.(\d+))?\s+length=(\d+) from=(\d+) to=(-?\d+)[ \t]*\r?\n?$")
-_WIRE_RECORD = re.compile(rb"^(\d+(?:\.(\d+))?) (>~|<~|>|<|!) ?(.*?)\r?\n?$", re.S)
+#: A record's head: seconds, direction, one optional space; the payload is the rest of the line
+#: less its line end (a "\n", then a "\r").
+_WIRE_HEAD = re.compile(rb"(\d+(?:\.(\d+))?) (>~|<~|>|<|!) ?")
 _HEX_LINE = re.compile(rb"^(?: [0-9a-fA-F]{2})+\s*$")
 
 
@@ -147,7 +149,7 @@ def detect_format(head: bytes) -> Optional[str]:
             if _HEX_LINE.match(nxt) or (len(nxt) > 50 and nxt[:1] == b" " and b"  " in nxt[48:]):
                 return "socat-x"
             return "socat-v"
-        if _WIRE_RECORD.match(ln):
+        if _WIRE_HEAD.match(ln):
             return "wirelog"
         return None
     return None
@@ -260,7 +262,7 @@ def timestamp_resolution(head: bytes, fmt: str) -> float:
     best = 1.0
     if fmt == "wirelog":
         for ln in head.split(b"\n")[:2000]:
-            m = _WIRE_RECORD.match(ln)
+            m = _WIRE_HEAD.match(ln)
             if m and m.group(3) != b"!":
                 best = min(best, _decimals_resolution(m.group(2)))
         return best
@@ -292,7 +294,7 @@ _BAUD = re.compile(r"\bbaud[ =:]+(\d+)")
 _SWAP = {">": "<", "<": ">"}
 
 
-def _header_comment(text: str, meta: LogMeta) -> None:
+def header_comment(text: str, meta: LogMeta) -> None:
     if len(meta.header) < 8:
         meta.header.append(text[1:].strip())
     m = _SCALE.search(text)
@@ -313,14 +315,15 @@ def _read_wirelog(f: BinaryIO, meta: LogMeta, swap: bool, progress: Progress) ->
     meta.time_unit = "decimal"
     meta.time_unit_basis = "wire-log 1 times are decimal seconds since the log began"
     n = 0
-    match = _WIRE_RECORD.match
+    match = _WIRE_HEAD.match
+    dirs = _SWAPPED_DIRS if swap else _DIRS
     for raw in f:
         n += 1
         if progress is not None:
             progress(len(raw))
         if raw[:1] == b"#":
             if n <= 16:
-                _header_comment(raw.decode("utf-8", "replace").rstrip("\r\n"), meta)
+                header_comment(raw.decode("utf-8", "replace").rstrip("\r\n"), meta)
             continue
         m = match(raw)
         if m is None:
@@ -329,26 +332,32 @@ def _read_wirelog(f: BinaryIO, meta: LogMeta, swap: bool, progress: Progress) ->
             yield Chunk(0.0, UNREADABLE, b"", n, "not a wire-log record (want '<seconds> <dir> <payload>')",
                         text=raw.decode("utf-8", "replace").rstrip("\r\n")[:200])
             continue
-        t = float(m.group(1))
-        d = m.group(3).decode()
-        payload = m.group(4)
-        if d == "!":
+        stamp, _, d = m.groups()
+        t = float(stamp)
+        payload = raw[m.end():]
+        if payload[-1:] == b"\n":
+            payload = payload[:-1]
+        if payload[-1:] == b"\r":
+            payload = payload[:-1]
+        if d == b"!":
             yield Chunk(t, NOTE, b"", n, payload.decode("utf-8", "replace"))
             continue
-        try:
-            text = payload.decode("ascii")
-        except UnicodeDecodeError:
+        if not payload.isascii():
             yield Chunk(t, UNREADABLE, b"", n, "payload is not ASCII (bytes must be escaped as \\xNN)",
                         text=payload.decode("utf-8", "replace")[:200])
             continue
-        data = unescape(text) if "\\" in text else text.encode("ascii")
-        direction = d[0]
-        if swap:
-            direction = _SWAP[direction]
-        if len(d) == 1:
-            yield Chunk(t, direction, data + b"\r\n", n, complete=True, text=text)
+        if b"\\" in payload:
+            payload = unescape(payload.decode("ascii"))
+        direction, whole = dirs[d]
+        if whole:
+            yield Chunk(t, direction, payload + b"\r\n", n, complete=True)
         else:
-            yield Chunk(t, direction, data, n, text=text)
+            yield Chunk(t, direction, payload, n)
+
+
+#: wire-log direction → (the chunk's direction, a whole CR LF line); as written, and swapped
+_DIRS = {b">": (">", True), b"<": ("<", True), b">~": (">", False), b"<~": ("<", False)}
+_SWAPPED_DIRS = {b">": ("<", True), b"<": (">", True), b">~": ("<", False), b"<~": (">", False)}
 
 
 _V_ESC = {ord("r"): 13, ord("a"): 7, ord("b"): 8, ord("v"): 11, ord("f"): 12, ord("\\"): 92,
@@ -441,7 +450,7 @@ def _read_socat(f: BinaryIO, meta: LogMeta, swap: bool, progress: Progress, hex_
                 if not line.strip():
                     break
                 if line.startswith(b"#") and not clock.started():
-                    _header_comment(line.decode("utf-8", "replace").rstrip("\r\n"), meta)
+                    header_comment(line.decode("utf-8", "replace").rstrip("\r\n"), meta)
                     break
                 m = _SOCAT_HEADER_ANYWHERE.match(line)
                 if m is None:

@@ -219,7 +219,7 @@ class Answers:
             if got:
                 self.book("fail", ("RH-OSD-2",), f"a refused $OSD carried {len(got)} data sentence(s)", ev, at=p)
             return
-        want = [type(r).__name__ for r in p.expected if not isinstance(r, s.ACK)]
+        want = [r if isinstance(r, str) else type(r).__name__ for r in p.expected if not isinstance(r, s.ACK)]
         if got == want:
             if want:
                 self.ledger.passed("RH-ACK-5", "the data came before the $ACK,8", ev, self.case)

@@ -1,7 +1,8 @@
 """One state a conforming vehicle may be in: a reference model plus what the observer adopted.
 
 A :class:`Candidate` wraps a :class:`~helmcheck.model.vehicle.VehicleModel` (with its row
-``trace`` on) and keeps, besides the model, what judging needs and the model does not:
+``trace`` on, and ``$OSD`` data answered by class name: the judge compares which sentences come,
+never their values) and keeps, besides the model, what judging needs and the model does not:
 
 * ``events`` / ``story`` — the unseen plant events adopted to explain the wire (fewer is more
   plausible) and what they were;
@@ -82,6 +83,7 @@ class Candidate:
     def __init__(self, model: VehicleModel):
         if model.trace is None:
             model.trace = []
+        model.data_names = True  # the judge compares which data sentences come, not their values
         self.model = model
         self.events = 0
         self.story: tuple[str, ...] = ()

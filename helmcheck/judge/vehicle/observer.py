@@ -99,6 +99,9 @@ class VehicleObserver(Answers):
         self.checks = osichecks.OsiChecks(self)
         self._decoded: dict = {}
         self._escaped: dict = {}  #: a line's evidence text (sessions repeat their lines)
+        self._kinds: dict = {}  #: a backseat line's :class:`~.lines.Kind`, by its bytes
+        #: per direction, a record's bytes → the one line it is, or () when it needs the framer
+        self._whole: dict = {TO_VEHICLE: {}, FROM_VEHICLE: {}}
         self.closed = False
         self.aborted = ""
         #: (mode before, command ID) of every accepted control command in a remote mode (coverage)
@@ -169,9 +172,17 @@ class VehicleObserver(Answers):
     def _frame(self, d: str, data: bytes):
         """The framer's events for ``data``; a record that is one whole line skips the framer."""
         fr = self.framers[d]
-        if (not fr.pending and data[:1] == b"$" and data.count(b"$") == 1 and data.find(b"\n") == len(data) - 1
-                and len(data) <= fr.max_line):
-            return (Line(data, 0),)
+        if not fr.pending:
+            known = self._whole[d]
+            whole = known.get(data)
+            if whole is None:  # sessions repeat their lines: the shape of each is worked out once
+                if len(known) >= 4096:
+                    known.clear()
+                whole = known[data] = ((Line(data, 0),) if data[:1] == b"$" and data.count(b"$") == 1
+                                       and data.find(b"\n") == len(data) - 1 and len(data) <= fr.max_line
+                                       else ())
+            if whole:
+                return whole
         return fr.feed(data)
 
     def decode(self, raw: bytes):
@@ -184,12 +195,13 @@ class VehicleObserver(Answers):
         return hit
 
     def _evidence(self, ev: WireEvent, raw: bytes, direction: str) -> Evidence:
+        text = self._escaped.get(raw)  # only whole CR LF lines are kept
+        if text is not None:
+            return Evidence(ev.t, direction, text, ev.lineno)
         if raw.endswith(b"\r\n") and b"\n" not in raw[:-1]:
-            text = self._escaped.get(raw)
-            if text is None:
-                if len(self._escaped) >= 4096:
-                    self._escaped.clear()
-                text = self._escaped[raw] = escape(raw[:-2])
+            if len(self._escaped) >= 4096:
+                self._escaped.clear()
+            text = self._escaped[raw] = escape(raw[:-2])
             return Evidence(ev.t, direction, text, ev.lineno)
         return Evidence(ev.t, direction + "~", escape(raw[:200]), ev.lineno)
 
@@ -239,7 +251,11 @@ class VehicleObserver(Answers):
             self.after_discard = True
         else:
             raw = fe.raw
-            k = classify(self.decode(raw), raw, self.profile)
+            k = self._kinds.get(raw)
+            if k is None:  # a line's kind depends on its bytes alone (sessions repeat their lines)
+                if len(self._kinds) >= 4096:
+                    self._kinds.clear()
+                k = self._kinds[raw] = classify(self.decode(raw), raw, self.profile)
             if self.after_discard and k.kind in ("command", "error") and not k.variant:
                 k = Kind(k.kind, k.item, k.ack_type, variant="RH-FRM-7")
             self.after_discard = False
@@ -331,9 +347,11 @@ class VehicleObserver(Answers):
         while self.silent and self._silent_over(self.silent[0], t):
             q = self.silent.popleft()
             self._silence_kept(q)
+        window = self.profile.ack_window_s
         for p in list(self.pending):
-            allowance = ack_allowance(self.profile.ack_window_s, len(p.raw), self.vbytes - p.vbytes0,
-                                      self.baud, self.res)
+            if t - p.t <= window:
+                continue  # inside the bare window: inside every allowance (ack_allowance ≥ the window)
+            allowance = ack_allowance(window, len(p.raw), self.vbytes - p.vbytes0, self.baud, self.res)
             if t - p.t > ack_fail_after(allowance):
                 self.pending.remove(p)
                 self._missing(p, allowance)

@@ -18,7 +18,7 @@ from .lines import Kind
 __all__ = ["Sent", "class_of_id", "text_of", "brief", "names"]
 
 
-@dataclass
+@dataclass(slots=True)
 class Sent:
     """One backseat line as the observer classified it, and what became of it."""
 
