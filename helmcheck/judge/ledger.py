@@ -21,12 +21,14 @@ numbers per clause), so a ledger stays small whatever the length of the run.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Iterable, NamedTuple, Optional
+from typing import Callable, Iterable, NamedTuple, Optional, Union
 
 from ..clauses import catalogue
 
 __all__ = ["Ledger", "Evidence", "ClauseVerdict", "MAX_EVIDENCE", "MAX_LINES", "RANK", "combine"]
 
+#: A finding's reason, or a function that makes it (see :meth:`Ledger.passed`).
+Reason = Union[str, Callable[[], str]]
 MAX_EVIDENCE = 8
 MAX_LINES = 50
 #: The combining rule: a higher rank wins.
@@ -100,7 +102,7 @@ class Ledger:
         return cid in self._e
 
     # ------------------------------------------------------------------ findings
-    def _add(self, cid: str, kind: str, reason: str, evidence: Iterable[Evidence], case: str) -> None:
+    def _add(self, cid: str, kind: str, reason: Reason, evidence: Iterable[Evidence], case: str) -> None:
         e = self._e.get(cid)
         if e is None:
             return  # a clause outside this ledger (not selected, or the other role)
@@ -109,7 +111,7 @@ class Ledger:
         if lv.full and (not case or case in e.cases):
             return  # everything kept is full: only the count changes (the common, repeated finding)
         if not lv.reason and reason:
-            lv.reason = reason
+            lv.reason = reason() if callable(reason) else reason
         ev = list(evidence)
         if ev and len(lv.lines) < MAX_LINES and ev[-1].lineno:
             lv.lines.append(ev[-1].lineno)  # evidence runs in time order: the last line is the offending one
@@ -128,8 +130,10 @@ class Ledger:
         lv = e.levels[kind]
         return not (lv.full and (not case or case in e.cases))
 
-    def passed(self, cid: str, reason: str = "", evidence: Iterable[Evidence] = (), case: str = "") -> None:
-        """The clause was exercised and met (the first call's reason and evidence are kept)."""
+    def passed(self, cid: str, reason: Reason = "", evidence: Iterable[Evidence] = (), case: str = "") -> None:
+        """The clause was exercised and met (the first call's reason and evidence are kept). A
+        reason may be a function that makes it: called only when the reason is kept (a repeated
+        pass on a hot path then formats nothing)."""
         e = self._e.get(cid)
         if e is None:
             return

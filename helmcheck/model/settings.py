@@ -20,7 +20,8 @@ __all__ = ["SettingsStore"]
 
 
 class SettingsStore:
-    """Setting name → (state, values)."""
+    """Setting name → (state, values). The mapping is never changed in place (a write makes a
+    new one), so a copy shares it until either side writes."""
 
     __slots__ = ("_values",)
 
@@ -30,14 +31,14 @@ class SettingsStore:
 
     def copy(self) -> "SettingsStore":
         new = SettingsStore.__new__(SettingsStore)
-        new._values = dict(self._values)
+        new._values = self._values  # shared: write() replaces, never mutates
         return new
 
     def read(self, name: str) -> tuple[int, tuple[str, ...]]:
         return self._values[name]
 
     def write(self, name: str, state: int, values: tuple[str, ...]) -> None:
-        self._values[name] = (state, tuple(values))
+        self._values = {**self._values, name: (state, tuple(values))}
 
     def reply_extra(self, name: str) -> tuple[str, ...]:
         """The ``$ACK,12`` tail for ``name``: setting, n, state, values (RH-RD-8)."""

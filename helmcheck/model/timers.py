@@ -25,20 +25,24 @@ def tolerance(duration: float, slack: float = 0.0) -> float:
 
 
 class Timers:
-    """A small set of named timers with a cached earliest deadline."""
+    """A small set of named timers with a cached next expiry. The name → (start, duration)
+    mapping is never changed in place (arming or disarming makes a new one), so a copy shares it
+    until either side changes."""
 
-    __slots__ = ("_t", "skew", "due")
+    __slots__ = ("_t", "skew", "due", "_next")
 
     def __init__(self) -> None:
         self._t: dict[str, tuple[float, float]] = {}
         self.skew: Optional[tuple[float, float]] = None
         self.due: Optional[float] = None  #: the earliest deadline, or None
+        self._next: Optional[tuple[float, float, str]] = None
 
     def copy(self) -> "Timers":
         new = Timers.__new__(Timers)
-        new._t = dict(self._t)
+        new._t = self._t  # shared: arm() and disarm() replace, never mutate
         new.skew = self.skew
         new.due = self.due
+        new._next = self._next
         return new
 
     def set_skew(self, sign: float, slack: float) -> None:
@@ -63,11 +67,12 @@ class Timers:
         return name in self._t
 
     def arm(self, name: str, start: float, duration: float) -> None:
-        self._t[name] = (start, duration)
+        self._t = {**self._t, name: (start, duration)}
         self._recompute()
 
     def disarm(self, name: str) -> None:
-        if self._t.pop(name, None) is not None:
+        if name in self._t:
+            self._t = {k: v for k, v in self._t.items() if k != name}
             self._recompute()
 
     def remaining(self, name: str, now: float) -> Optional[float]:
@@ -92,6 +97,11 @@ class Timers:
     def names(self) -> tuple[str, ...]:
         return tuple(self._t)
 
+    def next_timer(self) -> Optional[tuple[float, float, str]]:
+        """(deadline, duration, name) of the next timer to expire (as :meth:`earliest`), or None."""
+        return self._next
+
     def _recompute(self) -> None:
         e = self.earliest() if self._t else None
         self.due = None if e is None else e[0]
+        self._next = None if e is None else (e[0], self._t[e[1]][1], e[1])

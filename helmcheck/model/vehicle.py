@@ -225,10 +225,8 @@ class VehicleModel:
         ``None`` when it is not armed (RH-TIM-1 tolerances are taken on the duration)."""
         t = self.timers
         if name is None:
-            e = t.earliest()
-            if e is None:
-                return None
-            name = e[1]
+            got = t.next_timer()
+            return None if got is None else (got[0], got[1] or 0.0, got[2])
         d = t.deadline(name)
         if d is None:
             return None

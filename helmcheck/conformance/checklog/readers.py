@@ -321,12 +321,12 @@ def _read_wirelog(f: BinaryIO, meta: LogMeta, swap: bool, progress: Progress) ->
         n += 1
         if progress is not None:
             progress(len(raw))
-        if raw[:1] == b"#":
-            if n <= 16:
-                header_comment(raw.decode("utf-8", "replace").rstrip("\r\n"), meta)
-            continue
         m = match(raw)
         if m is None:
+            if raw[:1] == b"#":
+                if n <= 16:
+                    header_comment(raw.decode("utf-8", "replace").rstrip("\r\n"), meta)
+                continue
             if not raw.strip():
                 continue
             yield Chunk(0.0, UNREADABLE, b"", n, "not a wire-log record (want '<seconds> <dir> <payload>')",
@@ -334,9 +334,7 @@ def _read_wirelog(f: BinaryIO, meta: LogMeta, swap: bool, progress: Progress) ->
             continue
         stamp, _, d = m.groups()
         t = float(stamp)
-        payload = raw[m.end():]
-        if payload[-1:] == b"\n":
-            payload = payload[:-1]
+        payload = raw[m.end():-1] if raw[-1:] == b"\n" else raw[m.end():]
         if payload[-1:] == b"\r":
             payload = payload[:-1]
         if d == b"!":

@@ -118,8 +118,7 @@ class Answers:
         if p.branched:  # already in the mirror, unanswered: judge the late answer's content only
             self._late_answer(p, a, observed, ev)
             return
-        v_ack = self.v(t)
-        res = self.beliefs.command(p.kind.item, v_ack, self.k * (dt + JITTER_S + self.res), observed)
+        res = self.beliefs.command(p.kind.item, self.k * t, self.k * (dt + JITTER_S + self.res), observed)
         p.expected = res.expected
         want = next((r for r in res.expected if isinstance(r, s.ACK)), None)
         p.negative = want is not None and want.status == 1
@@ -178,15 +177,15 @@ class Answers:
                 self.ledger.remark(cid, f"explained by an unseen event: {res.adopted[-1]}.")
         row = res.row
         if a.status:
-            self.passed(passable(cands), f"{text_of(p)} refused with $ACK,{a.type},1,{a.err} as a conforming "
+            self.passed(passable(cands), lambda: f"{text_of(p)} refused with $ACK,{a.type},1,{a.err} as a conforming "
                                          f"vehicle in mode {res.before[0]} does", ev)
             if a.err == 26:
                 self.ledger.passed("RH-SAF-1" if res.before[1] == "lockout" else "RH-SAF-3",
                                    f"{text_of(p)} refused with err 26", ev, self.case)
         elif row is not None and row.target == "=" and row.phase_to is None:
-            self.passed(passable(cands), f"{text_of(p)} accepted in mode {res.before[0]}", ev)
+            self.passed(passable(cands), lambda: f"{text_of(p)} accepted in mode {res.before[0]}", ev)
         elif p.kind.variant:
-            self.passed((p.kind.variant,), f"{text_of(p)} read and answered", ev)
+            self.passed((p.kind.variant,), lambda: f"{text_of(p)} read and answered", ev)
 
     def _mission_unknown(self, p: Sent, a: s.ACK, cands: tuple[str, ...], ev: list, why: str = "") -> None:
         self.book("inconclusive", cands, f"{text_of(p)} answered {brief([a])}: the answer depends on the "
@@ -201,10 +200,10 @@ class Answers:
         if osi.mode == "S" or not osi.mission_name:
             return
         left = []
-        for p, a, cands, ev, names in self.mission_shown:
-            names = names - {osi.mission_name}
-            if names:
-                left.append((p, a, cands, ev, names))
+        for p, a, cands, ev, unseen in self.mission_shown:
+            unseen = unseen - {osi.mission_name}
+            if unseen:
+                left.append((p, a, cands, ev, unseen))
                 continue
             ran = " and ".join(sorted({p.kind.item.name} | ({p.kind.item.srp} if p.kind.item.srp else set())))
             for cid in passable(cands):
@@ -223,7 +222,7 @@ class Answers:
         if got == want:
             if want:
                 self.ledger.passed("RH-ACK-5", "the data came before the $ACK,8", ev, self.case)
-            self.ledger.passed("RH-OSD-1", f"{len(got)} data sentence(s) in request order", ev, self.case)
+            self.ledger.passed("RH-OSD-1", lambda: f"{len(got)} data sentence(s) in request order", ev, self.case)
         elif len(got) < len(want) and got == want[:len(got)]:
             self.book("fail", ("RH-ACK-5", "RH-OSD-1"), f"$ACK,8 came before all its data: got "
                                                        f"{names(got)}, expected {names(want)}", ev, at=p)
@@ -250,11 +249,11 @@ class Answers:
                 self.book("fail", cands, msg, ev, at=p)
             self.checks.after_osi(osi, p, t, ev, judged=False)
             return
-        self.ledger.passed("RH-OUT-4", f"mode {osi.mode}, waypoint {osi.next_waypoint}, P{osi.park_time}, "
+        self.ledger.passed("RH-OUT-4", lambda: f"mode {osi.mode}, waypoint {osi.next_waypoint}, P{osi.park_time}, "
                                        f"error {osi.error_state} as a conforming vehicle reports", ev, self.case)
         if res.adopted:
             self.ledger.remark("RH-OUT-4", f"unseen events were adopted to explain reports, e.g. {res.adopted[-1]}.")
-        self.passed(passable(res.passes), f"seen to take effect: $OSI mode {osi.mode}", ev)
+        self.passed(passable(res.passes), lambda: f"seen to take effect: $OSI mode {osi.mode}", ev)
         for cid in sorted(res.own):
             self.ledger.passed(cid, OWN_REASON[cid], ev, self.case)
         for tt, verdict, reason in res.timings:

@@ -40,7 +40,7 @@ from ...profile import Profile
 from ..facts import ASCENT_REFUSED, INTERRUPTS, LOCKOUT_REFUSED
 from ..timing import judgeable
 from .candidate import Candidate, Timed
-from .closure import explain_osi, explain_reply, osi_depth_m, same_replies
+from .closure import explain_osi, explain_reply, osi_depth_m, reply_keys
 
 __all__ = ["Beliefs", "CommandResult", "OsiResult", "CAP"]
 
@@ -50,7 +50,7 @@ _WP_ALT_EVENTS = INTERRUPTS
 _LOCK_ONLY = LOCKOUT_REFUSED - ASCENT_REFUSED
 
 
-@dataclass
+@dataclass(slots=True)
 class CommandResult:
     """What the mirror made of one answered command."""
 
@@ -64,7 +64,7 @@ class CommandResult:
     timings: list = field(default_factory=list)  #: (Timed, verdict, reason): the lockout's end
 
 
-@dataclass
+@dataclass(slots=True)
 class OsiResult:
     """What the mirror made of one ``$OSI``."""
 
@@ -144,7 +144,8 @@ class Beliefs:
         for c in self.cands:
             options += self._options(c, item, v, slack_v)
         nominal = options[0]
-        match = [o for o in options if same_replies(o[1], observed)]
+        got = reply_keys(observed)
+        match = [o for o in options if reply_keys(o[1]) == got]
         if match:
             base = len(self.cands[0].story)
             self._keep([o[0] for o in match])
@@ -425,12 +426,16 @@ class Beliefs:
     def _plant(self, c: Candidate, osi: s.OSI) -> None:
         """The ``$OSI``'s measured values become the candidate's plant snapshot."""
         m = c.model
-        changes = {"lat": float(osi.lat), "lon": float(osi.lon), "speed_kn": float(osi.speed)}
+        lat, lon, speed = float(osi.lat), float(osi.lon), float(osi.speed)
         depth = osi_depth_m(osi, self.profile.depth_unit)
-        if depth is not None and m.phase != "ascent":
-            changes["depth_m"] = depth
+        if depth is not None and m.phase == "ascent":
+            depth = None
         snap = m.snapshot
-        if any(getattr(snap, k) != val for k, val in changes.items()):
+        if snap.lat != lat or snap.lon != lon or snap.speed_kn != speed or (depth is not None
+                                                                           and snap.depth_m != depth):
+            changes = {"lat": lat, "lon": lon, "speed_kn": speed}
+            if depth is not None:
+                changes["depth_m"] = depth
             m.update_plant(snap.with_(**changes))
             c.drain()
 

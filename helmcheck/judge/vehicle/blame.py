@@ -24,6 +24,7 @@ observation (named beside it).
 
 from __future__ import annotations
 
+from functools import lru_cache
 from typing import Iterable, Optional
 
 from ...clauses import catalogue
@@ -63,12 +64,20 @@ def vehicle_clause(cid: str) -> bool:
     return cid in _KNOWN
 
 
-def passable(clauses: Iterable[str]) -> list[str]:
+def passable(clauses: Iterable[str]) -> tuple[str, ...]:
     """The clauses a confirmation passes: vehicle clauses without their own evidence."""
-    return [c for c in clauses if vehicle_clause(c) and c not in OWN_EVIDENCE]
+    if isinstance(clauses, tuple):
+        return _passable(clauses)
+    return tuple(c for c in clauses if vehicle_clause(c) and c not in OWN_EVIDENCE)
 
 
-def _dedupe(xs: Iterable[str]) -> tuple[str, ...]:
+@lru_cache(maxsize=1024)
+def _passable(clauses: tuple[str, ...]) -> tuple[str, ...]:
+    return tuple(c for c in clauses if vehicle_clause(c) and c not in OWN_EVIDENCE)
+
+
+@lru_cache(maxsize=1024)
+def _dedupe(xs: tuple[str, ...]) -> tuple[str, ...]:
     return tuple(dict.fromkeys(x for x in xs if vehicle_clause(x)))
 
 

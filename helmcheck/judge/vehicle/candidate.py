@@ -109,7 +109,7 @@ class Candidate:
         c.model.trace = list(self.model.trace or [])
         c.events, c.story, c.extra_v, c.window = self.events, self.story, self.extra_v, self.window
         c.pending = list(self.pending)
-        c.timed = [Timed(**vars(t)) for t in self.timed]
+        c.timed = [Timed(**vars(t)) for t in self.timed] if self.timed else []
         c.abandoned = set(self.abandoned)
         c.s_cause, c.refused_locked, c.refresh = self.s_cause, self.refused_locked, self.refresh
         c.seen_v, c.seen_mode, c.locked_v = self.seen_v, self.seen_mode, self.locked_v

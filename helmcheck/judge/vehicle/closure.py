@@ -44,7 +44,7 @@ from ...profile import SAFETY_CODES
 from .candidate import Candidate
 from .catalog import UnknownMission, _LearntOpen
 
-__all__ = ["explain_osi", "explain_reply", "same_replies", "MAX_WAYPOINTS", "osi_depth_m"]
+__all__ = ["explain_osi", "explain_reply", "same_replies", "reply_keys", "MAX_WAYPOINTS", "osi_depth_m"]
 
 #: The most mission (or queue) waypoints the observer assumes passed between two reports.
 MAX_WAYPOINTS = 8
@@ -60,9 +60,14 @@ def _key(r) -> tuple:
     return (type(r).__name__,)
 
 
+def reply_keys(replies: list) -> list[tuple]:
+    """What is judged of a reply list: ACK type/status/err, data sentence kinds."""
+    return [_key(r) for r in replies]
+
+
 def same_replies(want: list, got: list) -> bool:
-    """Two reply lists agree on what is judged: ACK type/status/err, data sentence kinds."""
-    return [_key(r) for r in want] == [_key(r) for r in got]
+    """Two reply lists agree on what is judged (:func:`reply_keys`)."""
+    return reply_keys(want) == reply_keys(got)
 
 
 def osi_depth_m(osi: s.OSI, depth_unit: str) -> Optional[float]:

@@ -38,7 +38,7 @@ from ...grammar import sentences as s
 from ...grammar.capture import escape
 from ...model import plant as P
 from ...profile import Profile
-from ..ledger import Evidence, Ledger
+from ..ledger import Evidence, Ledger, Reason
 from ..timing import JITTER_S, ack_allowance, ack_fail_after
 from ..wire import FROM_VEHICLE, NOTE, TO_VEHICLE, WireEvent, parse_note
 from . import osichecks
@@ -131,7 +131,7 @@ class VehicleObserver(Answers):
             else:
                 self.ledger.passed(cid, reason, evidence, case)
 
-    def passed(self, clauses, reason: str, evidence=()) -> None:
+    def passed(self, clauses, reason: Reason, evidence=()) -> None:
         for cid in clauses:
             self.ledger.passed(cid, reason, evidence, self.case)
 
@@ -287,10 +287,14 @@ class VehicleObserver(Answers):
         sent = self.out.line(d, evd, self.case)
         if sent is not None:
             self.alive_t = ev.t
-            self._revive(ev.t)
+            if self.dead or self.quiet:
+                self._revive(ev.t)
             if self.link_baud is not None:
-                self.ledger.passed("RH-FRM-9", f"sentences read and answered at {self.link_baud} baud 8N1 "
-                                               f"as the tester opened the line", [evd], self.case)
+                if self.ledger.keeps("RH-FRM-9", "pass", self.case):
+                    self.ledger.passed("RH-FRM-9", f"sentences read and answered at {self.link_baud} baud 8N1 "
+                                                   f"as the tester opened the line", [evd], self.case)
+                else:
+                    self.ledger.passed("RH-FRM-9", "", (), self.case)  # counted; what is kept is full
         if isinstance(sent, s.ACK):
             self._ack(sent, ev.t, evd)
         elif sent is not None:
@@ -311,7 +315,11 @@ class VehicleObserver(Answers):
 
     def _data(self, sentence, cls: str, t: float, evd: Evidence) -> None:
         """A data sentence: it belongs to the oldest ``$OSD`` still waiting (RH-ACK-5)."""
-        p = next((q for q in self.pending if q.kind.ack_type == 8), None)
+        p = None
+        for q in self.pending:
+            if q.kind.ack_type == 8:
+                p = q
+                break
         if p is not None:
             self._processed(p, t)
         if p is None:
@@ -348,7 +356,7 @@ class VehicleObserver(Answers):
             q = self.silent.popleft()
             self._silence_kept(q)
         window = self.profile.ack_window_s
-        for p in list(self.pending):
+        for p in list(self.pending) if self.pending else ():
             if t - p.t <= window:
                 continue  # inside the bare window: inside every allowance (ack_allowance ≥ the window)
             allowance = ack_allowance(window, len(p.raw), self.vbytes - p.vbytes0, self.baud, self.res)

@@ -8,6 +8,7 @@ waits on it. The helpers format lines and replies for verdict reasons.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import lru_cache
 from typing import Optional
 
 from ...grammar import sentences as s
@@ -59,7 +60,12 @@ def class_of_id(sid: Optional[str]) -> str:
 
 def text_of(p: Sent) -> str:
     """A backseat line as evidence text (escaped, at most 80 characters)."""
-    return escape(p.raw.rstrip(b"\r\n"))[:80]
+    return _text(p.raw)
+
+
+@lru_cache(maxsize=4096)
+def _text(raw: bytes) -> str:
+    return escape(raw.rstrip(b"\r\n"))[:80]  # sessions repeat their lines: each is escaped once
 
 
 def brief(replies: list) -> str:
