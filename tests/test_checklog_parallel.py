@@ -274,6 +274,21 @@ def test_sidejob_returns_the_value(jobs):
     assert jobs[-1].result() == helmcheck.__file__
 
 
+def test_sidejob_ignores_a_helmcheck_in_the_working_directory(jobs, tmp_path, monkeypatch):
+    """The child imports the caller's package, not a ``helmcheck`` folder where it was started."""
+    fake = tmp_path / "helmcheck"
+    fake.mkdir()
+    (fake / "__init__.py").write_text("raise ImportError('a shadow helmcheck was imported')\n")
+    monkeypatch.chdir(tmp_path)
+    jobs.append(SideJob(pkgutil.resolve_name, "helmcheck:__file__"))
+    assert jobs[-1].result() == helmcheck.__file__
+
+
+def test_sidejob_output_printed_by_the_function_does_not_spoil_the_answer(jobs):
+    jobs.append(SideJob(print, "hello from the side job"))
+    assert jobs[-1].result() is None
+
+
 def test_sidejob_runs_in_another_process_and_session(jobs):
     jobs.append(SideJob(os.getpid))
     pid = jobs[-1].result()
@@ -434,17 +449,48 @@ def _replace_before_start(path: Path, new: bytes, kill: bool = False):
 @pytest.mark.parametrize("kill", [False, True], ids=["side-job-reads-it", "fallback-reads-it"])
 def test_a_file_replaced_during_the_check_is_an_error(kill, tmp_path, monkeypatch):
     """Really different bytes: the side job (or, when it is lost, the in-process fallback)
-    opens the path again and reads a longer file than the caller."""
+    opens the path again and reads other bytes than the caller (one byte of the last record
+    changed, and a line appended)."""
     path = copy_fixture(LOGS / "nominal.log", tmp_path)
     old = path.read_bytes()
-    longer = old + old.splitlines(keepends=True)[-1]
-    cls = _replace_before_start(path, longer, kill=kill)
+    changed = old[:-4] + bytes([old[-4] ^ 1]) + old[-3:] + old.splitlines(keepends=True)[-1]
+    cls = _replace_before_start(path, changed, kill=kill)
     monkeypatch.setattr(checker, "SideJob", cls)
     with pytest.raises(checker.LogFormatError, match="changed while it was being checked"):
         checker.check_log(path, profile=PROFILE, role="both", parallel=True)
     assert len(cls.made) == 1 and cls.made[0]._proc.poll() is not None
-    assert path.read_bytes() == longer
+    assert path.read_bytes() == changed
     checker.check_log(path, profile=PROFILE, role="both", parallel=False)  # the new file itself is fine
+
+
+@pytest.mark.parametrize("parallel", [False, True], ids=["in-process", "side-job"])
+def test_a_log_still_being_written_is_judged_as_it_was_when_the_check_began(parallel, tmp_path, monkeypatch):
+    """A capture that grows while it is checked (same file, more records appended after the
+    check opened it) is judged up to the size it had then, the same in one process or two."""
+    path = copy_fixture(LOGS / "nominal.log", tmp_path)
+    before = path.read_bytes()
+    lines = before.splitlines(keepends=True)
+    appended = b"".join(lines[-40:]) + b"12.5 > $OMS,180,3,20,2,10*00\n"
+    original = tmp_path / "original.log"
+    original.write_bytes(before)
+
+    grown = []
+    real_head = checker._head
+
+    def head_then_grow(f, p, size):  # the check has taken the size: now the log grows
+        got = real_head(f, p, size)
+        if p == path and not grown:
+            with open(path, "ab") as w:
+                w.write(appended)
+            grown.append(True)
+        return got
+
+    monkeypatch.setattr(checker, "_head", head_then_grow)
+    out = checker.check_log(path, profile=PROFILE, role="both", parallel=parallel)
+    assert grown and path.read_bytes() == before + appended
+    want = checker.check_log(original, profile=PROFILE, role="both", parallel=False)
+    assert out.sha256 == want.sha256 and out.stats == want.stats
+    assert summary(out)["clauses"] == summary(want)["clauses"]
 
 
 def test_a_file_replaced_by_another_format_is_an_error(tmp_path, monkeypatch):

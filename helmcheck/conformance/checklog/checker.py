@@ -84,30 +84,37 @@ def check_log(path: Path | str, *, profile: Profile = DEFAULT, role: str = "both
 
     ``parallel``: judge the backseat role of ``role="both"`` in a second process (the roles are
     independent; the verdicts are the same either way). ``None`` decides by itself: for a log of
-    at least :data:`PARALLEL_BYTES` on a machine with more than one core."""
+    at least :data:`PARALLEL_BYTES` on a machine with more than one core.
+
+    The file is judged as it was when the check began: a log still being written is checked up
+    to the size it had then (in both processes alike)."""
     if role not in ROLES:
         raise ValueError(f"role must be one of {ROLES}")
     path = Path(path)
     started = time.monotonic()
     with open(path, "rb") as f:
-        fmt, meta = _head(f, path)
+        size = os.fstat(f.fileno()).st_size
+        fmt, meta = _head(f, path, size)
         scale = time_scale if time_scale is not None else (meta.time_scale or profile.time_scale or 1.0)
         baud = meta.baud or profile.baud
         if parallel is None:
-            parallel = role == "both" and os.fstat(f.fileno()).st_size >= PARALLEL_BYTES and cores() > 1
+            parallel = role == "both" and size >= PARALLEL_BYTES and cores() > 1
+        job = (str(path), fmt, profile, scale, meta.resolution, baud, swap, size)
         side = None
         if parallel and role == "both":
-            side = SideJob(_backseat_entries, str(path), fmt, profile, scale, meta.resolution, baud, swap)
+            try:
+                side = SideJob(_backseat_entries, *job)
+            except Exception:  # no second process (none can start, or the job does not pickle): judge here
+                side = None
         try:
             checker = _Checker(profile, role, catalog, scale, meta.resolution, baud,
                                judge_backseat=side is None)
-            sha = _feed(f, checker, fmt, meta, swap, progress)
+            sha = _feed(f, size, checker, fmt, meta, swap, progress)
             if side is not None:
                 try:
                     entries, side_sha = side.result()
                 except SideJobLost:  # judge it here after all
-                    entries, side_sha = _backseat_entries(str(path), fmt, profile, scale, meta.resolution,
-                                                          baud, swap)
+                    entries, side_sha = _backseat_entries(*job)
                 if side_sha != sha:
                     raise LogFormatError(f"{path}: the file changed while it was being checked")
                 checker.backseat_entries = entries
@@ -119,10 +126,10 @@ def check_log(path: Path | str, *, profile: Profile = DEFAULT, role: str = "both
     return out
 
 
-def _head(f: BinaryIO, path: Path) -> tuple[str, LogMeta]:
-    """The format and what the first :data:`HEAD_BYTES` say (timestamp step, header); ``f`` is
-    left at its start."""
-    head = f.read(HEAD_BYTES)
+def _head(f: BinaryIO, path: Path, size: int) -> tuple[str, LogMeta]:
+    """The format and what the first :data:`HEAD_BYTES` (of ``size``) say (timestamp step,
+    header); ``f`` is left at its start."""
+    head = f.read(min(HEAD_BYTES, size))
     fmt = detect_format(head)
     if fmt is None:
         raise LogFormatError(f"{path}: not a helmcheck wire log, socat -v or socat -x capture")
@@ -136,39 +143,49 @@ def _head(f: BinaryIO, path: Path) -> tuple[str, LogMeta]:
     return fmt, meta
 
 
-def _feed(f: BinaryIO, checker: "_Checker", fmt: str, meta: LogMeta, swap: bool,
+def _feed(f: BinaryIO, size: int, checker: "_Checker", fmt: str, meta: LogMeta, swap: bool,
           progress: Optional[Callable[[int], None]]) -> str:
-    """Every record of ``f`` to ``checker``, then close it; returns the SHA-256 of the bytes read."""
+    """Every record in the first ``size`` bytes of ``f`` to ``checker``, then close it; returns
+    the SHA-256 of the bytes read."""
     sha = hashlib.sha256()
-    for chunk in read_chunks(_Hashing(f, sha), fmt, meta, swap=swap, progress=progress):
+    for chunk in read_chunks(_Hashing(f, sha, size), fmt, meta, swap=swap, progress=progress):
         checker.chunk(chunk)
     checker.close()
     return sha.hexdigest()
 
 
 def _backseat_entries(path: str, fmt: str, profile: Profile, scale: float, resolution: float, baud: int,
-                      swap: bool) -> tuple[list, str]:
-    """The backseat role of a check on its own (the side job of a parallel check): its ledger
-    entries, and the SHA-256 of the bytes it read."""
+                      swap: bool, size: int) -> tuple[list, str]:
+    """The backseat role of a check on its own (the side job of a parallel check) over the first
+    ``size`` bytes: its ledger entries, and the SHA-256 of the bytes it read."""
     with open(path, "rb") as f:
-        fmt2, meta = _head(f, Path(path))
+        fmt2, meta = _head(f, Path(path), size)
         if fmt2 != fmt:
             raise LogFormatError(f"{path}: the file changed while it was being checked")
         checker = _Checker(profile, "backseat", None, scale, resolution, baud)
-        sha = _feed(f, checker, fmt, meta, swap, None)
+        sha = _feed(f, size, checker, fmt, meta, swap, None)
     return checker.backseat.ledger.entries(), sha  # type: ignore[union-attr]
 
 
 class _Hashing:
-    """Iterates the lines of a binary file while hashing them."""
+    """Iterates the lines in the first ``limit`` bytes of a binary file while hashing them."""
 
-    def __init__(self, f, h):
+    def __init__(self, f, h, limit: int):
         self.f = f
         self.h = h
+        self.limit = limit
 
     def __iter__(self):
         upd = self.h.update
+        left = self.limit
         for raw in self.f:
+            if len(raw) >= left:  # the line that reaches the size the file had when the check began
+                raw = raw[:left]
+                if raw:
+                    upd(raw)
+                    yield raw
+                return
+            left -= len(raw)
             upd(raw)
             yield raw
 
