@@ -53,8 +53,8 @@ def read_text(tmp_path: Path, text: str):
 def streams(chunks) -> dict:
     out = {">": bytearray(), "<": bytearray()}
     for c in chunks:
-        if c.direction in out:
-            out[c.direction] += c.data
+        if c.dir in out:
+            out[c.dir] += c.data
     return {d: bytes(b) for d, b in out.items()}
 
 
@@ -63,8 +63,8 @@ def framed(chunks) -> dict:
     framers = {">": Framer(DEFAULT.max_line_bytes), "<": Framer(DEFAULT.max_line_bytes)}
     out: dict = {">": [], "<": []}
     for c in chunks:
-        if c.direction in framers:
-            out[c.direction] += [(e, c.t) for e in framers[c.direction].feed(c.data)]
+        if c.dir in framers:
+            out[c.dir] += [(e, c.t) for e in framers[c.dir].feed(c.data)]
     for d, fr in framers.items():
         out[d] += [(e, None) for e in fr.close()]
     return out
@@ -92,7 +92,7 @@ def test_socat_capture_format_and_fraction_unit_detected_from_data(name):
     assert not meta.time_unit_ambiguous
     assert "begin 000" in meta.time_unit_basis
     assert meta.resolution == 1e-6  # a microsecond clock, not a nanosecond one
-    assert {c.direction for c in chunks} == {">", "<"}  # nothing unreadable, no notes
+    assert {c.dir for c in chunks} == {">", "<"}  # nothing unreadable, no notes
 
 
 @pytest.mark.parametrize("name", CAPTURES)
@@ -114,7 +114,7 @@ def test_socat_capture_span_matches_recorded_duration(name):
 def test_socat_capture_blocks_and_bytes_match_socat_counters(name):
     m = MANIFEST["captures"][name]
     _, _, chunks = read(HERE / name)
-    blocks = {d: sum(1 for c in chunks if c.direction == d) for d in "<>"}
+    blocks = {d: sum(1 for c in chunks if c.dir == d) for d in "<>"}
     assert blocks == m["blocks"]
     got = streams(chunks)
     assert {d: len(b) for d, b in got.items()} == m["bytes"]
@@ -138,7 +138,7 @@ def test_socat_certify_capture_bytes_equal_emulator_wire_log():
     assert got["<"] == want["<"]
     dropped = 0
     for c in emu:
-        if c.direction == NOTE and "bytes discarded, first" in c.note:
+        if c.dir == NOTE and "bytes discarded, first" in c.note:
             n, _, rest = c.note.partition(" bytes discarded, first ")
             dropped += int(n.split()[-1]) - int(rest.split()[0])
     assert dropped > 0
@@ -284,11 +284,11 @@ def test_socat_fraction_unit_switches_when_a_later_stamp_proves_nanoseconds(tmp_
     n = HEAD_BYTES // 60 + 10  # more header lines than fit in the head, all in one clock second
     stamps = [f"12:00:00.000{100 + i:06d}" for i in range(n)] + ["12:00:00.500000000", "12:00:01.000000250"]
     _, meta, chunks = read_text(tmp_path, socat_v(stamps))
-    notes = [c for c in chunks if c.direction == NOTE]
+    notes = [c for c in chunks if c.dir == NOTE]
     assert len(notes) == 1 and "nanoseconds" in notes[0].note
     assert notes[0].lineno == 2 * n + 1
     assert meta.time_unit == "ns" and f"line {2 * n + 1}" in meta.time_unit_basis
-    data = [c for c in chunks if c.direction != NOTE]
+    data = [c for c in chunks if c.dir != NOTE]
     assert data[-2].t == pytest.approx(0.5 - 100e-9, abs=1e-12)
     assert data[-1].t == pytest.approx(1.0 + 150e-9, abs=1e-12)
     assert data[1].t == pytest.approx(1e-6, abs=1e-12)  # read before the proof: as microseconds

@@ -9,7 +9,7 @@ certifiers' verdicts, in a results directory of role ``log``.
 Modules, one concern each:
 
 * :mod:`.readers` — the capture formats (helmcheck wire-log 1, ``socat -v``, ``socat -x``),
-  format and timestamp-resolution detection, streaming :class:`~.readers.Chunk` s.
+  format and timestamp-resolution detection, streaming records (:data:`~.readers.Chunk`).
 * :mod:`.checker` — :func:`~.checker.check_log`: re-framing per direction, decoding, dispatch to
   the judges, vehicle framing/content clauses (RH-FRM-*, RH-OUT-1..3), bounded bookkeeping.
 * :mod:`.vehicle` — the replay through the model: RH-ACK-*, RH-OUT-4, the command and timer

@@ -4,8 +4,8 @@ This module owns :func:`check_log` — Jepsen's ``analyze`` / TLA+ trace validat
 helm line: the whole log is consumed, in order, and every byte is attributed. Its steps:
 
 1. detect the format and the timestamp resolution from the first 64 KiB (:mod:`.readers`);
-2. stream :class:`~.readers.Chunk` s and feed each, as a :class:`~helmcheck.judge.wire.WireEvent`
-   with its time and log line, to the role's observer: the vehicle observer
+2. stream the records (:class:`~helmcheck.judge.wire.WireEvent` s, with their time and log line)
+   and feed each to the role's observer: the vehicle observer
    (:class:`~helmcheck.judge.vehicle.VehicleObserver`, the judge ``certify vehicle`` uses) for
    §1–8 and the backseat observer (:class:`~helmcheck.judge.backseat.BackseatObserver`, the judge
    ``certify backseat`` uses) for §9, each with its own :class:`~helmcheck.judge.ledger.Ledger`.
@@ -21,6 +21,8 @@ timeline and events are capped by the observers.
 from __future__ import annotations
 
 import hashlib
+import io
+import itertools
 import os
 import time
 from dataclasses import dataclass, field
@@ -31,10 +33,9 @@ from ...clauses import vehicle_clauses
 from ...judge.backseat import BS_CLAUSES, BackseatObserver
 from ...judge.ledger import Evidence as LedgerEvidence, Ledger
 from ...judge.vehicle import VehicleObserver
-from ...judge.wire import WireEvent
 from ...model.missions import MissionCatalog
 from ...profile import DEFAULT, Profile
-from .readers import (NOTE, Chunk, LogMeta, detect_format, header_comment, read_chunks,
+from .readers import (NOTE, UNREADABLE, Chunk, LogMeta, Unreadable, detect_format, header_comment, read_chunks,
                       timestamp_resolution)
 from .sidejob import SideJob, SideJobLost, cores
 
@@ -168,7 +169,12 @@ def _backseat_entries(path: str, fmt: str, profile: Profile, scale: float, resol
 
 
 class _Hashing:
-    """Iterates the lines in the first ``limit`` bytes of a binary file while hashing them."""
+    """Iterates the lines (each ending in LF, as a binary file's lines do; the last may not) of
+    the first ``limit`` bytes of a binary file while hashing them. The file is read in blocks of
+    whole lines, and each block's lines come from :class:`io.BytesIO`: no Python code runs per
+    line here."""
+
+    BLOCK = 1 << 20
 
     def __init__(self, f, h, limit: int):
         self.f = f
@@ -176,18 +182,24 @@ class _Hashing:
         self.limit = limit
 
     def __iter__(self):
-        upd = self.h.update
+        return itertools.chain.from_iterable(map(io.BytesIO, self._blocks()))
+
+    def _blocks(self):
         left = self.limit
-        for raw in self.f:
-            if len(raw) >= left:  # the line that reaches the size the file had when the check began
-                raw = raw[:left]
-                if raw:
-                    upd(raw)
-                    yield raw
-                return
-            left -= len(raw)
-            upd(raw)
-            yield raw
+        carry = b""
+        while left > 0:
+            block = self.f.read(min(self.BLOCK, left))
+            if not block:
+                break
+            left -= len(block)
+            self.h.update(block)
+            buf = carry + block if carry else block
+            cut = buf.rfind(b"\n") + 1
+            carry = buf[cut:]
+            if cut:
+                yield buf[:cut] if carry else buf
+        if carry:
+            yield carry
 
 
 class _Side:
@@ -198,7 +210,7 @@ class _Side:
     ledger: Ledger
     observer: "BackseatObserver | VehicleObserver"
 
-    def unreadable(self, c: Chunk) -> None:
+    def unreadable(self, c: Unreadable) -> None:
         """A log line that could not be read: the bytes there are unknown."""
         self.ledger.inconclusive(self.unreadable_clause, "a log line could not be read; the bytes there "
                                                          "are unknown",
@@ -267,37 +279,34 @@ class _Checker:
         self.mission_known = catalog is not None
         self.findings: list = []
         self.finding_count = 0
-        self.stats = {"records": 0, "notes": 0, "unreadable": 0, "records_to_vehicle": 0,
-                      "records_from_vehicle": 0, "bytes_to_vehicle": 0, "bytes_from_vehicle": 0}
+        self._records = {">": 0, "<": 0, NOTE: 0, UNREADABLE: 0}  #: per direction
+        self._bytes = {">": 0, "<": 0}
         self.last_t = 0.0
 
+    @property
+    def stats(self) -> dict:
+        """Counts for the report (a new dict each time)."""
+        n, b = self._records, self._bytes
+        return {"records": sum(n.values()), "notes": n[NOTE], "unreadable": n[UNREADABLE],
+                "records_to_vehicle": n[">"], "records_from_vehicle": n["<"], "bytes_to_vehicle": b[">"],
+                "bytes_from_vehicle": b["<"]}
+
     def chunk(self, c: Chunk) -> None:
-        st = self.stats
-        st["records"] += 1
+        d = c.dir
+        self._records[d] += 1
         if c.t > self.last_t:
             self.last_t = c.t
-        d = c.direction
-        if d == ">":
-            st["records_to_vehicle"] += 1
-            st["bytes_to_vehicle"] += len(c.data)
-            we = WireEvent(c.t, d, c.data, "", c.lineno)
-        elif d == "<":
-            st["records_from_vehicle"] += 1
-            st["bytes_from_vehicle"] += len(c.data)
-            we = WireEvent(c.t, d, c.data, "", c.lineno)
-        elif d == NOTE:
-            st["notes"] += 1
-            we = WireEvent(c.t, d, b"", c.note, c.lineno)
-        else:
-            st["unreadable"] += 1
+        if d == ">" or d == "<":
+            self._bytes[d] += len(c.data)
+        elif d != NOTE:
             self.finding_count += 1
             if len(self.findings) < MAX_FINDINGS:
                 self.findings.append({"line": c.lineno, "finding": c.note})
             for side in self.sides:
-                side.unreadable(c)
+                side.unreadable(c)  # type: ignore[arg-type]
             return
-        for feed in self.feeds:  # one event for both observers (neither changes it)
-            feed(we)
+        for feed in self.feeds:  # the same event to both observers (neither changes it)
+            feed(c)
 
     def close(self) -> None:
         if self.vehicle is not None:

@@ -69,11 +69,12 @@ import itertools
 import re
 from dataclasses import dataclass
 from datetime import datetime
-from typing import BinaryIO, Callable, Iterable, Iterator, Optional
+from typing import BinaryIO, Callable, Iterable, Iterator, NamedTuple, Optional, Union
 
 from ...grammar.capture import unescape
+from ...judge.wire import WireEvent
 
-__all__ = ["Chunk", "LogMeta", "TimeUnit", "detect_format", "socat_time_unit", "timestamp_resolution",
+__all__ = ["Chunk", "Unreadable", "LogMeta", "TimeUnit", "detect_format", "socat_time_unit", "timestamp_resolution",
            "read_chunks", "FORMATS", "UNREADABLE", "NOTE", "HEAD_BYTES"]
 
 FORMATS = ("wirelog", "socat-v", "socat-x")
@@ -83,22 +84,22 @@ NOTE = "!"
 HEAD_BYTES = 64 * 1024
 
 
-@dataclass(slots=True)
-class Chunk:
-    """Bytes seen on the wire at ``t`` (seconds since the log began) going ``direction``.
-
-    ``direction`` is ``>`` (to the vehicle), ``<`` (from the vehicle), ``!`` (a recorder
-    note, text in ``note``) or ``?`` (a log line that could not be read; ``note`` says why).
-    ``complete`` is True when the record is a whole CR LF line by itself (wire-log ``>``/``<``).
-    """
+class Unreadable(NamedTuple):
+    """A log line that could not be read (``dir`` is ``?``): ``note`` says why, ``text`` is the
+    line as written (for evidence). Its first fields are a :class:`~helmcheck.judge.wire.WireEvent`'s."""
 
     t: float
-    direction: str
+    dir: str
     data: bytes
+    note: str
     lineno: int
-    note: str = ""
-    complete: bool = False
-    text: str = ""  #: an unreadable line's text as written (for evidence)
+    text: str
+
+
+#: What a reader yields: a record as the :class:`~helmcheck.judge.wire.WireEvent` the observers
+#: are fed (bytes ``>`` to or ``<`` from the vehicle at ``t`` seconds since the log began, or a
+#: ``!`` note), or an :class:`Unreadable` line.
+Chunk = Union[WireEvent, Unreadable]
 
 
 @dataclass
@@ -329,8 +330,8 @@ def _read_wirelog(f: BinaryIO, meta: LogMeta, swap: bool, progress: Progress) ->
                 continue
             if not raw.strip():
                 continue
-            yield Chunk(0.0, UNREADABLE, b"", n, "not a wire-log record (want '<seconds> <dir> <payload>')",
-                        text=raw.decode("utf-8", "replace").rstrip("\r\n")[:200])
+            yield Unreadable(0.0, UNREADABLE, b"", "not a wire-log record (want '<seconds> <dir> <payload>')",
+                             n, raw.decode("utf-8", "replace").rstrip("\r\n")[:200])
             continue
         stamp, _, d = m.groups()
         t = float(stamp)
@@ -338,19 +339,19 @@ def _read_wirelog(f: BinaryIO, meta: LogMeta, swap: bool, progress: Progress) ->
         if payload[-1:] == b"\r":
             payload = payload[:-1]
         if d == b"!":
-            yield Chunk(t, NOTE, b"", n, payload.decode("utf-8", "replace"))
+            yield WireEvent(t, NOTE, b"", payload.decode("utf-8", "replace"), n)
             continue
         if not payload.isascii():
-            yield Chunk(t, UNREADABLE, b"", n, "payload is not ASCII (bytes must be escaped as \\xNN)",
-                        text=payload.decode("utf-8", "replace")[:200])
+            yield Unreadable(t, UNREADABLE, b"", "payload is not ASCII (bytes must be escaped as \\xNN)", n,
+                             payload.decode("utf-8", "replace")[:200])
             continue
         if b"\\" in payload:
             payload = unescape(payload.decode("ascii"))
         direction, whole = dirs[d]
         if whole:
-            yield Chunk(t, direction, payload + b"\r\n", n, complete=True)
+            yield WireEvent(t, direction, payload + b"\r\n", "", n)
         else:
-            yield Chunk(t, direction, payload, n)
+            yield WireEvent(t, direction, payload, "", n)
 
 
 #: wire-log direction → (the chunk's direction, a whole CR LF line); as written, and swapped
@@ -432,11 +433,11 @@ def _read_socat(f: BinaryIO, meta: LogMeta, swap: bool, progress: Progress, hex_
         data = bytes(b["got"])
         text = "".join(b["text"])[:300]
         if len(data) != b["want"]:
-            yield Chunk(b["t"], UNREADABLE, b"", b["lineno"],
-                        f"socat block announces length={b['want']} but carries {len(data)} bytes"
-                        + (f" ({short_reason})" if short_reason else ""), text=text)
+            yield Unreadable(b["t"], UNREADABLE, b"",
+                             f"socat block announces length={b['want']} but carries {len(data)} bytes"
+                             + (f" ({short_reason})" if short_reason else ""), b["lineno"], text)
         if data:
-            yield Chunk(b["t"], b["dir"], data, b["lineno"], text=text)
+            yield WireEvent(b["t"], b["dir"], data, "", b["lineno"])
 
     for raw in lines:
         n += 1
@@ -454,12 +455,12 @@ def _read_socat(f: BinaryIO, meta: LogMeta, swap: bool, progress: Progress, hex_
                 if m is None:
                     if hex_mode and line.strip() == b"--":
                         break
-                    yield Chunk(0.0, UNREADABLE, b"", n,
-                                "not a socat block header or data", text=line.decode("utf-8", "replace")[:200])
+                    yield Unreadable(0.0, UNREADABLE, b"", "not a socat block header or data", n,
+                                     line.decode("utf-8", "replace")[:200])
                     break
                 block = new_block(m, n)
                 if clock.note:
-                    yield Chunk(block["t"], NOTE, b"", n, clock.note)
+                    yield WireEvent(block["t"], NOTE, b"", clock.note, n)
                     clock.note = ""
                 if block["want"] == 0:
                     yield from finish(block)
@@ -471,8 +472,8 @@ def _read_socat(f: BinaryIO, meta: LogMeta, swap: bool, progress: Progress, hex_
                 if consumed_all is None:
                     yield from finish(block, "hex dump line unreadable")
                     block = None
-                    yield Chunk(0.0, UNREADABLE, b"", n, "not a socat hex dump line",
-                                text=line.decode("utf-8", "replace")[:200])
+                    yield Unreadable(0.0, UNREADABLE, b"", "not a socat hex dump line", n,
+                                     line.decode("utf-8", "replace")[:200])
                     break
                 if len(block["got"]) >= block["want"]:
                     yield from finish(block)

@@ -44,10 +44,16 @@ class Answers:
             return
         # the oldest waiting command of its type keeps the order; one the ACK of a later command
         # already overtook is matched only when no other waits (then it is out of order, RH-ACK-6)
-        idx = next((i for i, p in enumerate(self.pending) if p.kind.ack_type == a.type and not p.overtaken),
-                   None)
+        idx = first = None
+        for i, q in enumerate(self.pending):
+            if q.kind.ack_type == a.type:
+                if not q.overtaken:
+                    idx = i
+                    break
+                if first is None:
+                    first = i
         if idx is None:
-            idx = next((i for i, p in enumerate(self.pending) if p.kind.ack_type == a.type), None)
+            idx = first
         if idx is not None:
             p = self.pending[idx]
             self._processed(p, t)

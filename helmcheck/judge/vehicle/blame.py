@@ -68,6 +68,8 @@ def passable(clauses: Iterable[str]) -> tuple[str, ...]:
     """The clauses a confirmation passes: vehicle clauses without their own evidence."""
     if isinstance(clauses, tuple):
         return _passable(clauses)
+    if not clauses:
+        return ()
     return tuple(c for c in clauses if vehicle_clause(c) and c not in OWN_EVIDENCE)
 
 
