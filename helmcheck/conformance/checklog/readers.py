@@ -1,8 +1,10 @@
 """Log readers: one streaming reader per capture format, and the format detector.
 
-This module owns turning a capture file into a stream of :class:`Chunk` objects — timed runs of
-wire bytes with the log line they came from — without keeping the file in memory. It judges
-nothing; the checker (:mod:`.checker`) re-frames the bytes (RH-FRM-6/7) and judges them.
+This module owns turning a capture file into a stream of records (:data:`Chunk`): timed runs of
+wire bytes with the log line they came from, as the :class:`~helmcheck.judge.wire.WireEvent` s the
+observers are fed, without keeping the file in memory. It judges nothing; the checker
+(:mod:`.checker`) hands the records to the observers, which re-frame the bytes (RH-FRM-6/7) and
+judge them.
 
 Formats (detected from the first non-blank lines, :func:`detect_format`):
 
@@ -59,8 +61,8 @@ one second.
 resolution of 1 µs, not 1 ns). :class:`LogMeta` records the unit (``time_unit``), the width
 (``time_digits``) and the evidence in one sentence (``time_unit_basis``) for the report.
 
-Every text line is accounted for: a line the reader cannot read becomes a ``Chunk`` with
-direction ``?`` and a reason (the checker reports it as a finding with its line number).
+Every text line is accounted for: a line the reader cannot read becomes an :class:`Unreadable`
+record (direction ``?``) with a reason (the checker reports it as a finding with its line number).
 """
 
 from __future__ import annotations
@@ -280,7 +282,7 @@ Progress = Optional[Callable[[int], None]]
 
 def read_chunks(f: BinaryIO, fmt: str, meta: LogMeta, *, swap: bool = False,
                 progress: Progress = None) -> Iterator[Chunk]:
-    """Chunks of an open binary log file in format ``fmt`` (streaming, constant memory)."""
+    """The records of an open binary log file in format ``fmt`` (streaming, constant memory)."""
     if fmt == "wirelog":
         return _read_wirelog(f, meta, swap, progress)
     if fmt == "socat-v":
