@@ -8,15 +8,13 @@ certifiers' verdicts, in a results directory of role ``log``.
 
 Modules, one concern each:
 
-* :mod:`.readers` — the capture formats (helmcheck wire-log 1, ``socat -v``, ``socat -x``),
-  format and timestamp-resolution detection, streaming records (:data:`~.readers.Chunk`).
-* :mod:`.checker` — :func:`~.checker.check_log`: re-framing per direction, decoding, dispatch to
-  the judges, vehicle framing/content clauses (RH-FRM-*, RH-OUT-1..3), bounded bookkeeping.
-* :mod:`.vehicle` — the replay through the model: RH-ACK-*, RH-OUT-4, the command and timer
-  clauses, plant events from recorder notes or inferred from ``$OSI``.
-* RH-BS-1..8 are judged by :class:`helmcheck.judge.backseat.BackseatObserver`, the observer
-  ``certify backseat`` uses, fed every record by the checker.
-* :mod:`.accounting` — per-clause counts, bounded evidence, verdicts.
+* :mod:`.readers` — format detection, timestamp resolution, and the helmcheck wire-log 1 reader;
+* :mod:`.socat` — the ``socat -v`` / ``-x`` / ``-v -x`` reader and its timestamp unit;
+* :mod:`.records` — what the readers yield (:data:`~.records.Chunk`) and learn (:class:`~.records.LogMeta`);
+* :mod:`.checker` — :func:`~.checker.check_log`: one pass over the records, each fed to the role's
+  observer (:mod:`helmcheck.judge`: the vehicle observer for §1–8, the backseat observer for §9,
+  the same ones the certifiers use), bounded bookkeeping;
+* :mod:`.sidejob` — a second process for the backseat role of a long log;
 * :mod:`.report` — ``results.json``, the log copy, the rendered reports.
 """
 
