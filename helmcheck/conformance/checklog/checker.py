@@ -35,14 +35,13 @@ from ...judge.ledger import Evidence as LedgerEvidence, Ledger
 from ...judge.vehicle import VehicleObserver
 from ...model.missions import MissionCatalog
 from ...profile import DEFAULT, Profile
-from .readers import (NOTE, UNREADABLE, Chunk, LogMeta, Unreadable, detect_format, header_comment, read_chunks,
+from .readers import (HEAD_BYTES, NOTE, UNREADABLE, Chunk, LogMeta, Unreadable, detect_format, header_comment, read_chunks,
                       timestamp_resolution)
 from .sidejob import SideJob, SideJobLost, cores
 
 __all__ = ["check_log", "CheckOutcome", "LogFormatError", "ROLES", "VEHICLE_CLAUSES"]
 
 ROLES = ("vehicle", "backseat", "both")
-HEAD_BYTES = 64 * 1024
 MAX_FINDINGS = 50
 #: From this size on, ``role="both"`` judges the backseat role in a second process (when the
 #: machine has a second core): below it, starting that process costs more than it saves.
