@@ -13,6 +13,10 @@ Decisions:
   ignored, so the partial results and reports are written; a second Ctrl-C raises again (the
   user insists), as Python does by default.
 - Off the main thread (a test calling a command in a worker thread) nothing is installed.
+- Within :func:`deferred` an ending signal does not raise at once: it raises when the block
+  ends. The recorder writes a record to the wire log and feeds it to the judges inside one such
+  block, so an interruption never leaves a record logged but unjudged, or judged halfway (the
+  live verdicts would then differ from the log's).
 """
 
 from __future__ import annotations
@@ -24,9 +28,16 @@ from typing import Iterator
 
 from .failures import Interrupted
 
-__all__ = ["ENDING_SIGNALS", "ending_signals"]
+__all__ = ["ENDING_SIGNALS", "ending_signals", "deferred"]
 
 ENDING_SIGNALS = tuple(getattr(signal, name) for name in ("SIGINT", "SIGTERM", "SIGHUP") if hasattr(signal, name))
+
+
+class _Deferral:
+    """How deep the :func:`deferred` blocks run, and the signal that came inside one."""
+
+    depth = 0
+    pending: str | None = None
 
 
 class _Handler:
@@ -38,6 +49,23 @@ class _Handler:
         if self.raised is not None and signum != signal.SIGINT:
             return
         self.raised = name
+        if _Deferral.depth:
+            _Deferral.pending = name  # raised when the deferred block ends
+            return
+        raise Interrupted(name)
+
+
+@contextmanager
+def deferred() -> Iterator[None]:
+    """An ending signal that comes within the block raises :class:`Interrupted` when the block
+    ends, not inside it (module docstring)."""
+    _Deferral.depth += 1
+    try:
+        yield
+    finally:
+        _Deferral.depth -= 1
+    if _Deferral.depth == 0 and _Deferral.pending is not None:
+        name, _Deferral.pending = _Deferral.pending, None
         raise Interrupted(name)
 
 

@@ -7,6 +7,9 @@ and what it knows besides (notes). Each event is written to the wire log (format
 check of the same log therefore feeds the observers the very same events, and reaches the same
 verdicts (issue "One judge per role").
 
+A record is written and fed inside :func:`helmcheck.signals.deferred`: Ctrl-C or SIGTERM never
+leaves one logged but not judged, or judged halfway.
+
 Writes are flushed record by record, so a crash loses nothing recorded; a write that fails
 (a full disk) is remembered in :attr:`Recorder.write_error` and the run goes on judging — the
 command line reports the lost log loudly at the end.
@@ -18,6 +21,7 @@ from typing import IO, Iterable, Optional
 
 from ..grammar.capture import HEADER, NOTE, format_record
 from ..judge.wire import WireEvent
+from ..signals import deferred
 
 __all__ = ["Recorder"]
 
@@ -67,23 +71,25 @@ class Recorder:
         returns the time as recorded."""
         if not raw:
             return t
-        t = self._time(t)
-        n = self._write(format_record(t, direction, raw))
-        self.records += 1
-        ev = WireEvent(t, direction, raw, "", n)
-        for o in self.observers:
-            o.feed(ev)
+        with deferred():
+            t = self._time(t)
+            n = self._write(format_record(t, direction, raw))
+            self.records += 1
+            ev = WireEvent(t, direction, raw, "", n)
+            for o in self.observers:
+                o.feed(ev)
         return t
 
     def note(self, t: float, text: str) -> float:
         """A note (``!``) at ``t``; returns the time as recorded."""
-        t = self._time(t)
-        text = text.replace("\n", " ").replace("\r", " ")
-        n = self._write(format_record(t, NOTE, note=text))
-        self.records += 1
-        ev = WireEvent(t, NOTE, b"", text, n)
-        for o in self.observers:
-            o.feed(ev)
+        with deferred():
+            t = self._time(t)
+            text = text.replace("\n", " ").replace("\r", " ")
+            n = self._write(format_record(t, NOTE, note=text))
+            self.records += 1
+            ev = WireEvent(t, NOTE, b"", text, n)
+            for o in self.observers:
+                o.feed(ev)
         return t
 
     def close(self) -> None:
