@@ -99,7 +99,10 @@ class Custodian:
             self.found_mission = getattr(osi, "mission_name", None) or None
 
     def survey(self, session: Any) -> None:
-        """In ``S``: read every setting not read yet (``$ORWSET,<name>,R``)."""
+        """In ``S``: read every setting not read yet (``$ORWSET,<name>,R``) — when the profile
+        claims ``$ORWSET`` (what cannot be read is never written: the interlock)."""
+        if "ORWSET" not in session.profile.commands:
+            return
         for rec in self.records.values():
             if rec.before is not None:
                 continue

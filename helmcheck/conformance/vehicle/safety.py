@@ -9,6 +9,12 @@ might act on a line it should have discarded, so such a line must be safe as wel
 reason a motion command's speed is checked in **every alignment a vehicle could execute**: as
 sent, and with up to two leading empty fields or a clear keyword passed over
 (``$OMW,,<lat>,<lon>,…`` read from its second field), wherever the position fields are numbers.
+
+Whatever ``in_water`` says, the tester never sends a remote-helm command the profile does not
+claim (``commands``, §10): a vehicle without it would have to discard the line (RH-FRM-5), so
+nothing it does with it can be judged, and a case that needs it is NOT-TESTED with that reason.
+Decision (spec silent): any case of the ID counts (``$orwset`` for ``ORWSET``) — a faulty vehicle
+might act on a line it should discard.
 """
 
 from __future__ import annotations
@@ -16,7 +22,7 @@ from __future__ import annotations
 from decimal import Decimal, InvalidOperation
 from typing import Optional
 
-from ...profile import Profile
+from ...profile import COMMAND_IDS, Profile
 
 __all__ = ["BenchGuard", "BenchSafetyRefused"]
 
@@ -62,6 +68,7 @@ class BenchGuard:
         self.active = not b.in_water
         self.max_motor = int(b.max_motor_byte)
         self.max_speed = Decimal(str(b.max_speed_kn))
+        self.unclaimed = frozenset(COMMAND_IDS) - frozenset(profile.commands)
         self.refused = 0
 
     def describe(self) -> dict:
@@ -70,11 +77,12 @@ class BenchGuard:
 
     def problem(self, raw: bytes) -> Optional[str]:
         """Why ``raw`` must not be sent, or ``None``. Every ``$`` sentence in ``raw`` is read."""
-        if not self.active:
-            return None
         text = raw.decode("latin-1")
         for chunk in text.split("$")[1:]:
-            why = self._sentence(chunk)
+            sid = chunk.split("*", 1)[0].split(",", 1)[0].strip().upper()
+            if sid in self.unclaimed:
+                return f"${sid} is not among the commands the profile claims (commands)"
+            why = self._sentence(chunk) if self.active else None
             if why:
                 return why
         return None

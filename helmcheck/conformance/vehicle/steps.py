@@ -94,6 +94,7 @@ class Until:
     budget_v: float = 600.0
     surface: bool = False
     srp_active: Optional[bool] = None
+    submerged: Optional[bool] = None  #: True: until the depth is below the GPS-fix depth
 
 
 @dataclass(frozen=True)

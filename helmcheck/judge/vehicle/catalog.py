@@ -11,9 +11,14 @@ A real vehicle's mission files are not on the wire. The observer knows:
   it are INCONCLUSIVE (:class:`UnknownMission`).
 
 Waypoint positions are never known (the judges never read them: ``$OSI`` field 7 is the
-vehicle's own report). Park times are learnt from the first mission park the vehicle shows
-(``None`` = not seen yet, taken as no park until then); the length of a mission of unknown
-length is learnt when an ``S`` is explained by nothing but its end (RH-MSN-4).
+vehicle's own report). Park times are learnt from the mission parks the vehicle shows (``None``
+= not seen yet, taken as no park until then). A park first seen some time after it began is
+known only within an interval: at least the time the report shows, at most that plus the time
+since the park could have begun. A later report seen closer to a park's start (a mission
+restarted on station at that waypoint, RH-MSN-2) narrows the interval (:meth:`StubMission.refine_park`);
+a sighting outside it is not this park (the report is judged against the interval). The length
+of a mission of unknown length is learnt when an ``S`` is explained by nothing but its end
+(RH-MSN-4).
 
 With the vehicle's mission files (``check-log --missions DIR``, or an emulator's own catalogue in
 tests) the observer is given a real :class:`~helmcheck.model.missions.MissionCatalog` instead,
@@ -61,6 +66,8 @@ class StubMission:
     name: str
     waypoints: Optional[int] = None
     parks: dict = field(default_factory=dict)
+    #: waypoint -> (shortest, longest) park the sightings so far allow (vehicle seconds)
+    bounds: dict = field(default_factory=dict)
     _cache: Optional[Mission] = None
 
     def mission(self) -> Mission:
@@ -86,14 +93,38 @@ class StubMission:
             self.waypoints = last + 1
             self._cache = None
 
-    def learn_park(self, index: int, seconds: float) -> None:
-        """RH-RD-5: the mission parks ``seconds`` at waypoint ``index`` (first sighting wins)."""
+    def learn_park(self, index: int, seconds: float, shortest: Optional[float] = None) -> None:
+        """RH-RD-5: the mission parks ``seconds`` at waypoint ``index`` (first sighting wins); it
+        may be as short as ``shortest`` (a park first seen after it began)."""
         if self.parks.get(index) is None:
-            self.parks[index] = max(0.0, float(seconds))
+            seconds = max(0.0, float(seconds))
+            self.parks[index] = seconds
+            self.bounds[index] = (seconds if shortest is None else min(seconds, max(0.0, shortest)), seconds)
             self._cache = None
 
     def park_known(self, index: int) -> bool:
         return self.parks.get(index) is not None
+
+    def park_bounds(self, index: int) -> Optional[tuple[float, float]]:
+        """The (shortest, longest) park at ``index`` the sightings allow, or None."""
+        if self.parks.get(index) is None:
+            return None
+        return self.bounds.get(index, (self.parks[index], self.parks[index]))
+
+    def refine_park(self, index: int, shortest: float, longest: float) -> bool:
+        """A report showing the park at ``index`` between ``shortest`` and ``longest`` long:
+        narrows what is known when the two agree (returns True), else changes nothing."""
+        got = self.park_bounds(index)
+        if got is None:
+            return False
+        lo, hi = max(got[0], shortest), min(got[1], longest)
+        if lo > hi + 1e-9:
+            return False
+        if (lo, hi) != got:
+            self.bounds[index] = (lo, hi)
+            self.parks[index] = hi
+            self._cache = None
+        return True
 
     @property
     def park_waypoint(self) -> Optional[int]:
