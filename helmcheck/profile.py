@@ -333,6 +333,10 @@ def profile_from_dict(data: dict[str, Any], where: str = "<profile>") -> Profile
         if key == "bench_safety":
             kwargs[key] = _bench(where, value)
             continue
+        if key == EMULATOR_TABLE:
+            if not isinstance(value, dict):
+                raise ProfileError(f"{where}: [{EMULATOR_TABLE}] must be a table")
+            continue  # the emulator's own choices (helmcheck emulate reads them); not part of the claim
         if key not in known:
             raise ProfileError(f"{where}: unknown key {key!r}; known keys: {', '.join(sorted(known))}")
         kwargs[key] = _check(where, key, value, known[key])
@@ -363,6 +367,22 @@ def _check_trigger(where: str, kw: dict[str, Any]) -> None:
         if not kw.get("violation_after_s", 0.0) > 0:
             raise ProfileError(f"{where}: key 'violation_trigger': 'mission-rule' needs violation_after_s > 0, "
                                f"the vehicle seconds after its start at which the rule trips")
+
+
+#: The table of a profile file that holds ``helmcheck emulate``'s own settings, the freedoms the
+#: profile leaves a vehicle (:mod:`helmcheck.conformance.emulator.freedoms`). Only the emulator
+#: reads it (:func:`load_emulator_table`); a profile never carries it, so a tester never learns it.
+EMULATOR_TABLE = "emulator"
+
+
+def load_emulator_table(path: str | Path | None) -> dict[str, Any]:
+    """The ``[emulator]`` table of the profile file at ``path`` (``{}`` when none); call after
+    :func:`load_profile` has accepted the file."""
+    if path is None:
+        return {}
+    data = tomllib.loads(Path(path).read_bytes().decode("utf-8"))
+    table = data.get(EMULATOR_TABLE, {})
+    return table if isinstance(table, dict) else {}
 
 
 #: The built-in emulator's profile, package data (``helmcheck/profiles/emulator.toml``).

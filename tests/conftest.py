@@ -6,7 +6,11 @@ a function of the test alone) and keeps no example database between runs. ``make
 a database, and :data:`FUZZ_FACTOR` times the examples each test asks for.
 
 It also checks that no process helmcheck started (``--exec``) outlives the test session, and
-that every results directory a test writes verifies (live and offline judging agree).
+that every results directory a test writes verifies (live and offline judging agree): after
+each test, the directories under its ``tmp_path`` (:func:`every_run_verifies`); at the end of
+the session, every results directory under this worker's base temporary directory —
+``tmp_path_factory`` runs of module and session fixtures included (:func:`every_directory_verifies`,
+:func:`results_directories`). A directory verified once is not re-judged unless it changed.
 
 ``make test`` runs the suite on several workers (pytest-xdist, ``--dist loadgroup``): a module
 whose tests share a module-scoped run marks itself ``xdist_group`` so the run happens once, and
@@ -74,6 +78,45 @@ def pytest_configure(config):
                                        "purpose; the agreement check skips them")
 
 
+#: directories a test tampers with on purpose (``unverifiable``) or whose test failed: not checked
+_EXCLUDED: set[Path] = set()
+#: directory -> the stamp of its files when it verified (a directory verified once is not re-judged)
+_VERIFIED: dict[Path, tuple] = {}
+
+
+def results_directories(base: Path) -> list[Path]:
+    """Every results directory of a run under *base*: a ``results.json`` beside the
+    ``profile.toml`` of a certification (a report fixture or a check-log directory has none),
+    in a directory no ``unverifiable`` or failed test owns."""
+    out = []
+    for res in sorted(Path(base).rglob("results.json")):
+        d = res.parent
+        if (d / "profile.toml").is_file() and not any(d == x or x in d.parents for x in _EXCLUDED):
+            out.append(d)
+    return out
+
+
+def _stamp(d: Path) -> tuple:
+    return tuple((p.name, p.stat().st_mtime_ns, p.stat().st_size) for p in sorted(d.iterdir()) if p.is_file())
+
+
+def verify_directories(dirs) -> list[str]:
+    """``helmcheck verify`` (unsigned) of each directory: one line per directory that does not verify."""
+    from helmcheck.reports.verify import verify_run
+
+    problems = []
+    for d in dirs:
+        stamp = _stamp(d)
+        if _VERIFIED.get(d) == stamp:
+            continue
+        got = verify_run(d)
+        if got.ok:
+            _VERIFIED[d] = stamp
+        else:
+            problems.append(f"{d}: " + "; ".join(map(str, got.findings[:6])))
+    return problems
+
+
 @pytest.fixture(autouse=True)
 def every_run_verifies(request):
     """One judge per role: every results directory a test writes under its ``tmp_path`` is
@@ -81,22 +124,33 @@ def every_run_verifies(request):
     clause verdict, the run verdict and the certificate flag must follow — live and offline agree."""
     yield
     tmp = request.node.funcargs.get("tmp_path") if hasattr(request.node, "funcargs") else None
-    if tmp is None or request.node.get_closest_marker("unverifiable"):
+    if tmp is None:
         return
-    if hasattr(request.node, "rep_call") and request.node.rep_call.failed:
+    if request.node.get_closest_marker("unverifiable") or (
+            hasattr(request.node, "rep_call") and request.node.rep_call.failed):
+        _EXCLUDED.add(Path(tmp))
         return
-    from helmcheck.reports.verify import verify_run
-
-    problems = []
-    for res in sorted(Path(tmp).rglob("results.json")):
-        d = res.parent
-        if not (d / "profile.toml").is_file():
-            continue  # not a certification (a report fixture, a check-log directory)
-        got = verify_run(d)
-        if not got.ok:
-            problems.append(f"{d}: " + "; ".join(map(str, got.findings[:6])))
+    problems = verify_directories(results_directories(Path(tmp)))
     if problems:
         pytest.fail("live and offline judging disagree:\n" + "\n".join(problems), pytrace=False)
+
+
+@pytest.fixture(scope="session")
+def session_results_directories(tmp_path_factory):
+    """A function listing every results directory written so far in this session by this
+    worker (under its base temporary directory; pytest-xdist gives each worker its own)."""
+    return lambda: results_directories(tmp_path_factory.getbasetemp())
+
+
+@pytest.fixture(scope="session", autouse=True)
+def every_directory_verifies(session_results_directories):
+    """At the end of the session, every results directory any test wrote — under ``tmp_path``
+    or under ``tmp_path_factory`` (module and session fixtures) — verifies."""
+    yield
+    problems = verify_directories(session_results_directories())
+    if problems:
+        pytest.fail("results directories written in this session do not verify:\n" + "\n".join(problems),
+                    pytrace=False)
 
 
 @pytest.hookimpl(hookwrapper=True)

@@ -1,4 +1,5 @@
-"""JUnit XML, read back with junitparser: one testcase per clause, verdicts mapped, digest kept."""
+"""JUnit XML, read back with junitparser: one testcase per clause and one ``run-verdict`` testcase,
+verdicts mapped, digest kept."""
 
 from __future__ import annotations
 
@@ -27,9 +28,15 @@ def junit_of(tmp_path: Path, name: str, mutate=None):
     render_all(d, formats=("junit",))
     xml = JUnitXml.fromfile(str(d / "junit.xml"))
     suites = list(xml) if isinstance(xml, JUnitXml) else [xml]
-    cases = [case for suite in suites for case in suite]
+    cases = [case for suite in suites for case in suite if case.classname != "run"]  # the clauses
     doc = json.loads((d / "results.json").read_text(encoding="utf-8"))
     return d, suites, {case.name.split(" ", 1)[0]: case for case in cases}, cases, doc
+
+
+def run_case(suites):
+    [case] = [case for suite in suites for case in suite if case.classname == "run"]
+    assert case.name == "run-verdict"
+    return case
 
 
 @pytest.mark.parametrize("name", ["pass_run", "fail_run", "backseat_run"])
@@ -63,7 +70,9 @@ def test_verdicts_map_to_junit_results(tmp_path):
             assert results == []
     suite = suites[0]
     counts = {v: sum(c["verdict"] == v for c in doc["clauses"]) for v in ("fail", "inconclusive", "not-tested")}
-    assert (suite.failures, suite.errors, suite.skipped) == (counts["fail"], counts["inconclusive"],
+    # the run-verdict testcase counts too: the run is FAIL
+    assert doc["verdict"] == "fail" and isinstance(run_case(suites).result[0], Failure)
+    assert (suite.failures, suite.errors, suite.skipped) == (counts["fail"] + 1, counts["inconclusive"],
                                                              counts["not-tested"])
 
 
@@ -86,7 +95,7 @@ def test_non_strict_passes_with_a_note_or_fails_when_strict(tmp_path):
     _, suites, by_id, _, doc = junit_of(tmp_path / "strict", "backseat_run", strict)
     [res] = by_id["RH-BS-7"].result
     assert isinstance(res, Failure) and res.type == "non-strict"
-    assert suites[0].failures == 2
+    assert suites[0].failures == 3  # two clauses and the run verdict
 
 
 def test_digest_and_verdict_are_properties(tmp_path):

@@ -128,7 +128,8 @@ def test_junit_has_a_process_testcase_that_fails_when_it_ended_early(tmp_path):
         assert len(case) == 1 and case[0].get("name") == "backseat under test"
         failure = case[0].find("failure")
         assert (failure is not None) is early
-        assert suite.get("tests") == "4" and suite.get("failures") == ("1" if early else "0")
+        # 3 clauses, the process and the run verdict (FAIL when it ended early: a second failure)
+        assert suite.get("tests") == "5" and suite.get("failures") == ("2" if early else "0")
         if early:
             assert failure.get("type") == "process-ended" and "exited with code 3" in failure.get("message")
             assert failure.text.endswith("Traceback: boom")

@@ -39,6 +39,13 @@ the vehicle's own safety rules (RH-SAF-5), for certifying without $OXFLT:
   raises Stl 120 vehicle seconds after the mission starts (profile violation_trigger =
   "mission-rule"). SIGUSR1 is an operator tripping the leak sensor on the bench: the vehicle
   raises Sle at once (profile violation_trigger = "operator"), e.g. kill -USR1 <pid>.
+
+choices the profile leaves a conforming vehicle (docs/freedoms.md): the [emulator] table of the
+--profile file, or --set KEY=VALUE (a TOML value; a.b=V sets key b of table a), e.g.
+  helmcheck emulate --set 'reply_delay_s=[0.1, 0.6]' --set control_tick_s=0.25
+  helmcheck emulate --set timer_factor=1.03 --set pacing=burst --set decimals.lat=6
+A setting outside the profile's bounds is warned about and still obeyed (a non-conforming
+vehicle, for testing a tester).
 """
 
 
@@ -61,6 +68,9 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p.add_argument("--tui", action="store_true", help="live view in the terminal")
     p.add_argument("--fault-injection", action=argparse.BooleanOptionalAction, default=True,
                    help="honour $OXFLT,<code> (RH-SAF-5); default on")
+    p.add_argument("--set", dest="settings_set", action="append", default=[], metavar="KEY=VALUE",
+                   help="an emulator setting (a freedom the profile leaves a vehicle; docs/freedoms.md); "
+                        "overrides the profile file's [emulator] table; repeatable")
     p.set_defaults(func=run)
     return p
 
@@ -99,6 +109,10 @@ def run(args: argparse.Namespace) -> int:  # noqa: C901 - argument checks, then 
     from .ports import port_spec
 
     profile = load_profile(args.profile)  # a ProfileError is exit 64 (helmcheck.cli)
+    try:
+        choices = _emulator_settings(args)
+    except ValueError as e:
+        return _usage(str(e))
     scale = args.time_scale if args.time_scale is not None else profile.time_scale
     if not (isinstance(scale, float) or isinstance(scale, int)) or not math.isfinite(scale) or scale <= 0:
         return _usage(f"--time-scale must be a positive number (got {args.time_scale})")
@@ -139,7 +153,7 @@ def run(args: argparse.Namespace) -> int:  # noqa: C901 - argument checks, then 
         if main_log_path:
             main_log_file = open_output_stream(main_log_path, "--main-log", stop=True, what="main log",
                                                newline="")
-        return _serve(args, profile, link, baud, missions_dir, log_file, main_log_file)
+        return _serve(args, profile, link, baud, missions_dir, log_file, main_log_file, choices)
     except BaseException:
         link.close()
         raise
@@ -152,7 +166,19 @@ def run(args: argparse.Namespace) -> int:  # noqa: C901 - argument checks, then 
                     pass
 
 
-def _serve(args, profile, link, baud, missions_dir, log_file, main_log_file) -> int:
+def _emulator_settings(args: argparse.Namespace):
+    """The ``[emulator]`` table of ``--profile``, then each ``--set`` (a ``ValueError`` names a bad one)."""
+    from ..conformance.emulator.freedoms import DEFAULT_SETTINGS, parse_assignment, settings_from_dict
+    from ..profile import load_emulator_table
+
+    st = settings_from_dict(load_emulator_table(args.profile), where=f"{args.profile}: [emulator]",
+                            base=DEFAULT_SETTINGS)
+    for text in args.settings_set:
+        st = settings_from_dict(parse_assignment(text), where=f"--set {text}", base=st)
+    return st
+
+
+def _serve(args, profile, link, baud, missions_dir, log_file, main_log_file, choices=None) -> int:
     """Serve until stopped. A signal (:mod:`helmcheck.signals`) stops it with exit 0; a link that
     fails during the run is a :class:`~helmcheck.failures.LinkFault` (exit 2); a log that cannot
     be written stops it with :class:`~helmcheck.failures.OutputLost` (exit 2)."""
@@ -172,7 +198,7 @@ def _serve(args, profile, link, baud, missions_dir, log_file, main_log_file) -> 
         if log_file is not None:
             log = WireLogWriter(log_file, meta=(f"started {started.strftime('%Y-%m-%dT%H:%M:%S.%fZ')}  "
                                                 f"port {link.name}  baud {baud}  time_scale {profile.time_scale:g}"))
-        core = EmulatorCore(profile, catalog, start=time.monotonic(), baud=baud, log=log,
+        core = EmulatorCore(profile, catalog, start=time.monotonic(), baud=baud, log=log, settings=choices,
                             main_log=MainLog(main_log_file) if main_log_file is not None else None,
                             settings_path=Path(args.settings) if args.settings else None,
                             utc0=started.timestamp(),
@@ -188,6 +214,11 @@ def _serve(args, profile, link, baud, missions_dir, log_file, main_log_file) -> 
         print(f"helmcheck emulate: {link.description}, profile {profile.name}, time scale "
               f"{profile.time_scale:g}, baud {baud or 'unpaced'}, fault injection "
               f"{profile.fault_injection}, missions {', '.join(str(d) for d in dirs)}", file=sys.stderr)
+        if choices is not None and not choices.is_default:
+            from ..conformance.emulator.freedoms import nonconforming
+            print(f"helmcheck emulate: settings {' '.join(choices.assignments())}", file=sys.stderr)
+            for why in nonconforming(choices, profile):
+                print(f"helmcheck emulate: warning: not a conforming vehicle: {why}", file=sys.stderr)
         stopped = "stopped"
         try:
             if ui is not None:

@@ -8,6 +8,8 @@ reads them. Modules:
 * :mod:`~helmcheck.judge.timing` — RH-TIM-1 tolerances, observer slack, the ACK window;
 * :mod:`~helmcheck.judge.facts` — protocol facts derived from the transition table;
 * :mod:`~helmcheck.judge.wire` — wire events and the recorder notes a judge understands;
+* :mod:`~helmcheck.judge.runfacts` — the run facts (selection, the implementation's end, a
+  run cut short) the wire log's notes record, booked into a ledger;
 * :mod:`~helmcheck.judge.vehicle` — the vehicle observer (§1–8);
 * :mod:`~helmcheck.judge.backseat` — the backseat observer (§9).
 

@@ -10,7 +10,11 @@ observation of one clause:
   (reference profile, preamble);
 * ``inconclusive`` — the clause was exercised but could not be judged (timing the observer
   cannot bound, a mission file it does not have, a link fault);
-* ``not_tested`` — why the clause could not be exercised at all.
+* ``not_tested`` — why the clause could not be exercised at all;
+* ``withdraw`` — the clause is outside what the run judged (a ``--select`` run that did not
+  select it; a backseat whose exit cut short the scenarios exercising it): NOT-TESTED with that
+  reason whatever was observed, except a violation, which stands (a run fact,
+  :mod:`helmcheck.judge.runfacts`).
 
 The one combining rule (TTCN-3, "first fail wins"): ``fail``/``non-strict`` > ``inconclusive`` >
 ``pass`` > ``not-tested``. The reason shown is the first one at the winning level, with the
@@ -84,6 +88,7 @@ class _Entry:
                                                                           "not-tested")})
     cases: dict = field(default_factory=dict)
     remarks: list = field(default_factory=list)
+    withdrawn: Optional[tuple[str, str]] = None  #: (reason, prefix of an observed violation's reason)
 
 
 class Ledger:
@@ -173,6 +178,14 @@ class Ledger:
         """Why the clause could not be exercised (shown only if nothing else was found)."""
         self._add(cid, "not-tested", reason, (), case)
 
+    def withdraw(self, cid: str, reason: str, observed: str = "") -> None:
+        """The clause is outside what the run judged: its verdict is NOT-TESTED with *reason*
+        whatever was observed — except a violation, which stands, its reason prefixed with
+        *observed*. The first withdrawal of a clause holds; booking it again changes nothing."""
+        e = self._e.get(cid)
+        if e is not None and e.withdrawn is None:
+            e.withdrawn = (reason, observed)
+
     def remark(self, cid: str, text: str) -> None:
         """A remark appended to the clause's reason (an inference its verdict rests on)."""
         e = self._e.get(cid)
@@ -236,6 +249,13 @@ class Ledger:
         if e.remarks and out.verdict != "not-tested":
             out = ClauseVerdict(out.id, out.verdict, out.reason + " Note: " + " ".join(e.remarks), out.level,
                                 out.cases, out.evidence, out.lines, out.offending_count, out.observations)
+        if e.withdrawn is not None:
+            why, observed = e.withdrawn
+            if out.verdict in ("fail", "non-strict"):
+                out = ClauseVerdict(out.id, out.verdict, observed + out.reason, out.level, out.cases, out.evidence,
+                                    out.lines, out.offending_count, out.observations)
+            else:
+                out = ClauseVerdict(cid, "not-tested", why, level, (), (), (), 0, 0)
         return out
 
     def verdicts(self) -> list[ClauseVerdict]:

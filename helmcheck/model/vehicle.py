@@ -338,6 +338,8 @@ class VehicleModel:
         self._set_snapshot(snapshot)
         if self.phase == "ascent" and self.now is not None:
             self._maybe_surface(self.now)
+            if self.phase != "ascent":
+                self._base = None  # reaching the surface is an input: what came before is past
         out, self._pending = self._pending, []
         return out
 

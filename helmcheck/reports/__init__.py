@@ -4,6 +4,9 @@ Modules, one concern each:
 
 * :mod:`~helmcheck.reports.results` — ``results.json`` schema 1: builder, validator, loader,
   verdict rules (:func:`overall_verdict`, :func:`run_verdict`, :func:`exit_code`).
+* :mod:`~helmcheck.reports.assemble` — the one way from a verdict ledger and the run facts to
+  clause entries, run verdict and certificate flag (every certifier, ``check-log`` and
+  ``verify``).
 * :mod:`~helmcheck.reports.atomic` — atomic file writes.
 * :mod:`~helmcheck.reports.digest` — the certificate digest (SHA-256 of both files).
 * :mod:`~helmcheck.reports.wirelog` — a tolerant summary of the wire log.
@@ -23,7 +26,8 @@ Certificates (issue: certificates anyone can verify):
 * :mod:`~helmcheck.reports.manifest` — file digests and the signed manifest;
 * :mod:`~helmcheck.reports.signing` — Ed25519 keys and signatures;
 * :mod:`~helmcheck.reports.certificate` — :func:`finish_run`, the end of every certification;
-* :mod:`~helmcheck.reports.verify` — re-judging a results directory (``helmcheck verify``).
+* :mod:`~helmcheck.reports.verify` — re-judging a results directory (``helmcheck verify``): the
+  assembly again, on the evidence, compared.
 """
 
 from .digest import Digest, digest_bytes, digest_dir

@@ -1,4 +1,4 @@
-"""JUnit XML for CI dashboards: one ``<testcase>`` per clause of the results.
+"""JUnit XML for CI dashboards: one ``<testcase>`` per clause of the results, and the run verdict.
 
 Mapping (classname = section of the reference profile, name = clause ID + short title):
 
@@ -19,6 +19,15 @@ When helmcheck started the implementation (``process`` in the results, ``--exec`
 testcase (classname ``process``) says how it ended: a ``<failure type="process-ended">`` quoting
 its last output when it ended before the run's end — a dashboard must not show a run whose
 implementation died as a row of skipped clauses — else a plain testcase.
+
+The last testcase (classname ``run``, name ``run-verdict``) carries the run verdict, so a
+dashboard's totals never disagree with the exit status: ``fail`` (or ``non-strict`` in a strict
+run) → ``<failure type="run-verdict">``, ``inconclusive`` (an interrupted run, a backseat that
+never connected, a clause that could not be judged) → ``<error type="inconclusive">``, else a
+plain testcase. The message is ``VERDICT: reason``. A run that is not a certificate (partial,
+:mod:`.scope`) says so in the case's text (``<system-out>`` for a plain testcase) and in the
+suite property ``helmcheck.not_a_certificate`` (the scope statement and why; absent for a
+certificate).
 """
 
 from __future__ import annotations
@@ -54,6 +63,39 @@ def _evidence_text(row: Mapping[str, Any]) -> str:
     return _t("\n".join(head + lines))
 
 
+def _not_a_certificate(scope) -> str:
+    """Why the run is not a certificate (the scope statement and its gaps), or "" if it is one."""
+    if scope.certificate:
+        return ""
+    why = scope.why()
+    return scope.statement + (" — " + "; ".join(why) if why else "")
+
+
+def _run_verdict_case(suite: ET.Element, r: Mapping[str, Any], strict: bool, not_a_certificate: str,
+                      tallies: dict[str, int]) -> None:
+    """The ``run-verdict`` testcase (module docstring)."""
+    tallies["tests"] += 1
+    v = r["verdict"]
+    case = ET.SubElement(suite, "testcase", classname="run", name="run-verdict", time=f'{r["duration_s"] or 0:.3f}')
+    if not_a_certificate:
+        props = ET.SubElement(case, "properties")
+        ET.SubElement(props, "property", name="helmcheck.not_a_certificate", value=_t(not_a_certificate))
+    message = f"{VERDICT_LABEL.get(v, str(v).upper())}: {r['verdict_reason']}"
+    text = "\n".join(x for x in (message, headline(r), not_a_certificate and f"Not a certificate: {not_a_certificate}")
+                     if x)
+    if v == "fail" or (v == "non-strict" and strict):
+        el = ET.SubElement(case, "failure", message=_t(message), type="run-verdict")
+        el.text = _t(text)
+        tallies["failures"] += 1
+    elif v == "inconclusive":
+        el = ET.SubElement(case, "error", message=_t(message), type="inconclusive")
+        el.text = _t(text)
+        tallies["errors"] += 1
+    else:
+        out = ET.SubElement(case, "system-out")
+        out.text = _t(text)
+
+
 def render_junit(run: Run, strict: bool | None = None) -> str:
     """The JUnit XML document (a string with an XML declaration). *strict* defaults to the run's."""
     r = run.results
@@ -86,6 +128,9 @@ def render_junit(run: Run, strict: bool | None = None) -> str:
         ("helmcheck.tool_version", r["tool"]["version"]),
         ("helmcheck.command", r["command"]),
     ] + [(f"implementation.{k}", "" if v is None else str(v)) for k, v in r["implementation"].items()]
+    not_a_certificate = _not_a_certificate(scope)
+    if not_a_certificate:
+        meta.insert(4, ("helmcheck.not_a_certificate", not_a_certificate))
     for name, value in meta:
         ET.SubElement(props, "property", name=_t(name), value=_t(value))
 
@@ -121,6 +166,7 @@ def render_junit(run: Run, strict: bool | None = None) -> str:
             el = ET.SubElement(case, "failure", message=_t(describe_process(proc, r["role"])), type="process-ended")
             el.text = _t("\n".join([f"command: {proc.get('command', '')}", *map(str, proc.get("output_tail") or [])]))
             tallies["failures"] += 1
+    _run_verdict_case(suite, r, strict, not_a_certificate, tallies)
     for key, value in tallies.items():
         suite.set(key, str(value))
 

@@ -1,9 +1,11 @@
 """``results.json`` schema 1: the builder, the loader and the atomic writer.
 
-A results document is a plain ``dict`` (it is JSON on disk and JSON in memory). Certifiers build
-it with :func:`new_results`, :func:`add_clause`, :func:`add_replay`, :func:`add_event`,
-:func:`add_mode`, :func:`add_process` and :func:`finish`, and save it with :func:`write_results_atomic`. Reports read
-it back with :func:`load_results`, which validates it (:mod:`helmcheck.reports.schema`) and turns
+A results document is a plain ``dict`` (it is JSON on disk and JSON in memory). Certifiers start
+it with :func:`new_results`, add :func:`add_replay`, :func:`add_event` and :func:`add_mode`, take
+the clause entries, ``partial``, ``process`` and the run verdict from
+:func:`helmcheck.reports.assemble.assemble` (the one function ``helmcheck verify`` runs again),
+and save it with :func:`write_results_atomic`. :func:`add_clause`, :func:`add_process` and
+:func:`finish` build a document by hand (report fixtures, tests). Reports read it back with :func:`load_results`, which validates it (:mod:`helmcheck.reports.schema`) and turns
 every problem into a one-line :class:`ReportError` naming the file. The verdict rules live in
 :mod:`helmcheck.reports.verdicts` and are re-exported here.
 """

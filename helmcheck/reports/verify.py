@@ -7,15 +7,22 @@
    (``digests``), so one changed byte shows even in an unsigned run;
 3. ``profile.toml`` must load (:func:`helmcheck.profile.load_profile`) and be the profile
    ``results.json`` records (``profile``, key by key);
-4. the wire log is **re-judged** under that profile by the offline observer
+4. ``settings.time_scale`` must be the ``time_scale`` of ``profile.toml``;
+5. the wire log is **re-judged** under that profile by the offline observer
    (:func:`helmcheck.conformance.checklog.check_log`, role ``vehicle`` or ``backseat`` as
-   recorded, the recorded time scale), and every clause verdict, the run verdict and the
-   ``certificate`` flag of ``results.json`` must be the ones the re-judged verdicts give. Only
-   verdict words are compared, not reasons or evidence. Clauses a ``--select`` run did not select
-   must be NOT-TESTED — or a FAIL the run observed anyway, which is re-judged like the others;
-5. if the run is signed (``signature.json``, :mod:`.certificate`), the Ed25519 signature must
-   hold over the manifest and the manifest must name the files as they are now; with a trusted
-   public key (``--public-key``) the signature must be that key's, and an unsigned run fails.
+   recorded, the profile's time scale), which also reads the run facts of its notes
+   (:mod:`helmcheck.judge.runfacts`: the selection, the clauses not judged, the ``process``
+   note of an implementation helmcheck started, ``run partial``); then the one function that
+   assembled ``results.json`` (:func:`.assemble.assemble`) runs again on that evidence and
+   everything it decides is compared: ``settings.select`` with the wire log's selection note,
+   every clause verdict (inside and outside the selection), ``partial``, the ``process``
+   object key by key, the run verdict and the ``certificate`` flag. Only verdict words are
+   compared for the clauses, not reasons or evidence. A document saved while the run was still
+   going (``finished`` null, the run never closed it) is assembled as partial, as it was saved;
+6. if the run is signed (``signature.json``, :mod:`.certificate`), the signature and manifest
+   formats must be the ones this helmcheck writes, the Ed25519 signature must hold over the
+   manifest and the manifest must name the files as they are now; with a trusted public key
+   (``--public-key``) the signature must be that key's, and an unsigned run fails.
 
 Every difference is a :class:`Finding` naming the file or clause. A directory that is not a
 results directory at all raises :class:`VerifyUsageError` (exit 64).
@@ -25,21 +32,21 @@ from __future__ import annotations
 
 import json
 from dataclasses import dataclass, field
-from fnmatch import fnmatchcase
 from pathlib import Path
 from typing import Any, Mapping, Optional
 
-from .manifest import PROFILE_NAME, RESULTS_NAME, differing_files, evidence_files, sha256_file
+from ..judge.runfacts import RunFacts
+from .assemble import Assembly, assemble
+from .manifest import MANIFEST_FORMAT, PROFILE_NAME, RESULTS_NAME, differing_files, evidence_files, sha256_file
 from .results import parse_results
 from .schema import validate
-from .scope import scope_of
 from .signing import ALGORITHM, key_id, public_key_from_b64
-from .verdicts import run_verdict
 from .view import VERDICT_LABEL
 
 __all__ = ["Finding", "Verification", "VerifyUsageError", "verify_run"]
 
 _SIGNATURE_NAME = "signature.json"
+_SIGNATURE_FORMAT = "helmcheck-signature-1"  #: :data:`helmcheck.reports.certificate.SIGNATURE_FORMAT`
 _SCHEMA_ERRORS_SHOWN = 5
 
 
@@ -174,74 +181,110 @@ def _check_profile(out: Verification, directory: Path, results: Mapping[str, Any
 
 # --------------------------------------------------------------------------- re-judging
 
-def _selected(results: Mapping[str, Any], cid: str) -> bool:
-    select = (results.get("settings") or {}).get("select") or []
-    if not isinstance(select, list) or not select:
-        return True
-    return any(isinstance(p, str) and fnmatchcase(cid, p) for p in select)
-
-
 def _rejudge(out: Verification, directory: Path, results: Mapping[str, Any], profile) -> None:
     from ..conformance.checklog.checker import LogFormatError, check_log
 
     role = results["role"]
-    if role == "log":
-        role = (results.get("log") or {}).get("role") or "both"
-    time_scale = results["settings"].get("time_scale")
+    judge_role = role if role != "log" else ((results.get("log") or {}).get("role") or "both")
+    settings = results["settings"]
+    recorded_k = settings.get("time_scale")
+    time_scale = float(profile.time_scale or 1.0)
+    if role in ("vehicle", "backseat") and not _same_number(recorded_k, time_scale):
+        out.add("settings.time_scale", f"results.json says {recorded_k}, but profile.toml (the profile the run "
+                                       f"was judged under) has time_scale {time_scale:g}")
+    if role == "log" and isinstance(recorded_k, (int, float)) and recorded_k > 0:
+        time_scale = float(recorded_k)  # a log check's time scale is its own (no profile.toml holds it)
     wire_name, _ = evidence_files(results)
     wire_path = directory / wire_name
     if not wire_path.is_file():
         out.add(wire_name, "missing: there is no evidence to re-judge")
         return
     try:
-        outcome = check_log(wire_path, profile=profile, role=role,
-                            time_scale=float(time_scale) if time_scale else None)
+        outcome = check_log(wire_path, profile=profile, role=judge_role, time_scale=time_scale)
     except (LogFormatError, OSError, ValueError) as e:
         out.add(wire_name, f"cannot be re-judged: {e}")
         return
-    rejudged = {c["id"]: c for c in outcome.clauses}
-    recorded = {c["id"]: c for c in results["clauses"]}
-    verdicts: dict[str, str] = {}
-    for cid, entry in recorded.items():
-        said = entry["verdict"]
-        if not _selected(results, cid) and said not in ("fail", "non-strict"):
-            # outside the selection only what was observed to fail is reported; it is re-judged
-            verdicts[cid] = said
-            if said != "not-tested":
-                out.add(f"clause {cid}", f"results.json says {_word(said)}, but the run did not select it "
-                                         f"(--select {' '.join(results['settings']['select'])})")
-            continue
-        got = rejudged.get(cid)
-        if got is None:
-            verdicts[cid] = said
-            out.add(f"clause {cid}", f"results.json says {_word(said)}; re-judging the wire log as a {role} "
-                                     f"run does not judge this clause")
-            continue
-        verdicts[cid] = got["verdict"]
-        out.clauses_compared += 1
-        if got["verdict"] != said:
-            reason = " ".join(str(got.get("reason") or "").split())
-            out.add(f"clause {cid}", f"results.json says {_word(said)}, the wire log gives {_word(got['verdict'])}"
-                                     + (f" ({reason[:160]})" if reason else ""))
-    for cid, got in rejudged.items():
-        if cid not in recorded and _selected(results, cid) and got["verdict"] != "not-tested":
-            verdicts[cid] = got["verdict"]
-            out.add(f"clause {cid}", f"missing from results.json; the wire log gives {_word(got['verdict'])}")
-    strict = bool(results["settings"].get("strict", False))
-    ordered = [verdicts[cid] for cid in verdicts]
-    expected = run_verdict(ordered, strict=strict, partial=bool(results["partial"]))
-    if expected != results["verdict"]:
-        out.add("verdict", f"results.json says {_word(results['verdict'])}, the re-judged clauses give "
-                           f"{_word(expected)}")
-    if "certificate" in results:
-        scope = scope_of(results, verdicts)
-        if scope.certificate != results["certificate"]:
-            out.add("certificate", f"results.json says {str(results['certificate']).lower()}, the re-judged "
-                                   f"clauses give {str(scope.certificate).lower()} ({scope.statement})")
+    facts = outcome.facts
+    for text in facts.unreadable:
+        out.add(wire_name, f"a run-fact note cannot be read: {text}")
+    # the one function, again, on the evidence (:mod:`.assemble`); a document saved while the run
+    # was still going (``finished`` null: the run never closed it) is partial, as it was saved
+    in_progress = results.get("finished") is None
+    got = assemble(role, outcome.clauses, facts, strict=bool(settings.get("strict", False)),
+                   partial=True if in_progress else None)
+    _compare(out, results, got, facts, judge_role)
     tool = results.get("tool") or {}
     from helmcheck import __version__
     if tool.get("version") != __version__:
         out.notes.append(f"recorded by helmcheck {tool.get('version')}, re-judged by helmcheck {__version__}")
+
+
+def _same_number(a: Any, b: float) -> bool:
+    return isinstance(a, (int, float)) and not isinstance(a, bool) and abs(float(a) - b) <= 1e-9 * max(1.0, abs(b))
+
+
+def _compare(out: Verification, results: Mapping[str, Any], got: Assembly, facts: RunFacts, role: str) -> None:
+    """Every difference between *results* and the assembly of its evidence, one finding each."""
+    said_select = (results["settings"].get("select") or [])
+    if not isinstance(said_select, list) or [str(p) for p in said_select] != list(facts.select):
+        out.add("settings.select", f"results.json says {_patterns(said_select)}, the wire log's selection is "
+                                   f"{_patterns(list(facts.select))}")
+    rejudged = {c["id"]: c for c in got.clauses}
+    recorded = {c["id"]: c for c in results["clauses"]}
+    for cid, entry in recorded.items():
+        said = entry["verdict"]
+        c = rejudged.get(cid)
+        if c is None:
+            out.add(f"clause {cid}", f"results.json says {_word(said)}; re-judging the wire log as a {role} "
+                                     f"run does not judge this clause")
+            continue
+        out.clauses_compared += 1
+        if c["verdict"] != said:
+            reason = " ".join(str(c.get("reason") or "").split())
+            out.add(f"clause {cid}", f"results.json says {_word(said)}, the wire log gives {_word(c['verdict'])}"
+                                     + (f" ({reason[:160]})" if reason else ""))
+    for cid, c in rejudged.items():
+        if cid not in recorded:
+            out.add(f"clause {cid}", f"missing from results.json; the wire log gives {_word(c['verdict'])}")
+    if bool(results["partial"]) != got.partial:
+        out.add("partial", f"results.json says {str(bool(results['partial'])).lower()}, the wire log says the run "
+                           + (f"was cut short ({facts.partial})" if got.partial else "finished"))
+    _compare_process(out, results.get("process"), got.process)
+    if got.verdict != results["verdict"]:
+        out.add("verdict", f"results.json says {_word(results['verdict'])}, the re-judged run gives "
+                           f"{_word(got.verdict)} ({got.verdict_reason[:200]})")
+    if "certificate" in results and got.certificate != results["certificate"]:
+        out.add("certificate", f"results.json says {str(results['certificate']).lower()}, the re-judged "
+                               f"run gives {str(got.certificate).lower()} ({got.scope.statement})")
+
+
+def _patterns(select: Any) -> str:
+    if not select:
+        return "every clause (no --select)"
+    return "--select " + ",".join(map(str, select)) if isinstance(select, list) else json.dumps(select)
+
+
+def _compare_process(out: Verification, said: Any, evidence: Optional[dict]) -> None:
+    if said is None and evidence is None:
+        return
+    if evidence is None:
+        out.add("process", "results.json records the implementation under test's end, but the wire log has no "
+                           "process note (helmcheck did not start it)")
+        return
+    if not isinstance(said, Mapping):
+        out.add("process", "missing from results.json; the wire log records that helmcheck started the "
+                           f"implementation under test and that it {_ending(evidence)}")
+        return
+    for key in sorted(set(said) | set(evidence)):
+        if _normal(said.get(key)) != _normal(evidence.get(key)):
+            out.add(f"process.{key}", f"results.json says {json.dumps(said.get(key))[:120]}, the wire log "
+                                      f"records {json.dumps(evidence.get(key))[:120]}")
+
+
+def _ending(process: Mapping[str, Any]) -> str:
+    how = (f"was killed by {process.get('signal')}" if process.get("signal")
+           else f"exited with code {process.get('exit_code')}")
+    return how + (" before the run's end" if process.get("ended_early") else " when helmcheck stopped it")
 
 
 # --------------------------------------------------------------------------- signature
@@ -268,6 +311,11 @@ def _check_signature(out: Verification, directory: Path, results: Optional[Mappi
             or not isinstance(doc.get("signature"), str) or not isinstance(doc.get("public_key"), str):
         out.add(_SIGNATURE_NAME, "not a helmcheck signature (needs public_key, manifest and signature)")
         return
+    if doc.get("format") != _SIGNATURE_FORMAT:
+        out.add(_SIGNATURE_NAME, f"format {doc.get('format')!r}; only {_SIGNATURE_FORMAT} is accepted")
+    if doc["manifest"].get("format") != MANIFEST_FORMAT:
+        out.add(_SIGNATURE_NAME, f"manifest format {doc['manifest'].get('format')!r}; only {MANIFEST_FORMAT} "
+                                 f"is accepted")
     if doc.get("algorithm") != ALGORITHM:
         out.add(_SIGNATURE_NAME, f"algorithm {doc.get('algorithm')!r}; only {ALGORITHM} is accepted")
         return

@@ -20,6 +20,8 @@ hasty-oms           RH-BS-3    sends one ``$OMS`` 0.5 s after the vehicle report
 flood               RH-BS-4    once, 300 empty ``$OSD`` requests in one write (2700 bytes)
 lockout-ignore      RH-BS-5    keeps driving ``$OMS`` through a safety lockout
 fast-resend         RH-BS-5    resends a rejected command every 0.3 s
+resend-burst        RH-BS-5    answers its first refused ``$OMS`` with four copies of it
+                               within 0.1 s
 late-refresh        RH-BS-6    refreshes ``$OMS`` only after 1.6 × its timeout
 no-poll             RH-BS-8    polls ``$OSD`` every 7 s
 ==================  =========  ================================================================
@@ -158,6 +160,23 @@ class FastResend(Backseat):
         super().rejected(type_, now)
 
 
+class ResendBurst(Backseat):
+    """Answers its first refused ``$OMS`` at once with four copies of it, 0.025 s apart (a retry
+    loop without a back-off): only the first may have been sent before the rejection was known."""
+
+    burst_done = False
+
+    def rejected(self, type_: int, now: float) -> None:
+        if type_ == 9 and not self.burst_done:
+            self.burst_done = True
+            body = f"OMS,{self.heading:.1f},2.0,20.0,1.0,{self.servo_timeout}"
+            for i in range(4):
+                if i:
+                    time.sleep(0.025)
+                self.send(body)
+        super().rejected(type_, now)
+
+
 class LateRefresh(Backseat):
     def __init__(self, *a, **kw):
         super().__init__(*a, **kw)
@@ -172,7 +191,8 @@ FAULTS = {
     "bad-checksum": BadChecksum, "unpadded-checksum": UnpaddedChecksum, "lowercase-hex": LowercaseHex,
     "bare-lf": BareLf, "short-omp": ShortOmp, "rwset-after-start": RwsetAfterStart,
     "oms-while-stopped": OmsWhileStopped, "hasty-oms": HastyOms, "flood": Flood, "lockout-ignore": LockoutIgnore,
-    "fast-resend": FastResend, "late-refresh": LateRefresh, "no-poll": NoPoll,
+    "fast-resend": FastResend, "resend-burst": ResendBurst, "late-refresh": LateRefresh,
+    "no-poll": NoPoll,
 }
 
 if __name__ == "__main__":

@@ -434,3 +434,19 @@ MUTANTS = (
     Mutant("clock-runs-fast", "RH-TIM-2", ("RH-TIM-2",), core=ClockRunsFast, time_scales=TIMED_SCALES),
     Mutant("mission-never-ends", "RH-MSN-4", ("RH-MSN-4",), model=MissionNeverEnds, time_scales=(60.0, 90.0)),
 )
+
+
+class OmpNineHexAccepted(EmulatorCore):
+    """RH-PRM-2: an $OMP whose field 1 has nine hex digits is accepted (read as if a last 0 followed)."""
+
+    def _line(self, raw, now, v):
+        if raw.startswith(b"$OMP,") and b"*" in raw:
+            f = body(raw).split(b",")
+            if len(f) == 4 and len(f[1]) == 9 and all(ch in b"0123456789abcdefABCDEF" for ch in f[1]):
+                raw = reframe(raw, b",".join((f[0], f[1] + b"0", f[2], f[3])))
+        return super()._line(raw, now, v)
+
+
+MUTANTS += (
+    Mutant("omp-nine-hex-accepted", "RH-PRM-2", ("RH-PRM-2",), core=OmpNineHexAccepted),
+)

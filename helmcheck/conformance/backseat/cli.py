@@ -266,10 +266,7 @@ def _certify(args, profile, spec, plan, report_dir: Path, log_file, settings, co
                                   f"{outcome.ended_at - (outcome.connected_at or 0.0):.1f} s")
             finally:
                 progress.stop()
-                if child is not None:
-                    from .process import end_backseat
-                    process = end_backseat(child, epoch=runner.launch,
-                                           link_lost=outcome is None or outcome.status in ("disconnected", "exited"))
+                process = runner.outcome.process  # stopped and recorded before the record closed
     finally:
         if child is not None and process is None:
             child.stop()  # the run never started (or broke): leave nothing behind
@@ -290,9 +287,6 @@ def _certify(args, profile, spec, plan, report_dir: Path, log_file, settings, co
     results = build_results(outcome, profile=profile, settings=settings, command=command,
                             port=link.name if link is not None else args.port, started=started,
                             reason=reason)
-    if process is not None and outcome is not None:
-        from .process import record_backseat
-        record_backseat(results, process, plan=plan, connected_at=outcome.connected_at, ended_at=outcome.ended_at)
     try:
         # results.json with the certificate (profile.toml, digests, identity, scope, signature), then the reports
         finish_run(results, report_dir, profile, cert)

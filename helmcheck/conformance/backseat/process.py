@@ -5,15 +5,19 @@ Three steps around the run, each a small function so the command and the loop on
 * :func:`start_backseat` — once the port is open (after the ``port:`` line), start the command
   on it (:class:`~helmcheck.conformance.launcher.Launcher`: ``{port}`` is the pty path or
   ``socket://HOST:PORT``; output into ``backseat.stdout.log`` / ``backseat.stderr.log``).
-* :func:`end_backseat` — when the run is over: let an exit that closed the port become visible
-  (up to 1 s), stop it (SIGTERM to its process group, SIGKILL after the grace period) and
-  return the ``process`` object for ``results.json``. It *ended early* when it was seen ended
-  before helmcheck began to stop it.
-* :func:`record_backseat` — put that object into the results. A backseat that ended early is
-  a finding about the backseat, never a link fault: the run verdict is FAIL
-  (:func:`helmcheck.reports.verdicts.run_verdict`), the clauses with an offence keep their
-  verdict, and every other clause whose exercising scenarios (:data:`EXERCISED_BY`) had not all
-  finished when it ended becomes NOT-TESTED, with the exit as the reason.
+* :func:`end_backseat` — when the run is over, before its record closes
+  (:class:`~.runner.Runner`): let an exit that closed the port become visible (up to 1 s), stop
+  it (SIGTERM to its process group, SIGKILL after the grace period) and return the ``process``
+  object for ``results.json``. It *ended early* when it was seen ended before helmcheck began to
+  stop it.
+* :func:`process_notes` — the run facts of that end, as wire-log notes
+  (:mod:`helmcheck.judge.runfacts`): a ``not judged`` note for every clause whose exercising
+  scenarios (:data:`EXERCISED_BY`) had not all finished when it ended early, with the exit as
+  the reason, then the ``process:`` note. A backseat that ended early is a finding about the
+  backseat, never a link fault: :func:`helmcheck.reports.assemble.assemble` makes the run
+  verdict FAIL (:func:`helmcheck.reports.verdicts.run_verdict`), the clauses with an offence
+  keep their verdict, the clauses not judged are NOT-TESTED. Nothing rewrites a verdict after
+  the ledger: ``helmcheck verify`` reads the same notes.
 
 Decision (§9 is silent on which scenario judges what; every clause is judged all the time):
 :data:`EXERCISED_BY` follows :mod:`.scenarios` — ``nominal`` exercises every clause,
@@ -24,14 +28,14 @@ A clause none of whose exercising scenarios was planned needs the whole plan to 
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any, Optional
+from typing import Any, Iterable, Optional
 
-from ...reports.results import add_process, finish
+from ...judge.runfacts import not_judged_note, process_note
 from ..launcher import Launcher
 from ..transport import parse_port_spec
 from .scenarios import Plan
 
-__all__ = ["EXERCISED_BY", "start_backseat", "end_backseat", "record_backseat", "unfinished_clauses"]
+__all__ = ["EXERCISED_BY", "start_backseat", "end_backseat", "process_notes", "unfinished_clauses"]
 
 EXERCISED_BY: dict[str, tuple[str, ...]] = {
     "RH-BS-1": ("nominal",),
@@ -70,39 +74,36 @@ def end_backseat(child: Launcher, *, epoch: float, link_lost: bool) -> dict[str,
     return child.record(epoch=epoch)
 
 
-def unfinished_clauses(clauses: list[dict[str, Any]], plan: Plan, connected_at: Optional[float],
+def unfinished_clauses(clauses: Iterable[str], plan: Plan, connected_at: Optional[float],
                        ended_at: float) -> dict[str, list[str]]:
     """Clause ID → the exercising scenarios that had not finished by *ended_at*, for every clause
-    without an offence that has some (times in seconds since the certifier started)."""
+    of *clauses* that has some (times in seconds since the certifier started)."""
     planned = [slot.name for slot in plan.slots]
     done = {slot.name for slot in plan.slots
             if connected_at is not None and connected_at + slot.end <= ended_at + 1e-9}
     out: dict[str, list[str]] = {}
-    for c in clauses:
-        if c["verdict"] in ("fail", "non-strict"):
-            continue
-        need = [n for n in EXERCISED_BY.get(c["id"], ()) if n in planned] or planned
+    for cid in clauses:
+        need = [n for n in EXERCISED_BY.get(cid, ()) if n in planned] or planned
         missing = [n for n in need if n not in done]
         if missing:
-            out[c["id"]] = missing
+            out[cid] = missing
     return out
 
 
-def record_backseat(results: dict[str, Any], process: dict[str, Any], *, plan: Plan,
-                    connected_at: Optional[float], ended_at: float) -> None:
-    """Record the backseat's ``process`` in *results*; when it ended early, apply the rule of
-    the module docstring and close the results again (verdict FAIL, the exit quoted)."""
-    if not process.get("ended_early"):
-        add_process(results, process)
-        return
-    how = (f"was killed by {process['signal']}" if process.get("signal")
-           else f"exited with code {process.get('exit_code')}")
-    at = process.get("ended_at_s")
-    when = f" at {at:.1f} s" if at is not None else ""
-    missing = unfinished_clauses(results["clauses"], plan, connected_at, ended_at)
-    for cid, scenarios in missing.items():
-        add_process(results, process, not_run=[cid],
-                    reason=f"the backseat {how}{when}, before the scenario(s) exercising this clause "
-                           f"({', '.join(scenarios)}) finished")
-    add_process(results, process)
-    finish(results, partial=results.get("partial", True), duration_s=results.get("duration_s"))
+def process_notes(process: dict[str, Any], *, clauses: Iterable[str], plan: Plan,
+                  connected_at: Optional[float], ended_at: float) -> list[str]:
+    """The run-fact notes of the backseat's end (module docstring), in the order to record them."""
+    notes: list[str] = []
+    if process.get("ended_early"):
+        how = (f"was killed by {process['signal']}" if process.get("signal")
+               else f"exited with code {process.get('exit_code')}")
+        at = process.get("ended_at_s")
+        when = f" at {at:.1f} s" if at is not None else ""
+        groups: dict[str, list[str]] = {}
+        for cid, scenarios in unfinished_clauses(clauses, plan, connected_at, ended_at).items():
+            reason = (f"the backseat {how}{when}, before the scenario(s) exercising this clause "
+                      f"({', '.join(scenarios)}) finished")
+            groups.setdefault(reason, []).append(cid)
+        notes += [not_judged_note(ids, reason) for reason, ids in groups.items()]
+    notes.append(process_note(process))
+    return notes

@@ -1,14 +1,17 @@
 """From a finished (or cut short) run to ``results.json`` and every report format.
 
 The document is schema 1 (:mod:`helmcheck.reports.results`) with ``"role": "backseat"``: one
-entry per §9 clause (RH-BS-1..8) exactly as the verdict ledger combined the observer's findings
-(:meth:`helmcheck.judge.ledger.Ledger.entries`: verdict, reason, the scenarios it was observed
-in as cases, ``offending_count`` and the first offending lines quoted as evidence); the
-scenarios staged, the mode timeline, the staged events. This module judges nothing.
+entry per §9 clause (RH-BS-1..8), the run verdict and the ``process`` object exactly as
+:func:`helmcheck.reports.assemble.assemble` makes them from the verdict ledger (the observer's
+findings, :class:`helmcheck.judge.ledger.Ledger`: verdict, reason, the scenarios it was observed
+in as cases, ``offending_count`` and the first offending lines quoted as evidence) and the run
+facts the record's notes give (:mod:`helmcheck.judge.runfacts`); the scenarios staged, the mode
+timeline, the staged events. This module judges nothing and changes no verdict.
 A MUST not met is ``fail``; a SHOULD not met ``non-strict`` (``fail`` with ``--strict``). A run
 that never started or was cut short (the backseat never connected, closed the port, crashed,
 or Ctrl-C) is ``partial`` and cannot certify: INCONCLUSIVE, with the reason first in
-``verdict_reason`` — unless a MUST already failed, which stands.
+``verdict_reason`` — unless a MUST already failed, which stands; a backseat helmcheck started
+that ended early fails the run (:mod:`.process`).
 """
 
 from __future__ import annotations
@@ -18,9 +21,12 @@ from typing import Any, Optional
 
 from ...clauses import backseat_clauses
 from ...judge.backseat import BS_CLAUSES
+from ...judge.ledger import Ledger
+from ...judge.runfacts import RunFacts
 from ...profile import Profile
 from ...reports import render_all
-from ...reports.results import add_clause, add_event, add_mode, finish, new_results, write_results_atomic
+from ...reports.assemble import apply, assemble
+from ...reports.results import add_event, add_mode, new_results, write_results_atomic
 from .runner import Outcome
 
 __all__ = ["build_results", "write_reports"]
@@ -33,16 +39,14 @@ def build_results(outcome: Optional[Outcome], *, profile: Profile, settings: dic
     results = new_results("backseat", command=command, started=started,
                           implementation={"port": port, "protocol": profile.protocol},
                           profile=profile.as_dict(), settings=settings)
-    levels = {c.id: c.level for c in backseat_clauses()}
-    status = outcome.status if outcome is not None else "link-error"
     why = outcome.reason if outcome is not None else reason
-    if outcome is None or outcome.status == "never-connected":
-        for cid in BS_CLAUSES:
-            add_clause(results, cid, "not-tested", f"not judged: {why}", level=levels[cid])
+    if outcome is None:  # no record at all: the facts its notes would have given
+        ledger = Ledger([c.id for c in backseat_clauses()])
+        facts = RunFacts(not_judged={cid: f"not judged: {why}" for cid in BS_CLAUSES}, partial=why)
     else:
-        for e in outcome.observer.ledger.entries():
-            add_clause(results, e["id"], e["verdict"], e["reason"], cases=e["cases"], evidence=e["evidence"],
-                       offending_count=e["offending_count"], level=e["level"])
+        ledger, facts = outcome.observer.ledger, outcome.facts
+    a = assemble("backseat", ledger, facts, strict=strict, lead=why if facts.partial is not None else "")
+    if outcome is not None and outcome.status != "never-connected":
         for t, kind, label in outcome.events:
             add_event(results, round(t, 6), kind, label)
         seen: list[str] = []
@@ -57,11 +61,7 @@ def build_results(outcome: Optional[Outcome], *, profile: Profile, settings: dic
                           "bytes_from_backseat": outcome.observer.stats["bytes"],
                           "lines_from_backseat": outcome.observer.stats["lines"],
                           "vehicle": outcome.vehicle_stats}
-    partial = status != "complete"
-    finish(results, partial=partial, strict=strict,
-           duration_s=round(outcome.ended_at - (outcome.connected_at or 0.0), 3) if outcome else 0.0)
-    if partial:
-        results["verdict_reason"] = f"{why[:1].upper()}{why[1:]}. {results['verdict_reason']}"
+    apply(results, a, duration_s=round(outcome.ended_at - (outcome.connected_at or 0.0), 3) if outcome else 0.0)
     return results
 
 

@@ -27,6 +27,12 @@ loop waits in ``select`` at most 50 ms at a time; SIGINT/SIGTERM (or :meth:`Runn
 end it early as "interrupted". When helmcheck started the backseat (``child``, a
 :class:`~helmcheck.conformance.launcher.Launcher`), the loop also ends, as "exited", as soon as
 that process has ended (checked every tick).
+
+Run facts (:mod:`helmcheck.judge.runfacts`): before the record closes, the loop stops the
+backseat it started and records its end (``not judged`` notes for the clauses its exit cut
+short, a ``process:`` note, :mod:`.process`), a ``not judged`` note for every clause when the
+backseat never connected, and a ``run partial:`` note when the run did not complete — so the
+results (:mod:`.report`) and ``helmcheck verify`` assemble the same verdicts from the record.
 """
 
 from __future__ import annotations
@@ -43,6 +49,7 @@ from ...grammar import sentences as s
 from ...grammar.capture import FROM_VEHICLE, TO_VEHICLE
 from ...judge.backseat import BS_CLAUSES, BackseatObserver
 from ...judge.ledger import Ledger
+from ...judge.runfacts import RunFacts, not_judged_note, partial_note
 from ...model.missions import MissionCatalog
 from ...profile import Profile
 from ..emulator.core import EmulatorCore
@@ -88,6 +95,8 @@ class Outcome:
     modes: list[tuple[float, str]] = field(default_factory=list)
     scenarios_run: list[str] = field(default_factory=list)
     vehicle_stats: dict = field(default_factory=dict)
+    facts: RunFacts = field(default_factory=RunFacts)  #: the run facts, as the record's notes gave them
+    process: Optional[dict] = None  #: the backseat's ``process`` object, when helmcheck started it
 
 
 class Runner:
@@ -108,7 +117,8 @@ class Runner:
         self.launch = clock()
         self.ledger = Ledger(BS_CLAUSES)
         self.observer = BackseatObserver(profile, self.ledger, time_scale=time_scale, baud=profile.baud)
-        self.recorder = Recorder(log, meta, observers=[self.observer])
+        self.facts = RunFacts()
+        self.recorder = Recorder(log, meta, observers=[self.observer, self.facts])
         self.core = EmulatorCore(profile.replace(fault_injection="none"), missions, start=self.launch,
                                  time_scale=time_scale, baud=profile.baud, log=_CoreNotes(self.recorder))
         self._framer = Framer(profile.max_line_bytes)
@@ -123,7 +133,7 @@ class Runner:
         self._scenario = ""
         self._dropped_out = 0
         self.connected_at: Optional[float] = None
-        self.outcome = Outcome("interrupted", "", self.observer, planned=plan.total)
+        self.outcome = Outcome("interrupted", "", self.observer, planned=plan.total, facts=self.facts)
 
     # ------------------------------------------------------------------ control
     def stop(self, why: str = "interrupted") -> None:
@@ -174,13 +184,31 @@ class Runner:
         finally:
             now = self.clock()
             end = self.recorder.note(self.rel(now), f"run ended: {reason}")
-            self.observer.close(end)
-            self.recorder.close()
             o.status, o.reason = status, reason
             o.connected_at = self.connected_at
             o.ended_at = self.rel(now)
             o.vehicle_stats = dict(self.core.stats)
+            try:
+                self._record_facts(status, reason, end)
+            finally:
+                self.observer.close(end)
+                self.recorder.close()
         return o
+
+    def _record_facts(self, status: str, reason: str, t: float) -> None:
+        """The run facts of the run's end, as notes at *t* (module docstring)."""
+        if self.child is not None:
+            from .process import end_backseat, process_notes
+
+            o = self.outcome
+            o.process = end_backseat(self.child, epoch=self.launch, link_lost=status in ("disconnected", "exited"))
+            for text in process_notes(o.process, clauses=BS_CLAUSES, plan=self.plan,
+                                      connected_at=self.connected_at, ended_at=o.ended_at):
+                self.recorder.note(t, text)
+        if status == "never-connected":
+            self.recorder.note(t, not_judged_note(BS_CLAUSES, f"not judged: {reason}"))
+        if status != "complete":
+            self.recorder.note(t, partial_note(reason))
 
     def _elapsed(self, now: float) -> float:
         return 0.0 if self.connected_at is None else self.rel(now) - self.connected_at

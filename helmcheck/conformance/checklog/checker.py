@@ -12,7 +12,12 @@ helm line: the whole log is consumed, in order, and every byte is attributed. It
    Notes go to them too (a certification's ``case``/``not tested``/``link:`` notes, an
    emulator's ``plant:`` notes), so a certification's own log gets the verdicts the run got;
 3. a log line that cannot be read is a finding with its line number (INCONCLUSIVE for RH-FRM-1 /
-   RH-BS-1: the bytes there are unknown).
+   RH-BS-1: the bytes there are unknown);
+4. the notes are read for the run facts too (:class:`~helmcheck.judge.runfacts.RunFacts`: a
+   certification's selection, the clauses it did not judge, the end of the implementation it
+   started, a run cut short), and the clause facts are booked into each role's ledger, as the
+   live run booked them; the facts go out with the outcome for
+   :func:`helmcheck.reports.assemble.assemble`.
 
 No judging happens here. Memory is bounded: the ledgers keep a few evidence lines per clause;
 timeline and events are capped by the observers.
@@ -32,6 +37,7 @@ from typing import BinaryIO, Callable, Optional
 from ...clauses import vehicle_clauses
 from ...judge.backseat import BS_CLAUSES, BackseatObserver
 from ...judge.ledger import Evidence as LedgerEvidence, Ledger
+from ...judge.runfacts import RunFacts
 from ...judge.vehicle import VehicleObserver
 from ...model.missions import MissionCatalog
 from ...profile import DEFAULT, Profile
@@ -73,6 +79,7 @@ class CheckOutcome:
     mission_known: bool = False
     seconds: float = 0.0
     notes: list = field(default_factory=list)
+    facts: RunFacts = field(default_factory=RunFacts)  #: the run facts of the log's notes
 
 
 def check_log(path: Path | str, *, profile: Profile = DEFAULT, role: str = "both",
@@ -247,9 +254,10 @@ class _Vehicle(_Side):
         self.observer = VehicleObserver(profile, self.ledger, time_scale=scale, baud=baud,
                                         resolution=resolution, catalog=catalog)
 
-    def entries(self, to_vehicle: bool, from_vehicle: bool) -> list:
+    def entries(self, to_vehicle: bool, from_vehicle: bool, facts: RunFacts) -> list:
         if not from_vehicle and not self.observer.aborted:
             led = Ledger(VEHICLE_CLAUSES)
+            facts.book(led)
             for c in VEHICLE_CLAUSES:
                 led.not_tested(c, "One-direction log: it has no vehicle→backseat traffic, so the vehicle's "
                                   "answers cannot be judged.")
@@ -272,7 +280,8 @@ class _Checker:
         #: the backseat role's entries when a side job judged it (:func:`check_log`)
         self.backseat_entries: Optional[list] = None
         self.sides: list[_Side] = [x for x in (self.vehicle, self.backseat) if x is not None]
-        self.feeds = [x.observer.feed for x in self.sides]
+        self.facts = RunFacts()
+        self.feeds = [x.observer.feed for x in self.sides] + [self.facts.feed]
         self.scale = scale
         self.r = resolution
         self.mission_known = catalog is not None
@@ -308,6 +317,8 @@ class _Checker:
             feed(c)
 
     def close(self) -> None:
+        for side in self.sides:
+            self.facts.book(side.ledger)
         if self.vehicle is not None:
             self.vehicle.observer.close()
         if self.backseat is not None:
@@ -325,7 +336,7 @@ class _Checker:
         timeline: list = []
         events: list = []
         if self.vehicle is not None:
-            clauses += self.vehicle.entries(to_v, from_v)
+            clauses += self.vehicle.entries(to_v, from_v, self.facts)
             obs = self.vehicle.observer
             timeline = [{"t": t, "mode": m} for t, m in obs.timeline]
             events = list(obs.events)
@@ -338,4 +349,4 @@ class _Checker:
                             time_scale=self.scale, resolution=self.r, stats=dict(st),
                             findings=list(self.findings), timeline=timeline, events=events, sha256=sha,
                             one_direction=one, mission_known=self.mission_known,
-                            notes=[f"{self.finding_count} log line(s) that could not be read"])
+                            notes=[f"{self.finding_count} log line(s) that could not be read"], facts=self.facts)

@@ -1,7 +1,9 @@
 """Writing a log check's results directory: ``results.json`` (role ``log``), the log, the reports.
 
 This module owns turning a :class:`~.checker.CheckOutcome` into a schema-1 results document
-(:mod:`helmcheck.reports.results`) and a results directory: ``results.json`` (atomic), the
+(:mod:`helmcheck.reports.results`; the clause entries, run verdict and ``process`` assembled from
+the check's ledger entries and run facts by :func:`helmcheck.reports.assemble.assemble`, the one
+function every certifier and ``helmcheck verify`` use) and a results directory: ``results.json`` (atomic), the
 checked log as ``wire.log`` (a copy for a helmcheck wire log; for a socat capture the copy keeps
 its own name and ``wire.log`` is not written; above :data:`COPY_LIMIT` bytes the log is only
 referenced by path and SHA-256), and every report format (:func:`helmcheck.reports.render_all`).
@@ -14,6 +16,7 @@ from typing import Any, Optional
 
 from ...profile import Profile
 from ...reports import results as R
+from ...reports.assemble import apply, assemble
 from ...reports.atomic import copy_file_atomic
 from ...reports.render import render_all
 from .checker import CheckOutcome
@@ -31,10 +34,8 @@ def build_results(out: CheckOutcome, profile: Profile, command: str, *, strict: 
                                         "fault_injection": profile.fault_injection},
                         profile=profile.as_dict(),
                         settings={"time_scale": out.time_scale, "strict": strict}, wire_log=wire_log)
-    for c in out.clauses:
-        entry = R.add_clause(res, c["id"], c["verdict"], c["reason"], cases=[f"log:{out.path.name}"],
-                             evidence=c["evidence"], offending_count=c["offending_count"])
-        entry["lines"] = c["lines"]
+    entries = [{**c, "cases": [f"log:{out.path.name}", *c.get("cases", ())]} for c in out.clauses]
+    apply(res, assemble("log", entries, out.facts, strict=strict), duration_s=round(out.seconds, 3))
     res["timeline"] = out.timeline
     res["events"] = out.events
     res["log"] = {
@@ -48,7 +49,6 @@ def build_results(out: CheckOutcome, profile: Profile, command: str, *, strict: 
         res["log"]["one_direction_note"] = (
             f"The log carries traffic of one side only ({out.one_direction}); clauses that need "
             f"the other side are NOT-TESTED.")
-    R.finish(res, strict=strict, duration_s=round(out.seconds, 3))
     return res
 
 

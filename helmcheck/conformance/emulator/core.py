@@ -42,6 +42,7 @@ from __future__ import annotations
 
 import csv
 import json
+import math
 from collections import deque
 from dataclasses import dataclass, fields as dc_fields
 from pathlib import Path
@@ -57,10 +58,11 @@ from ...model.plant import SafetyViolation
 from ...model.vehicle import VehicleModel
 from ...profile import SAFETY_CODES, Profile
 from ..transport import LinePacer
+from .freedoms import DEFAULT_SETTINGS, EmulatorSettings, ReplyDelay, ReplyShaper, SkewedTimers
 from .plant import Plant, PlantParams
 from .rules import OperationTimeRule
 
-__all__ = ["EmulatorCore", "HistoryEntry", "MainLog", "MAX_OUTBOX_BYTES", "DEFAULT_UTC0"]
+__all__ = ["EmulatorCore", "HistoryEntry", "MainLog", "MAX_OUTBOX_BYTES", "DEFAULT_UTC0", "plant_params"]
 
 #: Replies waiting for the line are capped; beyond this a flood's replies are dropped (noted).
 MAX_OUTBOX_BYTES = 64 * 1024
@@ -119,6 +121,15 @@ def _event_text(e: Any) -> str:
     return f"{type(e).__name__}({inner})" + (f" [{clause}]" if clause else "")
 
 
+def plant_params(st: EmulatorSettings) -> PlantParams:
+    """The plant's physics for the emulator settings ``st`` (defaults: :class:`PlantParams`'s)."""
+    return PlantParams(home_lat=st.start_lat, home_lon=st.start_lon, declination=st.declination,
+                       turn_rate_dps=st.turn_rate_dps, default_max_pitch_deg=st.dive_pitch_deg,
+                       buoyancy_rise_mps=st.buoyancy_rise_mps, ascent_mps=st.ascent_mps,
+                       water_depth_m=st.water_depth_m, start_battery_pct=st.start_battery_pct,
+                       start_heading=st.start_heading, speed_factor=st.speed_factor)
+
+
 class EmulatorCore:
     """One emulated vehicle behind a byte stream. See the module docstring."""
 
@@ -128,19 +139,32 @@ class EmulatorCore:
                  settings_path: Optional[Path] = None, utc0: float = DEFAULT_UTC0,
                  params: Optional[PlantParams] = None, history: int = 400,
                  on_error: Optional[Callable[[str], None]] = None,
-                 model_factory: Callable[[Profile, Optional[MissionCatalog]], VehicleModel] = VehicleModel):
+                 model_factory: Callable[[Profile, Optional[MissionCatalog]], VehicleModel] = VehicleModel,
+                 settings: Optional[EmulatorSettings] = None):
         prepare()  # the first malformed line is answered within the ACK window too (RH-ACK-2)
         self.profile = profile
+        st = self.settings = settings if settings is not None else DEFAULT_SETTINGS
         self.time_scale = float(time_scale if time_scale is not None else profile.time_scale)
         if self.time_scale <= 0:
             raise ValueError("time scale must be positive")
         self.start = start
         self.utc0 = utc0
-        self.plant = Plant(profile, params or PlantParams())
+        self.plant = Plant(profile, params or plant_params(st))
         self.model = model_factory(profile, missions)
+        if st.timer_factor != 1.0 or st.timer_offset_s != 0.0:  # RH-TIM-1: a vehicle's own clock
+            self.model.timers = SkewedTimers(st.timer_factor, st.timer_offset_s)
+        for name, state, values in st.factory_settings:  # the vehicle's own settings (RH-SET-2)
+            self.model.settings.write(name, state, values)
+        #: vehicle seconds between control-loop ticks (0: continuous; :mod:`.freedoms`)
+        self.tick_v = st.control_tick_s
+        self._shaper = ReplyShaper(st)
+        self._delay = ReplyDelay(st)
+        self._inbox: deque[tuple[float, Any]] = deque()  #: (wall time to process, framer event)
+        self._burst = st.burst_interval_s if st.pacing == "burst" else 0.0
+        self._last_target: Optional[tuple[float, float]] = None  #: for ``idle_distance = "last"``
         self.rules = OperationTimeRule()  #: a mission's own Maximum Operation Time (RH-SAF-5)
         self.framer = Framer(profile.max_line_bytes)
-        self.pacer = LinePacer(profile.baud if baud is None else baud)
+        self.pacer = LinePacer(0 if st.pacing == "burst" else profile.baud if baud is None else baud)
         self.log = log
         self.main_log = main_log
         self.settings_path = settings_path
@@ -173,35 +197,83 @@ class EmulatorCore:
         self.stats["bytes_in"] += len(data)
         v = self._catch_up(now)
         for ev in self.framer.feed(data):
-            if isinstance(ev, Discard):
+            if self._delay.active or self._burst:  # processed later, in arrival order (RH-ACK-2, RH-ACK-6)
+                self._inbox.append((self._due(ev, now), ev))
+            elif isinstance(ev, Discard):
                 self._discard(ev, now)
             else:
-                self._line(ev.raw, now, v)
+                self._line(ev.raw, now, self._command_v(v, now))
+        self._process_inbox(now)
         return self._release(now)
 
     def tick(self, now: float) -> bytes:
         """Run whatever is due by ``now``; returns bytes to send now."""
         self._catch_up(now)
+        self._process_inbox(now)
         return self._release(now)
+
+    def _due(self, ev: Any, now: float) -> float:
+        """When a line that arrived at ``now`` is processed: after the reply delay, at the serial
+        loop's next turn (burst pacing), never before a line that came earlier (RH-ACK-6).
+        ``$OXFLT`` raises its violation at once (RH-SAF-5): it waits only for the lines before it."""
+        last = self._inbox[-1][0] if self._inbox else now
+        if not isinstance(ev, Discard) and ev.raw.startswith(b"$OXFLT"):
+            return max(now, last)
+        due = now + (self._delay.draw() if self._delay.active else 0.0)
+        if self._burst:
+            due = self.start + math.ceil((due - self.start) / self._burst - 1e-9) * self._burst
+        return max(due, last)
+
+    def _process_inbox(self, now: float) -> None:
+        """Lines whose processing time has come (``reply_delay_s``), oldest first."""
+        while self._inbox and self._inbox[0][0] <= now:
+            _, ev = self._inbox.popleft()
+            v = self._catch_up(now)
+            if isinstance(ev, Discard):
+                self._discard(ev, now)
+            else:
+                self._line(ev.raw, now, self._command_v(v, now))
+
+    def _command_v(self, v: float, now: float) -> float:
+        """The vehicle time a command is processed at: the instant itself, also between two
+        control ticks (RH-RD-15), never before what the model has reached."""
+        return max(v, self.vehicle_time(now)) if self.tick_v else v
 
     def next_wakeup(self) -> Optional[float]:
         """Wall time of the next thing :meth:`tick` must do, or ``None`` (wait for input)."""
         best: Optional[float] = None
+        up = self._tick_up
         md = self.model.next_deadline()
         if md is not None:
-            best = self.wall_time(max(md, self.v))
+            best = self.wall_time(up(max(md, self.v)))
         rd = self.rules.due_v
         if rd is not None:
-            w = self.wall_time(max(rd, self.v))
+            w = self.wall_time(up(max(rd, self.v)))
             best = w if best is None else min(best, w)
         pb = self.plant.next_event_in(self.model)
         if pb is not None:
-            w = self.wall_time(self.v + max(pb, self.plant.params.dt / 4))
+            w = self.wall_time(up(self.v + max(pb, self.plant.params.dt / 4)))
             best = w if best is None else min(best, w)
         if self._out:
             w = self.pacer.free_at
             best = w if best is None else min(best, w)
+        if self._inbox:
+            w = self._inbox[0][0]
+            best = w if best is None else min(best, w)
         return best
+
+    def _tick_up(self, v: float) -> float:
+        """The first control tick at or after vehicle time ``v`` (``v`` itself with no tick)."""
+        k = self.tick_v
+        if not k:
+            return v
+        return max(v, math.ceil(v / k - 1e-9) * k)
+
+    def _tick_down(self, v: float) -> float:
+        k = self.tick_v
+        if not k:
+            return v
+        return math.floor(v / k + 1e-9) * k
 
     def inject_fault(self, code: str, now: float, source: str = "key") -> bytes:
         """Raise safety violation ``code`` on the vehicle at once (RH-SAF-1, RH-SAF-5)."""
@@ -250,6 +322,9 @@ class EmulatorCore:
         """The peer went away: pending input is discarded, unsent replies are dropped."""
         for ev in self.framer.close():
             self._discard(ev, now)
+        if self._inbox:
+            self._note(now, f"link: {len(self._inbox)} unprocessed lines dropped")
+            self._inbox.clear()
         if self._out:
             self._note(now, f"link: {len(self._out)} unsent sentences dropped")
             self.stats["dropped_out"] += self._out_bytes
@@ -339,6 +414,8 @@ class EmulatorCore:
                 self._write_main_log()
             elif isinstance(item, s.ORWSET) and item.access == "W" and self.settings_path is not None:
                 self._save_settings(self.settings_path)
+        if self._shaper.active:
+            replies = [self._shaper.shape(r, self._idle_distance(), m.snapshot.utc) for r in replies]
         for r in replies:
             self._send(format_sentence(r), now)
         self._after_model(now)
@@ -379,12 +456,15 @@ class EmulatorCore:
     # ================================================================ time
     def _catch_up(self, now: float) -> float:
         """Bring plant and model to vehicle time ``vehicle_time(now)``, events in time order."""
-        target = self.vehicle_time(now)
+        target = self._tick_down(self.vehicle_time(now))
         if target < self.v:
             target = self.v
         m, p = self.model, self.plant
+        up = self._tick_up
         for _ in range(100_000):  # a hard bound; each pass consumes time, an event or a timer
             md = m.next_deadline()
+            if md is not None and self.tick_v:
+                md = up(md)  # a timer takes effect on the control tick after it ran out
             if md is not None and md <= self.v:
                 self._push_snapshot()
                 wall = self.wall_time(self.v)
@@ -393,6 +473,8 @@ class EmulatorCore:
                 p.sync(m)
                 continue
             rd = self.rules.due_v
+            if rd is not None and self.tick_v:
+                rd = up(rd)
             if rd is not None and rd <= self.v:  # the mission's Maximum Operation Time tripped
                 self._push_snapshot()
                 wall = self.wall_time(self.v)
@@ -411,6 +493,13 @@ class EmulatorCore:
                 self.v = seg_end
                 continue
             self.v = min(seg_end, self.v + p.consumed)
+            if self.tick_v:  # the control loop learns of it on its next tick
+                tick_end = min(seg_end, up(self.v))
+                while self.v < tick_end - 1e-12:
+                    more = p.step(m, tick_end - self.v)
+                    self.v = min(tick_end, self.v + p.consumed) if more else tick_end
+                    evs += more
+                self.v = tick_end
             self._push_snapshot()
             wall = self.wall_time(self.v)
             for e in evs:
@@ -423,6 +512,10 @@ class EmulatorCore:
 
     def _push_snapshot(self) -> None:
         m = self.model
+        if self._shaper.st.idle_distance == "last":
+            target = m.navigation_target()
+            if target is not None:
+                self._last_target = target
         snap = self.plant.snapshot(m, self.v, self.utc0, m.snapshot)
         out = self._model_call(lambda: m.update_plant(snap), self.wall_time(self.v)) or ()
         for me in out:
@@ -457,6 +550,17 @@ class EmulatorCore:
                                              _reply_label(raw)))
         self.stats["bytes_out"] += len(out)
         return bytes(out)
+
+    def _idle_distance(self) -> Optional[float]:
+        """``$OSI`` field 7 where the profile leaves it to the vehicle (RH-RD-5: no navigation
+        target, in ``S`` or an ``M`` entered from ``S``): the distance to the last target, for
+        ``idle_distance = "last"``; ``None`` elsewhere (the model's value stands)."""
+        m = self.model
+        if self._last_target is None or m.running or m.mode not in ("S", "M"):
+            return None
+        from ...model.geo import distance_m
+        p = self.plant
+        return distance_m(p.lat, p.lon, *self._last_target)
 
     def _note(self, now: float, text: str) -> None:
         if self.log is not None:

@@ -74,6 +74,8 @@ class PlantParams:
     propulsion_w_per_kn2: float = 8.0
     primitive_pitch_deg: float = 30.0
     start_battery_pct: float = 95.0
+    start_heading: float = 90.0  #: magnetic, degrees
+    speed_factor: float = 1.0  #: speed made good ÷ commanded speed (:mod:`.freedoms`)
 
 
 @dataclass
@@ -119,7 +121,7 @@ class Plant:
         if not (self.lat or self.lon):
             self.lat, self.lon = p.home_lat, p.home_lon
         if not self.heading:
-            self.heading = 90.0
+            self.heading = p.start_heading % 360.0
         if not self.energy_wh:
             self.energy_wh = p.capacity_wh * p.start_battery_pct / 100.0
         self.watts = p.hotel_w
@@ -130,6 +132,13 @@ class Plant:
 
     def target(self, m: Any) -> Target:
         """What to steer for, read from the model ``m`` (a VehicleModel), read-only."""
+        t = self._target(m)
+        f = self.params.speed_factor
+        if f != 1.0 and t.speed_kn:
+            t.speed_kn *= f
+        return t
+
+    def _target(self, m: Any) -> Target:
         phase = m.phase
         mode = m.mode
         if phase == "lockout":

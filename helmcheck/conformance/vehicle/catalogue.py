@@ -27,6 +27,7 @@ __all__ = ["CASES", "select_cases", "unmet_need"]
 
 OMS = "OMS,90,2,20,{speed},10"
 OMS0 = "OMS,90,2,20,0,10"  # speed 0: the vehicle holds its position
+OMS_DIVE = "OMS,90,{dive_depth},20,{speed},120"  # down to a depth an ascent takes a while to leave
 FAR_OMW = "OMW,{near_lat},{lon},2,,15,{speed},0,"
 
 
@@ -284,9 +285,10 @@ CASES: tuple[Case, ...] = (
        Send("ODVL,0.5,0,5", expect="$ACK,15,0,0"), Start(), Send("ODVL,0.5,-0.2,5", expect="$ACK,15,0,0"),
        Send("ODVL,9,0,5", expect="$ACK,15,1,35"), Send("ODVL,0,0,0", expect="$ACK,15,1,35")),
     # --- §7 safety -------------------------------------------------------------------------------
-    _c("V-57", "RH-SAF-5", "$OXFLT raises a violation at once",
-       "no ACK; the next $OSI shows the safety code", "N",
-       Fault("Sle"), Poll(), needs=("oxflt",)),
+    _c("V-57", "RH-SAF-5", "A violation raised by the vehicle shows in field 8",
+       "the profile's violation trigger raises one: $OXFLT gets no ACK and the next $OSI shows the "
+       "code; the vehicle's own rule (or a sensor an operator trips) shows its code in field 8", "N",
+       Fault("Sle"), Poll(), needs=("violation",)),
     _c("V-58", "RH-SAF-1", "The lockout refuses everything but $OSD for lockout_s",
        "field 8 shows the code; $OMS, $OMSTOP, $ODVL get 26, $OSD is served; the refusal ends after "
        "the lockout within tolerance", "N",
@@ -298,9 +300,10 @@ CASES: tuple[Case, ...] = (
        Fault("Sop"), Send("OMP,8080808080,00,60", expect="$ACK,10,1,26"),
        Settle("lockout", probe="ORWSET,Sle,R"), Poll(mode_not="M"), needs=("violation",)),
     _c("V-60", "RH-SAF-3", "After the lockout only $OMP is released until the surface",
-       "after the lockout (its end shown by a command only the lockout refuses), while still under "
-       "water, $OMS is refused (26) and $OMP is accepted", "N",
-       Wait(12.0), Fault("Sed"), Settle("lockout", probe="ORWSET,Sle,R"), Poll(submerged=True), Send(OMS),
+       "brought under water by a servo dive first; after the lockout (its end shown by a command only "
+       "the lockout refuses), while still under water, $OMS is refused (26) and $OMP is accepted", "N",
+       Send(OMS_DIVE), Until("under water", mode="A", submerged=True, depth_at_least=5.0, budget_v=300.0), Fault("Sed"),
+       Settle("lockout", probe="ORWSET,Sle,R"), Poll(submerged=True), Send(OMS),
        Send("OMP,8080808080,00,5", expect="$ACK,10,0,0"), Poll(mode="M"), needs=("violation",)),
     _c("V-61", "RH-SAF-4", "At the surface the SafetyAction runs",
        "with SafetyAction park the vehicle parks at the surface: mode P, P0, the code kept", "N",

@@ -5,7 +5,8 @@ command, send an invalid line (one mutation of a valid one: out-of-range field, 
 count, bad checksum, lower-case ID), let protocol time pass (vehicle seconds ÷ k, RH-TIM-2),
 poll ``$OSD,S`` and, when the profile declares it, raise a safety violation with ``$OXFLT``.
 Every reply and every ``$OSI`` is judged by the vehicle observer, as everywhere else; an example
-fails when the observer booked a failure during it (the example stops there).
+fails when the observer booked a failure during it (the example stops there, raising
+:class:`VehicleFailure`: the one exception hypothesis is meant to find and shrink).
 
 Each example starts from a verified reset (with ``$OLOGL`` and ``$OMLOAD`` in ``S`` so that the
 observer knows the log labels and the loaded mission), then optionally starts the test mission.
@@ -16,6 +17,17 @@ hypothesis ends with, and re-drives it twice to say whether it fails again. Expl
 wall-clock budget (``fast``: emulators, ``patient``: hardware); when it is spent, the remaining
 candidates do nothing, so hypothesis finishes quickly — and the report says so: only the
 sequences that really ran are counted.
+
+A tester error — any other exception from the machine or from hypothesis, i.e. a bug in
+helmcheck, not a finding about the vehicle — stops the exploration at once (the remaining
+candidates do nothing) and is raised again from :func:`explore`: the run ends with exit 2, its
+results partial (never a PASS) and the traceback beside them (:func:`~.runner.certify`,
+:mod:`helmcheck.cli`). What hypothesis may end with on a finding (:func:`_vehicle_finding`):
+:class:`VehicleFailure`; or, once the vehicle has failed at least once, hypothesis's ``Flaky``
+family — ``FlakyFailure`` (a failure its replay did not reproduce: a flaky vehicle, or the budget
+spent) holding only those, or ``FlakyStrategyDefinition`` (an example that stopped at a failure
+once and ran on when replayed drew more data). The vehicle can change nothing else in what the
+machine draws.
 
 Bench safety: the strategies keep speeds and the motor byte within ``[bench_safety]``, and the
 link's send function refuses anything above it anyway (:mod:`.safety`).
@@ -28,6 +40,7 @@ from typing import Optional
 
 from hypothesis import HealthCheck, Phase, seed, settings, strategies as st
 from hypothesis.database import DirectoryBasedExampleDatabase
+from hypothesis.errors import Flaky
 from hypothesis.stateful import RuleBasedStateMachine, initialize, precondition, rule, run_state_machine_as_test
 
 from ...grammar import checksum_hex
@@ -37,7 +50,7 @@ from .replay import save_replay
 from .safety import BenchSafetyRefused
 from .session import frame
 
-__all__ = ["explore", "PROFILES", "valid_commands", "control_commands", "invalid_lines"]
+__all__ = ["explore", "PROFILES", "valid_commands", "control_commands", "invalid_lines", "VehicleFailure"]
 
 #: name -> (examples, steps per example, wall budget in seconds)
 PROFILES = {"fast": (20, 10, 25.0), "patient": (6, 8, 600.0)}
@@ -101,6 +114,20 @@ def _raw(kind: str, body: str) -> bytes:
     return b"$" + body.encode() + b"\r\n"
 
 
+class VehicleFailure(AssertionError):
+    """An example failed: the observer booked a failure about the vehicle (the reason)."""
+
+
+def _vehicle_finding(e: BaseException, failures: int) -> bool:
+    """Whether hypothesis ended on a finding about the vehicle (module docstring), not on a tester
+    error; *failures*: how many examples the vehicle failed."""
+    if isinstance(e, VehicleFailure):
+        return True
+    if isinstance(e, BaseExceptionGroup):  # FlakyFailure: what each replay ended on
+        return bool(e.exceptions) and all(_vehicle_finding(x, failures) for x in e.exceptions)
+    return isinstance(e, Flaky) and failures > 0
+
+
 class _State:
     """Shared between the machine instances of one exploration."""
 
@@ -116,10 +143,15 @@ class _State:
         self.failures = 0
         self.passes_after_fail = 0
         self.lost: Optional[str] = None
+        self.error: Optional[Exception] = None  #: the first tester error (module docstring)
 
     @property
     def spent(self) -> bool:
-        return time.monotonic() > self.end or self.lost is not None
+        return time.monotonic() > self.end or self.lost is not None or self.error is not None
+
+    def tester_error(self, e: Exception) -> None:
+        if self.error is None:
+            self.error = e
 
 
 def _machine(state: _State, start_states, nwp, speed, motor, oxflt):
@@ -135,8 +167,12 @@ def _machine(state: _State, start_states, nwp, speed, motor, oxflt):
                 state.executions += 1
                 session.trace = []
                 if state.progress is not None:
-                    state.progress.explore(state.executions, state.examples,
-                                           max(0.0, state.end - time.monotonic()))
+                    try:
+                        state.progress.explore(state.executions, state.examples,
+                                               max(0.0, state.end - time.monotonic()))
+                    except Exception as e:  # noqa: BLE001 - a tester error: kept, raised by explore()
+                        state.tester_error(e)
+                        self.active = False
             else:
                 state.skipped += 1
 
@@ -149,12 +185,15 @@ def _machine(state: _State, start_states, nwp, speed, motor, oxflt):
             except CaseStop as f:
                 if f.outcome == "fail":
                     self._failed(f)
-                    raise AssertionError(f.reason) from None
+                    raise VehicleFailure(f.reason) from None
                 return
             except BenchSafetyRefused:
                 return
             except LinkLost as e:
                 state.lost = str(e)
+                self.active = False
+            except Exception as e:  # noqa: BLE001 - a tester error: kept, raised by explore()
+                state.tester_error(e)
                 self.active = False
 
         def _failed(self, f: CaseStop) -> None:
@@ -167,6 +206,7 @@ def _machine(state: _State, start_states, nwp, speed, motor, oxflt):
         def start(self, start):
             def go():
                 session.mark = session.ledger.mark()
+                self.ctx = context(session)  # a rule after a failed start still has its fields
                 session.reset(mission=False)
                 session.exchange(frame("OLOGL,a,b"))
                 session.exchange(frame(f"OMLOAD,{session.profile.mission},0"))
@@ -236,6 +276,11 @@ def explore(run) -> None:
         budget = o.explore_budget_s
     if examples <= 0:
         return
+    if "OMSTOP" not in p.commands:  # every sequence starts from a verified reset ($OMSTOP,0 until S)
+        run.session.note("exploration: not run: the verified reset needs $OMSTOP, which the profile "
+                         "does not claim")
+        run.stats["explore"] = {"examples": 0, "ran": 0, "outcome": "not run (no $OMSTOP claimed)"}
+        return
     state = _State(run, budget)
     state.examples = examples
     state.progress = run.progress
@@ -257,16 +302,27 @@ def explore(run) -> None:
     session.lazy_silence = True
     try:
         run_state_machine_as_test(factory, settings=cfg)
-    except Exception as e:  # noqa: BLE001 - AssertionError, Flaky…, whatever ended it
-        outcome = type(e).__name__
+    except Exception as e:  # noqa: BLE001 - a finding about the vehicle, or a tester error
+        if _vehicle_finding(e, state.failures):
+            outcome = type(e).__name__
+        else:
+            state.tester_error(e)
     finally:
         session.trace = None
         session.lazy_silence = False
         session.end_case()
-    spent = state.skipped > 0 or time.monotonic() > state.end
+    error = state.error
+    spent = error is None and (state.skipped > 0 or time.monotonic() > state.end)
     run.stats["explore"] = {"examples": examples, "ran": state.executions, "failures": state.failures,
                             "budget_s": budget, "budget_spent": spent,
-                            "wall_s": round(time.monotonic() - t0, 3), "outcome": outcome}
+                            "wall_s": round(time.monotonic() - t0, 3),
+                            "outcome": outcome if error is None else "tester error"}
+    if error is not None:
+        first = (str(error).splitlines() or [""])[0][:160]
+        run.stats["explore"]["error"] = f"{type(error).__name__}{': ' + first if first else ''}"
+        session.note(f"exploration: tester error after {state.executions} sequence(s) "
+                     f"({run.stats['explore']['error']}); the run stops")
+        raise error
     session.note(f"exploration: {state.executions} sequence(s) ran" +
                  (f"; the {budget:g} s budget was spent before {examples} examples" if spent else ""))
     if state.best is not None:

@@ -44,7 +44,9 @@ def context(session: Session) -> dict:
     base = p.waypoint_base
     ctx = {"mission": p.mission, "speed": f"{speed.normalize():f}", "motor": f"{motor:02X}",
            "wp_last": str(nwp - 1 + base), "wp_bad": str(nwp + base),
-           "depth_over": f"{p.max_depth + 1:g}", "speed_over": f"{p.max_speed_kn + 0.5:g}"}
+           "depth_over": f"{p.max_depth + 1:g}", "speed_over": f"{p.max_speed_kn + 0.5:g}",
+           # deep enough that an ascent after a lockout takes a while, within any depth range
+           "dive_depth": f"{min(p.max_depth / 2, 10.0 if p.depth_unit == 'm' else 33.0):g}"}
     _position(ctx, lat, lon)
     _other(session, ctx)
     return ctx
@@ -68,6 +70,23 @@ def _other(session: Session, ctx: dict) -> None:
 def _here(session: Session, ctx: dict) -> None:
     _position(ctx, *session.here())
     _other(session, ctx)
+
+
+#: Commands only the lockout refuses once a mission runs (RH-SAF-1: err 26; afterwards refused for
+#: the state, 23/24, changing nothing): the probes that show a lockout's end, first claimed first.
+LOCKOUT_PROBES = ("ORWSET,Sle,R", "OLOGL,probe")
+
+
+def _claimed_probe(session: Session, probe: Optional[str]) -> Optional[str]:
+    """``probe``, or another lockout probe when the profile does not claim its command (a command
+    the profile does not claim is never sent); None when it claims none."""
+    if not probe:
+        return None
+    claimed = session.profile.commands
+    for text in (probe,) + tuple(p for p in LOCKOUT_PROBES if p != probe):
+        if text.split(",", 1)[0] in claimed:
+            return text
+    return None
 
 
 def fill(text: str, ctx: dict) -> str:
@@ -176,7 +195,8 @@ def run_step(session: Session, st, ctx: dict) -> None:
     elif isinstance(st, Wait):
         session.wait(st.vehicle_s, frame(fill(st.probe, ctx)) if st.probe else None)
     elif isinstance(st, Settle):
-        session.settle(st.timer, frame(fill(st.probe, ctx)) if st.probe else None, session.case_clauses[0])
+        probe = _claimed_probe(session, st.probe)
+        session.settle(st.timer, frame(fill(probe, ctx)) if probe else None, session.case_clauses[0])
         _here(session, ctx)
     elif isinstance(st, Until):
         _until(session, st)
@@ -212,7 +232,9 @@ def _until(session: Session, st: Until) -> None:
 
     def pred(o: s.OSI) -> bool:
         flag = o.srp_active if session.profile.protocol == "rh5" else o.battery
-        return (_condition(session, o, st.mode, None, st.park_below)
+        need = None if st.depth_at_least is None else min(st.depth_at_least, session.profile.max_depth / 4)
+        deep = need is None or (o.depth is not None and float(o.depth) >= need)
+        return (deep and _condition(session, o, st.mode, None, st.park_below, st.submerged)
                 and (not st.surface or (o.depth is not None and float(o.depth) <= fix))
                 and (srp is None or flag == srp))
     session.until(st.what, pred, st.budget_v, session.case_clauses[0])

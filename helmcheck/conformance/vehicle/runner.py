@@ -9,9 +9,12 @@ in order (:mod:`.interpreter`), then the hypothesis exploration (:mod:`.explore`
 report marked ``partial`` — plus ``DIR/wire.log`` and, at the end, every report format.
 
 Every byte and note goes through one :class:`~helmcheck.conformance.recorder.Recorder`: to the
-wire log and to the one vehicle observer (:class:`~helmcheck.judge.vehicle.VehicleObserver`),
-which writes the one ledger. The clause verdicts in ``results.json`` are that ledger's; an
-offline ``check-log`` of ``wire.log`` feeds the same observer the same events.
+wire log, to the one vehicle observer (:class:`~helmcheck.judge.vehicle.VehicleObserver`),
+which writes the one ledger, and to the run facts (:class:`~helmcheck.judge.runfacts.RunFacts`:
+the ``selection:`` note of a ``--select`` run, the ``process:`` note of ``--exec``, ``run
+partial:``). ``results.json`` is assembled from that ledger and those facts by
+:func:`helmcheck.reports.assemble.assemble` — the function ``check-log`` and ``helmcheck verify``
+use on ``wire.log`` — and nothing changes a verdict after it.
 
 A vanished device stops the run: a ``run aborted`` note makes the clauses not yet judged
 INCONCLUSIVE with that reason, and the report is still written.
@@ -21,7 +24,8 @@ port (:mod:`helmcheck.conformance.exec_port`, :mod:`helmcheck.conformance.launch
 is still running before every case, and stops it at the end. If it ends before the run's end,
 that is a finding about the vehicle, not a link fault: the clauses judged before keep their
 verdicts, those not judged yet are NOT-TESTED with the exit as the reason (a ``not tested``
-note), ``results.json`` gets a ``process`` object, and the run verdict is FAIL.
+note), the exit is recorded as a ``process:`` note (``results.json`` ``process``), and the run
+verdict is FAIL.
 """
 
 from __future__ import annotations
@@ -38,10 +42,12 @@ from ...clauses import vehicle_clauses
 from ...failures import describe_interrupt
 from ...grammar import prepare
 from ...judge import Ledger
+from ...judge.runfacts import RunFacts, partial_note, process_note, selection_note
 from ...judge.vehicle import VehicleObserver
 from ...judge.wire import tester_note
 from ...profile import Profile
 from ...reports import results as R
+from ...reports.assemble import apply, assemble
 from ..recorder import Recorder
 from ...reports.certificate import RunDeclaration, finish_run
 from ..transport import open_link
@@ -123,6 +129,8 @@ class Run:
         #: every vehicle clause: a finding the observer makes outside the selection is kept
         self.ledger = Ledger([c.id for c in vehicle_clauses()])
         self.observer = VehicleObserver(self.p, self.ledger, time_scale=self.k, baud=self.p.baud)
+        #: the run facts (selection, process, partial), fed by the recorder like the observer
+        self.facts = RunFacts()
         self.progress = Progress(enabled=opts.progress)
         self.aborted: Optional[str] = None
         self.stopped: Optional[str] = None  #: a start-up check stopped the run: leads the verdict reason
@@ -152,27 +160,20 @@ class Run:
         self.resumed: Optional[Resumed] = None
         if opts.resume:
             self.resumed = resume_into(self)
+            self.facts = RunFacts.from_wire_log(self.dir / R.WIRE_LOG_NAME)  # the first part's facts
 
     # ------------------------------------------------------------------ results
     def save(self, final: bool = False) -> None:
         r = self.results
         obs = self.observer
-        entries = {e["id"]: e for e in self.ledger.entries()}
-        chosen = set(self.ids)
-        r["clauses"] = []
-        for c in vehicle_clauses():
-            e = entries[c.id]
-            if c.id not in chosen:
-                if e["verdict"] in ("fail", "non-strict"):
-                    e["reason"] = "not selected, but observed: " + e["reason"]
-                else:
-                    e = {"id": c.id, "verdict": "not-tested", "reason": "not selected (--select)", "level": c.level,
-                         "cases": [], "evidence": [], "offending_count": 0, "replay": None}
-            r["clauses"].append(e)
-        for rep in r["replays"]:
-            for c in r["clauses"]:
-                if c["id"] == rep["clause"]:
-                    c["replay"] = rep["file"]
+        if self.recorder is None:  # no record at all: the facts the notes would have given
+            self.facts.select = tuple(self.o.select or ())
+        partial = None  # from the record's own ``run partial`` note
+        if not final or (self.partial and self.facts.partial is None):
+            partial = True
+        lead = (self.aborted if self.partial else self.stopped) or ""
+        assembly = assemble("vehicle", self.ledger, self.facts, strict=self.o.strict, partial=partial,
+                            lead=lead if final else "")
         r["timeline"] = [{"t": t, "mode": m} for t, m in obs.timeline]
         r["events"] = list(obs.events)
         modes = sorted({m for _, m in obs.timeline})
@@ -191,14 +192,12 @@ class Run:
         self.stats["wall_s"] = round(time.monotonic() - self.t_start
                                      + (self.resumed.wall_s if self.resumed is not None else 0.0), 3)
         r["stats"] = self.stats
-        if final:
-            R.finish(r, partial=self.partial, strict=self.o.strict, duration_s=self.stats["wall_s"])
-            lead = self.aborted if self.partial else self.stopped
-            if lead:
-                r["verdict_reason"] = f"{lead[:1].upper()}{lead[1:]}. {r['verdict_reason']}"
-        else:
-            r["partial"] = True
-            r["verdict"] = R.run_verdict([c["verdict"] for c in r["clauses"]], strict=self.o.strict, partial=True)
+        apply(r, assembly, final=final, duration_s=self.stats["wall_s"])
+        for rep in r["replays"]:  # where a clause's replay script is (not a verdict)
+            for c in r["clauses"]:
+                if c["id"] == rep["clause"]:
+                    c["replay"] = rep["file"]
+        if not final:
             r["verdict_reason"] = "The run is in progress."
         R.write_results_atomic(self.dir, r)
 
@@ -216,22 +215,23 @@ class Run:
             else:
                 raw = open_link(self.o.port, role="client", baud=self.p.baud)
         except (OSError, ValueError) as e:
-            self.recorder = Recorder(wire, [], [self.observer])
+            self._record(wire, [])
             raise LinkLost(f"cannot open {self.o.port}: {getattr(e, 'strerror', None) or e}") from None
         except LinkLost:
-            self.recorder = Recorder(wire, [], [self.observer])
+            self._record(wire, [])
             raise
         meta = [f"started {time.strftime('%Y-%m-%dT%H:%M:%SZ', time.gmtime())}  port "
                 f"{getattr(raw, 'name', None) or self.o.port}  baud {self.p.baud}  time_scale {self.k:g}",
                 f"helmcheck {__version__} certify vehicle; profile {self.p.name}"]
         if self.resumed is not None:  # the record goes on after a gap of a second
             lines, last_t = self.resumed.lines, self.resumed.last_t
-            self.recorder = Recorder(wire, observers=[self.observer], after=(lines, last_t))
+            self.recorder = Recorder(wire, observers=[self.observer, self.facts], after=(lines, last_t))
             self.link = TesterLink(raw, self.p, self.recorder, start_at=last_t + 1.0)
             self.link.note(f"run resumed: {time.strftime('%Y-%m-%dT%H:%M:%SZ', time.gmtime())}, "
                            f"{self.resumed.done} case(s) already run")
         else:
-            self.recorder = Recorder(wire, meta, [self.observer])
+            self._record(wire, meta)
+            assert self.recorder is not None
             self.link = TesterLink(raw, self.p, self.recorder)
         try:
             ser = getattr(raw, "ser", None)
@@ -244,6 +244,13 @@ class Run:
         self.session.custodian = self.custodian
         if self.o.operator:
             self.session.operator = self.tell_operator
+
+    def _record(self, wire, meta: list) -> None:
+        """The recorder of a new record: to the observer and the run facts; a ``--select`` run's
+        first note is its selection (:mod:`helmcheck.judge.runfacts`)."""
+        self.recorder = Recorder(wire, meta, [self.observer, self.facts])
+        if self.o.select:
+            self.recorder.note(0.0, selection_note(self.o.select))
 
     def tell_operator(self, text: str) -> None:
         """An instruction to the person at the bench: on the terminal, and in the record."""
@@ -388,14 +395,20 @@ class Run:
             raise LinkLost(gone)
 
     def stop_child(self) -> None:
-        """End of the run: stop the vehicle under test and record it (``results.json`` ``process``)."""
+        """End of the run: stop the vehicle under test and record its end as a ``process:`` note
+        (a run fact: ``results.json`` ``process``), before the record closes."""
         c = self.child
         if c is None or c.proc is None:
             return
         if self.aborted and not c.ended:
             c.wait(1.0)  # a link fault may be its exit, not yet reaped
         c.stop()
-        self.results["process"] = c.record(epoch=self.t_start)
+        rec = c.record(epoch=self.t_start)
+        if self.recorder is not None:
+            t = self.link.now() if self.link is not None else self.recorder.last_t
+            self.recorder.note(t, process_note(rec))
+        else:
+            self.facts.process = rec
 
     def end(self, reason: Optional[str]) -> None:
         """Close the record: a ``run aborted`` note when it ended early (a ``not tested`` note for
@@ -410,7 +423,25 @@ class Run:
                 self.recorder.note(t, "run ends")
             else:
                 self.recorder.note(t, f"run aborted: {reason}" if reason else "run ends")
+            if self.partial:  # a run fact: it cannot certify a pass
+                self.recorder.note(t, partial_note(reason or "the run was interrupted"))
         self.observer.close()
+
+
+def _keep_traceback(run: Run, exc: BaseException) -> str:
+    """A tester error's traceback beside ``results.json`` (``tester-error.txt``, where the command
+    line writes it too): ``"; traceback in tester-error.txt"`` for the verdict reason, or ``""``."""
+    import traceback
+
+    from ...cli import TRACEBACK_NAME
+    text = (f"helmcheck {__version__} tester error\ncommand: {run.o.command or 'certify()'}\n"
+            f"time: {time.strftime('%Y-%m-%dT%H:%M:%SZ', time.gmtime())}\n\n"
+            + "".join(traceback.format_exception(exc)))
+    try:
+        (run.dir / TRACEBACK_NAME).write_text(text, encoding="utf-8")
+    except OSError:
+        return ""
+    return f"; traceback in {TRACEBACK_NAME}"
 
 
 def certify(opts: Options) -> Outcome:
@@ -444,7 +475,7 @@ def certify(opts: Options) -> Outcome:
         run.aborted = describe_interrupt(e)
     except Exception as e:  # a tester error: the results say partial, the command line says why
         run.partial = True
-        run.aborted = f"tester error ({type(e).__name__})"
+        run.aborted = f"tester error ({type(e).__name__}){_keep_traceback(run, e)}"
         raise
     finally:
         try:
@@ -453,8 +484,10 @@ def certify(opts: Options) -> Outcome:
             run.custodian.could_not(f"tester error during the restore ({type(e).__name__}: {e})")
         run.progress.stop()
         try:
-            run.end(run.aborted)
-            run.stop_child()
+            try:
+                run.stop_child()  # its end is a note: before the record closes
+            finally:
+                run.end(run.aborted)
         finally:
             if run.link is not None:
                 run.link.close()

@@ -30,7 +30,7 @@ from typing import Callable, Optional
 
 from ...grammar import checksum_hex
 from ...grammar import sentences as s
-from ...judge.timing import ack_allowance, ack_fail_after, tolerance
+from ...judge.timing import ack_allowance, ack_give_up_after, tolerance
 from ...judge.vehicle import Sent, VehicleObserver
 from ...judge.wire import case_end_note, case_note, tester_note
 from ...profile import Profile
@@ -142,7 +142,7 @@ class Session:
             self.link.sleep(max(0.0, sent.t + wait - self.now()))
             self.check()
             return sent
-        hard = sent.t + ack_fail_after(allowance) + 0.05
+        hard = sent.t + ack_give_up_after(allowance) + 0.05  # long enough to see a late ACK (RH-ACK-2)
         while not sent.done:
             rx = self.link.next(hard)
             if rx is None:
@@ -181,7 +181,7 @@ class Session:
         self._trace({"send": _esc(b"".join(raws)), "t": round(t, 6)})
         sents = [x for x in self.obs.sent if x.seq > seq]
         allowance = ack_allowance(self.profile.ack_window_s, sum(map(len, raws)), 0, self.profile.baud)
-        hard = t + ack_fail_after(allowance) * len(raws) + 0.05
+        hard = t + ack_give_up_after(allowance) * len(raws) + 0.05
         while any(not x.done for x in sents):
             if self.link.next(hard) is None:
                 break

@@ -95,6 +95,7 @@ class Until:
     surface: bool = False
     srp_active: Optional[bool] = None
     submerged: Optional[bool] = None  #: True: until the depth is below the GPS-fix depth
+    depth_at_least: Optional[float] = None  #: until ``$OSI`` field 15 shows at least this depth
 
 
 @dataclass(frozen=True)

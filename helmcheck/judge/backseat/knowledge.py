@@ -14,7 +14,7 @@ profile's ``reaction_s`` (RH-BS-3/5) to that arrival.
   order (RH-ACK-6), so an ``$ACK`` of type ``n`` answers the oldest waiting command of that
   type; older ones of other types that it overtakes will never be answered and are dropped.
   An ``$ACK`` no waiting command expects is ignored. Decision: a command still unanswered
-  when an ``$ACK`` could no longer be merely late (:func:`~helmcheck.judge.timing.ack_fail_after`
+  when an ``$ACK`` is no longer awaited (:func:`~helmcheck.judge.timing.ack_give_up_after`
   of the longest :func:`~helmcheck.judge.timing.ack_allowance`) waits no more: the vehicle
   missed it (RH-ACK-1), and a later answer is not taken for it.
 * :class:`Lockout` — the safety lockout as the backseat could know it (RH-BS-5, RH-SAF-1).

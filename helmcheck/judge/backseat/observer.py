@@ -37,7 +37,7 @@ from ...grammar.capture import escape
 from ...profile import Profile
 from ..facts import LOCKOUT_REFUSED, NEEDS_MISSION, NEEDS_RUNNING, NEEDS_STOPPED
 from ..ledger import Evidence, Ledger
-from ..timing import ack_allowance, ack_fail_after
+from ..timing import ack_allowance, ack_give_up_after
 from ..wire import FROM_VEHICLE, NOTE, TO_VEHICLE, WireEvent, parse_note
 from .budget import LineBudget
 from .common import BS_CLAUSES, SentLine, Settings
@@ -93,9 +93,9 @@ class BackseatObserver:
         self.servo = ServoRefresh(st, ledger)
         self.polling = Polling(st, ledger)
         #: how long an answer may be awaited (RH-ACK-2's allowance for the longest line and
-        #: the most replies before it, and the margin past which a late ACK is a fault)
-        self.max_wait = ack_fail_after(ack_allowance(profile.ack_window_s, profile.max_line_bytes, 1024,
-                                                     st.baud, st.resolution))
+        #: the most replies before it, and how long a late ACK is still awaited)
+        self.max_wait = ack_give_up_after(ack_allowance(profile.ack_window_s, profile.max_line_bytes, 1024,
+                                                        st.baud, st.resolution))
         self.silent = False
         self.started: Optional[float] = None  #: time of the backseat's first byte
         self.ended: Optional[float] = None

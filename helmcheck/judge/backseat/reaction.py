@@ -1,13 +1,20 @@
 """RH-BS-5 (SHOULD): how a backseat reacts to a rejection and to a safety lockout.
 
-*Resend.* After a command was rejected (``$ACK`` status 1), the same command text (everything
-before the checksum) is not sent again sooner than 1 s after its previous sending. Judged from
-when the rejection had arrived plus ``reaction_s``; a sending before that is not judged (the
-backseat could not know). The interval runs between the first bytes of the two sendings and is
-judged by :func:`~.common.spacing` against 1 s less the observer's
-:data:`~helmcheck.judge.timing.JITTER_S` (the earlier line may have been seen late). Each
-rejection is judged once, at the next sending of its text; a rejected text never sent again
-met the clause. An accepted sending clears the text.
+*Resend.* After a command was rejected (``$ACK`` status other than 0), the same command text
+(everything before the checksum) is not sent more than once per second. A rejection opens a
+*series* for its text, which lasts until a sending of that text is accepted; a further rejection
+while the text stands rejected opens nothing new. Every sending of the text after the rejected
+one belongs to the series, those already on the line when the rejection arrived included (they
+are judged as soon as it arrives). At most what can have been in flight may be excused, and that
+is one copy: the first sending after the rejected one, if its first byte came before the
+rejection could be known (arrived plus ``reaction_s``). Every other sending of the series (the
+first one too, when it came later) is judged against the sending of the same text just before
+it: the interval between their first bytes, by :func:`~.common.spacing` against 1 s less the
+observer's :data:`~helmcheck.judge.timing.JITTER_S` (the earlier line may have been seen late),
+so a coarse timestamp step gives INCONCLUSIVE, never a violation it cannot show; so does a
+first sending within the timestamp step of that known time (it may have been the excused one).
+A burst of copies is therefore one violation per copy after the excused one. A series with no
+judged sending (its text never sent again once the rejection was known) met the clause.
 
 *Lockout.* During a safety lockout the backseat sends nothing but ``$OSD``: every line with a
 sentence ID other than ``OSD`` whose first byte falls in the judged window of an episode
@@ -19,18 +26,32 @@ bytes with no sentence ID is RH-BS-1's alone. An episode with no violation met t
 
 from __future__ import annotations
 
-from collections import OrderedDict
+from collections import OrderedDict, deque
 from typing import Optional
 
 from ..ledger import Ledger
 from ..timing import JITTER_S
-from .common import INCONCLUSIVE, VIOLATION, SentLine, Settings, spacing
+from .common import PASS, VIOLATION, SentLine, Settings, spacing
 from .knowledge import Episode, Lockout
 
 __all__ = ["Reaction", "RESEND_SPACING_S"]
 
 RESEND_SPACING_S = 1.0  #: RH-BS-5: at most once per second
 _MEMORY = 1024  #: command texts remembered (bounded memory)
+_RECENT = 8  #: sendings remembered per text, for those on the line when a rejection arrives
+
+
+class _Series:
+    """The sendings of one rejected text (module docstring)."""
+
+    __slots__ = ("known", "case", "last", "copies", "judged")
+
+    def __init__(self, known: float, case: str, last: float):
+        self.known = known  #: the rejection arrived plus ``reaction_s``
+        self.case = case
+        self.last = last  #: first byte of the text's latest sending
+        self.copies = 0  #: sendings since the rejected one
+        self.judged = 0  #: of which judged (all but an excused one)
 
 
 class Reaction:
@@ -40,8 +61,8 @@ class Reaction:
         self.s = settings
         self.ledger = ledger
         self.lockout = lockout
-        self._last: OrderedDict[bytes, float] = OrderedDict()  # text -> first byte of its last sending
-        self._rejected: OrderedDict[bytes, tuple[float, str]] = OrderedDict()  # text -> (known, case)
+        self._recent: OrderedDict[bytes, deque[SentLine]] = OrderedDict()  # text -> its latest sendings
+        self._rejected: OrderedDict[bytes, _Series] = OrderedDict()
         self.rejections = 0
         self._passed = False
 
@@ -53,35 +74,60 @@ class Reaction:
             self._rejected.pop(body, None)
             return
         self.rejections += 1
-        if body not in self._rejected:
-            self._rejected[body] = (arrived + self.s.reaction_s, self.s.case)
-            if len(self._rejected) > _MEMORY:
-                self._met(self._rejected.popitem(last=False)[1][1], None, "a rejected command was not resent")
+        if body in self._rejected:
+            return  # the text already stands rejected: one series, one excused copy
+        ser = self._rejected[body] = _Series(arrived + self.s.reaction_s, self.s.case, line.t)
+        if len(self._rejected) > _MEMORY:
+            self._end(self._rejected.popitem(last=False)[1])
+        # sendings of the text after the rejected one, already on the line
+        recent = list(self._recent.get(body, ()))
+        i = next((j for j in range(len(recent) - 1, -1, -1) if recent[j] is line), None)
+        later = recent[i + 1:] if i is not None else [c for c in recent if c.t > line.t]
+        for c in later:
+            self._resend(ser, c)
 
     def sent(self, line: SentLine) -> None:
         """A line from the backseat (a decoded command or a damaged line with its ID)."""
         self._lockout_rule(line)
         body = line.body
-        t = line.t
-        prev = self._last.get(body)
-        rej = self._rejected.get(body)
-        if rej is not None and prev is not None and t >= rej[0]:
-            del self._rejected[body]
-            measured = t - prev
-            v = spacing(measured, RESEND_SPACING_S - JITTER_S, self.s.resolution)
-            what = (f"${line.sid} resent {measured:.3f} s after its previous sending, which the "
-                    f"vehicle had rejected (at most once per second)")
-            if v == VIOLATION:
-                self.ledger.failed("RH-BS-5", what, [line.evidence()], self.s.case)
-            elif v == INCONCLUSIVE:
-                self.ledger.inconclusive("RH-BS-5", what + "; the timestamp step cannot tell",
-                                         [line.evidence()], self.s.case)
-            else:
-                self._met(self.s.case, line, f"${line.sid} resent {measured:.3f} s after a rejection")
-        self._last[body] = t
-        self._last.move_to_end(body)
-        if len(self._last) > _MEMORY:
-            self._last.popitem(last=False)
+        ser = self._rejected.get(body)
+        if ser is not None:
+            self._resend(ser, line)
+        recent = self._recent.get(body)
+        if recent is None:
+            recent = self._recent[body] = deque(maxlen=_RECENT)
+            if len(self._recent) > _MEMORY:
+                self._recent.popitem(last=False)
+        else:
+            self._recent.move_to_end(body)
+        recent.append(line)
+
+    def _resend(self, ser: _Series, line: SentLine) -> None:
+        """One more sending of a rejected text: the one excused copy, or judged."""
+        r = self.s.resolution
+        measured = line.t - ser.last
+        ser.last = line.t
+        ser.copies += 1
+        in_flight = ser.copies == 1 and line.t - r < ser.known  # possibly before it was known
+        if in_flight and line.t + r < ser.known:
+            return  # sent before the backseat could know: the one excused copy
+        ser.judged += 1
+        v = spacing(measured, RESEND_SPACING_S - JITTER_S, r)
+        what = (f"${line.sid} sent again {measured:.3f} s after its previous sending, once the "
+                f"vehicle had rejected it (at most once per second)")
+        if v == VIOLATION and not in_flight:
+            self.ledger.failed("RH-BS-5", what, [line.evidence()], self.s.case)
+        elif v != PASS:
+            why = ("it may have been sent before the rejection could be known" if v == VIOLATION
+                   else "the timestamp step cannot tell")
+            self.ledger.inconclusive("RH-BS-5", f"{what}; {why}", [line.evidence()], self.s.case)
+        else:
+            self._met(self.s.case, line, f"${line.sid} sent again {measured:.3f} s after its previous "
+                                         f"sending, once the vehicle had rejected it")
+
+    def _end(self, ser: _Series) -> None:
+        if not ser.judged:
+            self._met(ser.case, None, "a rejected command was not resent once the rejection was known")
 
     # ------------------------------------------------------------------ lockout
     def _lockout_rule(self, line: SentLine) -> None:
@@ -107,8 +153,8 @@ class Reaction:
         self._met(ep.case, None, f"only $OSD during the lockout ({ep.code}, {ep.osd} poll(s))")
 
     def close(self) -> None:
-        for _, (_, case) in self._rejected.items():
-            self._met(case, None, "a rejected command was not resent")
+        for ser in self._rejected.values():
+            self._end(ser)
         self._rejected.clear()
 
     def _met(self, case: str, line: Optional[SentLine], reason: str) -> None:

@@ -7,8 +7,10 @@ judges replies, split out to keep one concern per module; it works on the observ
 * **ACK pairing** (RH-ACK-1, RH-ACK-6): the oldest waiting command of the ACK's type takes it;
   one that a later command's ACK overtook is matched only when no other waits. An ACK after the
   give-up deadline belongs to its late command (RH-ACK-2); one answering a line that must be
-  discarded fails that line's clause (RH-FRM-2/4/5/6/7, RH-SAF-5 for ``$OXFLT``).
-* **The ACK window** (RH-ACK-2, :func:`~helmcheck.judge.timing.ack_allowance`), the answer
+  discarded fails that line's clause (RH-FRM-2/4/5/6/7, RH-SAF-5 for ``$OXFLT``) — for a line of
+  an unknown ID (RH-FRM-5) an ACK of any type, or one whose fields do not decode, is an answer.
+* **The ACK window** (RH-ACK-2, :func:`~helmcheck.judge.timing.ack_allowance`; an ACK later
+  than the window, transmit time and the observer's own uncertainty is a FAIL), the answer
   against the mirror (:mod:`.belief`), and ``$OSD``'s data before its ACK (RH-ACK-5, RH-OSD-1).
 * **Every** ``$OSI`` against the mirror (RH-OUT-4 and the clauses of what led there, attributed by
   :mod:`.blame`), the timers it brackets (RH-TIM-1/2), and the checks beyond the mirror
@@ -18,8 +20,9 @@ judges replies, split out to keep one concern per module; it works on the observ
 from __future__ import annotations
 
 from ...grammar import sentences as s
+from ...grammar.capture import escape
 from ..ledger import Evidence
-from ..timing import ACK_GRACE_S, JITTER_S, ack_allowance, ack_fail_after
+from ..timing import JITTER_S, ack_allowance, ack_uncertainty, ack_verdict, transmit_time
 from .blame import command_clauses, passable
 from .sent import Sent, brief, names, text_of
 
@@ -72,22 +75,7 @@ class Answers:
             self.gave_up.remove(late)
             self._answered(late, a, t, evd, late=True)
             return
-        silent = next((q for q in reversed(self.silent)
-                       if q.kind.kind != "oxflt" and q.kind.would_be in (a.type, None)), None)
-        oxflt = next((q for q in reversed(self.silent) if q.kind.kind == "oxflt"), None)
-        if oxflt is not None and silent is None:
-            oxflt.state, oxflt.ack = "answered-discard", a
-            self.silent.remove(oxflt)
-            self.book("fail", ("RH-SAF-5",), f"$ACK,{a.type},{a.status},{a.err} answered $OXFLT, which gets "
-                                             f"no ACK", [oxflt.ev, evd], at=oxflt)
-            return
-        if silent is not None:
-            silent.state, silent.ack = "answered-discard", a
-            self.silent.remove(silent)
-            self.book("fail", (silent.kind.clause,), f"{text_of(silent)} must be discarded silently "
-                                                     f"({silent.kind.clause}); the vehicle answered "
-                                                     f"$ACK,{a.type},{a.status},{a.err}", [silent.ev, evd],
-                      at=silent)
+        if self._discard_answered(a.type, f"$ACK,{a.type},{a.status},{a.err}", a, evd):
             return
         if self.first_command_t is None:
             self.ledger.inconclusive("RH-ACK-1", "an $ACK before the first command of the record (its "
@@ -96,24 +84,68 @@ class Answers:
         self.book("fail", ("RH-ACK-1",), f"$ACK,{a.type},{a.status},{a.err} answers no command waiting "
                                          f"for one (a second ACK, or one for a line never sent)", [evd])
 
+    def _discard_answered(self, ack_type, text: str, a, evd: Evidence) -> bool:
+        """An ``$ACK`` (``text``; ``ack_type`` None when unreadable) no waiting command takes: does
+        it answer a line the vehicle must discard? Then that line's clause fails (RH-FRM-2/4/5/6/7;
+        RH-SAF-5 for ``$OXFLT``), whatever else is wrong with the answer. A line of an ID the
+        vehicle does not know (RH-FRM-5) has no ACK type of its own: an ACK of any type answers it."""
+        silent = next((q for q in reversed(self.silent)
+                       if q.kind.kind != "oxflt" and q.kind.would_be in (ack_type, None)), None)
+        oxflt = next((q for q in reversed(self.silent) if q.kind.kind == "oxflt"), None)
+        if oxflt is not None and silent is None:
+            oxflt.state, oxflt.ack = "answered-discard", a
+            self.silent.remove(oxflt)
+            self.book("fail", ("RH-SAF-5",), f"{text} answered $OXFLT, which gets no ACK", [oxflt.ev, evd],
+                      at=oxflt)
+            return True
+        if silent is None:
+            silent = next((q for q in reversed(self.silent)
+                           if q.kind.kind == "discard" and q.kind.clause == "RH-FRM-5"), None)
+        if silent is None:
+            return False
+        silent.state, silent.ack = "answered-discard", a
+        self.silent.remove(silent)
+        self.book("fail", (silent.kind.clause,), f"{text_of(silent)} must be discarded silently "
+                                                 f"({silent.kind.clause}); the vehicle answered {text}",
+                  [silent.ev, evd], at=silent)
+        return True
+
+    def _invalid_ack(self, raw: bytes, evd: Evidence) -> bool:
+        """A well-framed ``$ACK`` whose fields do not decode (``$ACK,0,1,0``: a type no command has).
+        When no waiting command can own it and it answers a line the vehicle must discard, that
+        line's clause fails (:meth:`_discard_answered`) and True is returned: the answer is that
+        line's fault, not an output fault of its own. Otherwise False (judged as output)."""
+        fields = raw.rstrip(b"\r\n").split(b"*", 1)[0].split(b",")
+        try:
+            ack_type = int(fields[1]) if len(fields) > 1 else None
+        except ValueError:
+            ack_type = None
+        waiting = [q.kind.ack_type for q in self.pending] + [q.kind.ack_type for q in self.gave_up
+                                                             if q.ack is None]
+        if (ack_type is None and waiting) or ack_type in waiting:
+            return False  # perhaps a waiting command's own ACK, malformed
+        return self._discard_answered(ack_type, escape(raw.rstrip(b"\r\n")), None, evd)
+
     def _answered(self, p: Sent, a: s.ACK, t: float, evd: Evidence, late: bool) -> None:
         p.state, p.ack, p.t_ack = "answered", a, t
         ev = [p.ev, evd]
         replies = self.vbytes - p.vbytes0
-        allowance = ack_allowance(self.profile.ack_window_s, len(p.raw), replies, self.baud, self.res)
+        window = self.profile.ack_window_s
+        allowance = ack_allowance(window, len(p.raw), replies, self.baud, self.res)
         dt = t - p.t
+        verdict = "fail" if late else ack_verdict(dt, allowance, window, self.res)
         if late and p.late_booked:
             pass  # RH-ACK-2 was booked when the give-up deadline passed
-        elif late or dt > ack_fail_after(allowance):
-            self.book("fail", ("RH-ACK-2",), f"$ACK,{a.type} came {dt:.2f} s after {text_of(p)}; the window with "
-                                             f"transmit time is {allowance - ACK_GRACE_S:.2f} s", ev, at=p)
-        elif dt > allowance:
-            self.ledger.inconclusive("RH-ACK-2", f"an $ACK came {dt:.2f} s after its command, over the "
-                                                 f"{allowance:.2f} s allowed by a margin host load can explain",
-                                     ev, self.case)
-        elif self.res > self.profile.ack_window_s / 10:
-            self.ledger.inconclusive("RH-ACK-2", f"timestamps step {self.res:g} s cannot bound a "
-                                                 f"{self.profile.ack_window_s:g} s window (RH-TIM-1)", ev, self.case)
+        elif verdict == "fail":
+            self.book("fail", ("RH-ACK-2",), f"$ACK,{a.type} came {dt:.2f} s after {text_of(p)}; allowed "
+                                             f"{allowance:.2f} s: the {window:g} s window, "
+                                             f"{transmit_time(len(p.raw) + replies, self.baud):.3f} s of transmit "
+                                             f"time, {ack_uncertainty(self.res):.3f} s of observer "
+                                             f"uncertainty", ev, at=p)
+        elif verdict == "inconclusive":
+            self.ledger.inconclusive("RH-ACK-2", f"an $ACK came {dt:.2f} s after its command: timestamps step "
+                                                 f"{self.res:g} s cannot tell whether that was within the "
+                                                 f"{window:g} s window (RH-TIM-1)", ev, self.case)
         elif self.ledger.keeps("RH-ACK-2", "pass", self.case):
             self.ledger.passed("RH-ACK-2", f"$ACK within {dt:.3f} s (allowed {allowance:.3f} s)", ev, self.case)
         else:
@@ -124,7 +156,10 @@ class Answers:
         if p.branched:  # already in the mirror, unanswered: judge the late answer's content only
             self._late_answer(p, a, observed, ev)
             return
-        res = self.beliefs.command(p.kind.item, self.k * t, self.k * (dt + JITTER_S + self.res), observed)
+        # RH-RD-15: the command took effect the instant its ACK went out, which its arrival bounds
+        # (less the replies' transmit time), however long the vehicle took to answer
+        took = min(dt, transmit_time(replies, self.baud))
+        res = self.beliefs.command(p.kind.item, self.k * t, self.k * (took + JITTER_S + self.res), observed)
         p.expected = res.expected
         want = next((r for r in res.expected if isinstance(r, s.ACK)), None)
         p.negative = want is not None and want.status == 1
@@ -244,7 +279,10 @@ class Answers:
             self._mission_seen(osi, evd)
         self.last_osi, self.last_osi_t = osi, t
         self.mode_seen(t, osi.mode)
-        res = self.beliefs.osi(osi, self.v(p.t), self.v(t), self.slack_v())
+        # the report shows the state the instant it was sent (RH-OUT-4), which its arrival bounds
+        # less its own transmit time (RH-RD-15: the $OSD is processed as its ACK goes out)
+        t_from = max(p.t, t - transmit_time(len(evd.text) + 2, self.baud))
+        res = self.beliefs.osi(osi, self.v(t_from), self.v(t), self.slack_v())
         if res.findings:
             cands = ("RH-OUT-4",) + tuple(c for c in res.causes if c != "RH-OUT-4") + self.checks.recent()
             msg = res.findings[0][1]

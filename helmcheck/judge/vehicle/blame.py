@@ -5,17 +5,37 @@ Every finding names an ordered tuple of *candidate* clauses, the most specific f
 * an answered command — :func:`command_clauses`: a malformed command's field clause and RH-ACK-3
   (``$OSD`` letters: RH-OSD-2); a command the table refuses: the refusing row's clauses (the
   precondition and RH-ACK-4, or the lockout's RH-SAF-1/RH-SAF-3); an accepted one: its row's
-  clauses. Readings (``RH-RD-*``) are never booked: they say how a clause is read, not what a
-  vehicle must do;
+  clauses. A value out of range is booked on the clause that sets the range, whether the
+  grammar (a field's form: ``$OMP`` field 1 not ten hex digits, a timeout that is not an integer)
+  or the range check (``$OMP`` field 2 not ``00``, a timeout of 0) finds it: :data:`FIELD_CLAUSE`
+  names that clause for each field whose form or range a vehicle clause sets; a field count, or
+  a field whose range only a reading sets (``RH-RD-9``: ``$OPOS`` speed, ``$ODVL`` x/y, the
+  ``$OMW`` fields), is RH-ACK-3's. Readings (``RH-RD-*``) are never booked: they say how a clause
+  is read, not what a vehicle must do;
 * an ``$OSI`` no conforming state explains — RH-OUT-4 and the clauses of what changed since the
-  last confirmed report (a timer's row, an accepted command's row);
+  last confirmed report (a timer's row, an accepted command's row); RH-TIM-1/2 follow when a
+  duration was being timed around the report;
 * a line the vehicle must discard but answered — the discard's own clause (RH-FRM-2/4/5/6/7),
   whatever else is wrong with the answer.
 
 :func:`targets` books a finding: inside a clause case (its ``case …`` note) on the candidates the
 case is about, if any (a failure inside a case belongs to its subject, not to a neighbour it
 touched); otherwise on the first candidate (and, when that is the generic RH-OUT-4, on the first
-specific cause as well).
+specific cause as well), with three refinements of that first cause:
+
+* a clause that says only when, or with which values, a command is accepted
+  (:data:`ACCEPTANCE`: RH-SRV-1/2, RH-PRM-1/2, RH-JW-1, RH-PK-1, RH-OMW-1) was settled by the
+  command's ``$ACK``: a report after it is about the state the command leads to, so the next
+  cause is taken (RH-PK-2 "mode becomes mP", not RH-PK-1);
+* a release (:data:`RELEASES`): a timer or command that ends remote control says *that* control
+  ends, RH-INT-2 says *what* the vehicle resumes — the waypoint it was heading for, the park time
+  left. A report no conforming state explains after one may be wrong in either (still in the
+  remote mode: the trigger's clause; released, but to the wrong waypoint or park: RH-INT-2), and
+  the candidates do not say which: both are booked;
+* a report whose only specific cause is a clause its own check judges on that same report
+  (:data:`REPORT_JUDGED`: the ``$OPK`` countdown, RH-PK-2, judged from fields 7 and 10 by
+  :mod:`.osichecks`) is booked on RH-OUT-4 alone: the own check books the clause, with the
+  reason the report gives (where the vehicle was, what it counted).
 
 :data:`OWN_EVIDENCE` lists the clauses a row's confirmation does not pass by itself, because
 their text asks for more than the mode the row leads to; each passes only on its own
@@ -31,7 +51,7 @@ from ...clauses import catalogue
 from ...grammar import sentences as s
 from ...grammar.errors import SentenceError
 
-__all__ = ["command_clauses", "targets", "vehicle_clause", "OWN_EVIDENCE", "passable"]
+__all__ = ["command_clauses", "targets", "vehicle_clause", "OWN_EVIDENCE", "FIELD_CLAUSE", "passable"]
 
 #: clause → the observation that passes it (instead of a row's confirmation).
 OWN_EVIDENCE = {
@@ -51,6 +71,19 @@ OWN_EVIDENCE = {
     "RH-SET-2": "an $ORWSET reply showing what was written",
     "RH-OSD-1": "the data sentences of an $OSD, in request order",
     "RH-TIM-1": "an RH-TIM-1 bracket", "RH-TIM-2": "an RH-TIM-1 bracket at the declared time scale",
+}
+
+#: (sentence ID, field) → the vehicle clause that sets the field's form or range (§4–6, as the
+#: range checks of :mod:`helmcheck.grammar.ranges` name it): a value the grammar cannot read there
+#: (nine hex digits, ``1.5`` for an integer timeout) breaks that clause, not only RH-ACK-3.
+FIELD_CLAUSE = {
+    **{("OMS", f): "RH-SRV-2" for f in ("heading", "depth", "max_pitch", "speed", "timeout")},
+    **{("OMP", f): "RH-PRM-2" for f in ("actuators", "reserved", "timeout")},
+    ("OJW", "waypoint"): "RH-JW-1",
+    **{("OPK", f): "RH-PK-1" for f in ("lat", "lon", "minutes", "speed")},
+    ("OPOS", "lat"): "RH-POS-1", ("OPOS", "lon"): "RH-POS-1",
+    ("ODVL", "timeout"): "RH-DVL-1",
+    ("OMSTOP", "flag"): "RH-MSN-3",
 }
 
 _KNOWN = None
@@ -89,6 +122,8 @@ def command_clauses(item, expected_ack: Optional[s.ACK], row) -> tuple[str, ...]
         if expected_ack is not None and expected_ack.err == 26:
             return ("RH-SAF-1",) if row is None else _dedupe(row.clauses)
         first = "RH-OSD-2" if item.sentence_id == "OSD" else item.clause
+        if first == "RH-ACK-3" and item.field:  # a field's form: the clause that sets it
+            first = FIELD_CLAUSE.get((item.sentence_id, item.field), first)
         return _dedupe((first, "RH-ACK-3")) or ("RH-ACK-3",)
     if row is None:
         return ("RH-ACK-1",)
@@ -103,6 +138,15 @@ def command_clauses(item, expected_ack: Optional[s.ACK], row) -> tuple[str, ...]
 #: Clauses that say only "the report must be consistent": outside a case, a finding on one of
 #: them is booked on its first specific cause too (what the vehicle did wrong to get there).
 GENERIC = frozenset({"RH-OUT-4"})
+#: The clauses of what ends remote control whose text hands what follows to RH-INT-2 (the servo
+#: and primitive timeouts, the ``$OPK`` time up, ``$OMW,Clr`` and the queue done).
+RELEASES = frozenset({"RH-SRV-4", "RH-PRM-4", "RH-PK-3", "RH-OMW-3", "RH-OMW-4"})
+#: Clauses a report's own check judges on every report they speak to (module docstring).
+REPORT_JUDGED = frozenset({"RH-PK-2"})
+#: Clauses that say only when, or with which values, a command is accepted (module docstring).
+ACCEPTANCE = frozenset({"RH-SRV-1", "RH-SRV-2", "RH-PRM-1", "RH-PRM-2", "RH-JW-1", "RH-PK-1", "RH-OMW-1"})
+#: Named when a duration was being timed around a report: no cause by themselves.
+_TIMING = frozenset({"RH-TIM-1", "RH-TIM-2"})
 
 
 def targets(candidates: tuple[str, ...], case_clauses: tuple[str, ...]) -> tuple[str, ...]:
@@ -112,5 +156,13 @@ def targets(candidates: tuple[str, ...], case_clauses: tuple[str, ...]) -> tuple
         if inside:
             return inside
     if candidates and candidates[0] in GENERIC and len(candidates) > 1:
-        return candidates[:2]
+        specific = [c for c in candidates[1:] if c not in _TIMING and c not in GENERIC]
+        if specific and all(c in REPORT_JUDGED for c in specific):
+            return candidates[:1]
+        first = candidates[1]
+        if first in ACCEPTANCE:
+            first = next((c for c in specific if c not in ACCEPTANCE), first)
+        if first in RELEASES and "RH-INT-2" in candidates[2:]:
+            return (candidates[0], first, "RH-INT-2")
+        return (candidates[0], first)
     return candidates[:1]

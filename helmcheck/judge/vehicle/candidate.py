@@ -25,7 +25,12 @@ never their values) and keeps, besides the model, what judging needs and the mod
   timer's before-state: the ``$OSI`` mode (the latest report, and the latest of each mode: a
   report of the after-state a little before the model's own deadline, within the tolerance,
   leaves the last report of the before-state as the bracket's start), and the last err 26 to a
-  command only the lockout refuses.
+  command only the lockout refuses;
+* ``nav_seen`` / ``fix_seen`` — the latest report of the running mission's distance to its next
+  waypoint (``$OSI`` field 7 in ``N`` or ``P`` at that waypoint: mission name, waypoint, metres,
+  vehicle time, position, speed) and the latest reported position (earliest and latest vehicle
+  time, lat, lon, speed), both set by the report checks (:mod:`.osichecks`): what makes an unseen waypoint
+  reached physically possible or not (:mod:`.closure`).
 """
 
 from __future__ import annotations
@@ -78,7 +83,7 @@ class Candidate:
 
     __slots__ = ("model", "events", "story", "extra_v", "window", "pending", "timed", "abandoned",
                  "s_cause", "refused_locked", "seen_v", "seen_mode", "seen_at", "locked_v", "code_unknown",
-                 "refresh", "_mode", "_phase")
+                 "refresh", "nav_seen", "fix_seen", "_mode", "_phase")
 
     def __init__(self, model: VehicleModel):
         if model.trace is None:
@@ -100,6 +105,8 @@ class Candidate:
         self.seen_at: dict[str, float] = {}
         self.locked_v: Optional[float] = None
         self.code_unknown = False
+        self.nav_seen: Optional[tuple] = None
+        self.fix_seen: Optional[tuple] = None
         self._mode = model.mode
         self._phase = model.phase
 
@@ -107,6 +114,9 @@ class Candidate:
         c = Candidate.__new__(Candidate)
         c.model = self.model.clone()
         c.model.trace = list(self.model.trace or [])
+        # the state before a timer that fired since the last input stays what may be expected
+        # (RH-TIM-1's slow shadow): a copy answering a command is the same vehicle, not a new one
+        c.model._base = self.model.checkpoint
         c.events, c.story, c.extra_v, c.window = self.events, self.story, self.extra_v, self.window
         c.pending = list(self.pending)
         c.timed = [Timed(**vars(t)) for t in self.timed] if self.timed else []
@@ -115,6 +125,7 @@ class Candidate:
         c.seen_v, c.seen_mode, c.locked_v = self.seen_v, self.seen_mode, self.locked_v
         c.seen_at = dict(self.seen_at)
         c.code_unknown = self.code_unknown
+        c.nav_seen, c.fix_seen = self.nav_seen, self.fix_seen
         c._mode, c._phase = self._mode, self._phase
         return c
 

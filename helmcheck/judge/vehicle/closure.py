@@ -136,9 +136,56 @@ def explain_osi(c: Candidate, osi: s.OSI, v: float, slack_v: float, tp: float, c
 
 
 def _motion_trials(c: Candidate, osi: s.OSI, tp: float, gap: float, catalog) -> list:
+    """The plant events that fit ``c``'s mode, each only where it is physically possible.
+
+    Nothing moves faster than the profile's ``max_speed_kn`` (or the speed the vehicle itself
+    reports, if higher), and "there" means within ``on_station_m`` (RH-RD-5):
+
+    * a mission waypoint is reached (mode ``N``; every trial that passes the next waypoint ``k``,
+      the learnt parks and mission ends included) only if the vehicle can have come within
+      ``on_station_m`` of ``k`` by the report: from the last report of its distance to ``k``
+      (field 7 in ``N`` or ``P`` at ``k``, :attr:`~.candidate.Candidate.nav_seen`) — and, from
+      the last position reported after it (under remote control, when the mission is frozen,
+      RH-RD-5), less the way it has made since; with the vehicle's mission files (a catalogue
+      that learns nothing), from the last position reported, to ``k`` as the file places it.
+      Nothing of that reported: no evidence, adoptable;
+    * the ``$OPK`` countdown starts on station (RH-PK-2) only if the report showing it can be on
+      station when its count began: field 7 at most ``on_station_m`` plus the way the vehicle can
+      have drifted in the time field 10 has counted (rounded up, RH-RD-5, and the RH-TIM-1
+      tolerance of the park) — the profile does not say it must stay on station while it counts.
+      (What earlier reports show of where it was is judged by :mod:`.osichecks`, RH-PK-2.)
+    """
+    from ...model.geo import distance_m
+    from ...model.timers import tolerance
+
     m = c.model
     out: list = []
+    prof = m.profile
+    knots = max([prof.max_speed_kn, float(osi.speed)]
+                + [x[-1] for x in (c.nav_seen, c.fix_seen) if x is not None])  # their speed is last
+    vmax = knots * 1852.0 / 3600.0  # m/s
+    v = tp + gap
+
+    def can_reach(k: int) -> bool:
+        run, nav, fix = m.mission, c.nav_seen, c.fix_seen
+        need = []  # (since when, metres it still had to make at least to be on station at k)
+        if nav is not None and nav[0] == run.name and nav[1] == k:  # type: ignore[union-attr]
+            _, _, d, t0, lat, lon, _ = nav
+            need.append((t0, d - prof.on_station_m))
+            if fix is not None and fix[0] > t0:  # the way made since (under remote control, say)
+                need.append((fix[0], d - distance_m(lat, lon, fix[2], fix[3]) - prof.on_station_m))
+        if fix is not None and not getattr(catalog, "learns", True) and not run.is_open:  # type: ignore[union-attr]
+            w = run.waypoints[k]  # type: ignore[union-attr]
+            need.append((fix[0], distance_m(fix[2], fix[3], w.lat, w.lon) - prof.on_station_m))
+        for since, metres in need:
+            left = max(0.0, v - since)
+            if metres > vmax * (left + tolerance(left)):
+                return False
+        return True
+
     if m.mode == "N" and m.mission is not None:
+        k = m.mission_wp
+
         def waypoints(n: int):
             def build(t: Candidate) -> Optional[Candidate]:
                 for _ in range(n):
@@ -151,13 +198,25 @@ def _motion_trials(c: Candidate, osi: s.OSI, tp: float, gap: float, catalog) -> 
             out.append(("mission waypoint reached" if n == 1 else f"{n} mission waypoints reached",
                         waypoints(n), n, None))
         out += _park_and_end(c, osi, tp, gap, catalog)
+        if not can_reach(k):
+            def not_past(build):
+                def guarded(t: Candidate) -> Optional[Candidate]:
+                    before = t.model
+                    got = build(t)
+                    if got is None or got.model is not before:
+                        return got  # not from here (a park's end taken from the checkpoint)
+                    return got if (got.model.mode, got.model.mission_wp) == ("N", k) else None
+                return guarded
+            out = [(name, not_past(build), n, learn) for name, build, n, learn in out]
     elif m.mode == "P" and m.mission is not None and osi.mode == "S":
         out += _park_and_end(c, osi, tp, gap, catalog)
     elif m.mode == "mP":
-        def on_station(t: Candidate) -> Candidate:
-            t.model.plant(OnStation(), tp)
-            return t
-        out.append(("on station at the $OPK position", on_station, 1, None))
+        counted = max(0.0, m.opk_seconds - osi.park_time) + 1.0 + tolerance(m.opk_seconds)
+        if float(osi.distance) <= prof.on_station_m + vmax * counted:
+            def on_station(t: Candidate) -> Candidate:
+                t.model.plant(OnStation(), tp)
+                return t
+            out.append(("on station at the $OPK position", on_station, 1, None))
     elif m.mode == "W":
         def queue(n: int):
             def build(t: Candidate) -> Optional[Candidate]:
@@ -198,7 +257,7 @@ def _park_and_end(c: Candidate, osi: s.OSI, tp: float, gap: float, catalog) -> l
         seconds = osi.park_time + gap
 
         def learn_p():
-            entry.learn_park(at, seconds)
+            entry.learn_park(at, seconds, osi.park_time - 1.0)
 
         def build_p(t: Candidate) -> Optional[Candidate]:
             swap(t, _with_park(run, at, seconds))
@@ -209,6 +268,23 @@ def _park_and_end(c: Candidate, osi: s.OSI, tp: float, gap: float, catalog) -> l
             return t
         name = "a mission park (learnt)" if not j else f"{j} mission waypoint(s) reached, then a mission park"
         out.append((name, build_p, j + 1, None if j else learn_p))
+    bounds = entry.park_bounds(osi.next_waypoint) if m.mode == "N" and osi.mode == "P" else None
+    if bounds is not None and osi.next_waypoint == wp and bounds[1] - bounds[0] > 1e-6:
+        # a park known only within an interval (first seen after it began), seen again from
+        # closer to its start — a mission restarted on station there (RH-MSN-2, RH-RD-5): the
+        # length this report allows, where it agrees with what was seen before, narrows it
+        lo, hi = osi.park_time - 1.0, osi.park_time + gap
+        if lo <= bounds[1] + 1e-6 and hi >= bounds[0] - 1e-6:
+            refined = max(bounds[0], min(bounds[1], hi))
+
+            def learn_r():
+                entry.refine_park(wp, lo, hi)
+
+            def build_r(t: Candidate) -> Optional[Candidate]:
+                swap(t, _with_park(run, wp, refined))
+                t.model.plant(WaypointReached(), tp)
+                return t if t.model.mode == "P" else None
+            out.append(("a mission park (its length narrowed)", build_r, 1, learn_r))
     if m.mode == "N" and not entry.park_known(wp):
         if osi.mode == "N" and osi.next_waypoint == wp + 1:
             def learn_0():

@@ -8,7 +8,7 @@
 * **ACK pairing**: every backseat line a vehicle must answer waits in order for an ``$ACK`` of its
   type (RH-ACK-1, RH-ACK-6); its data sentences before it (RH-ACK-5, RH-OSD-1/2); the ACK window
   (RH-ACK-2, :func:`~helmcheck.judge.timing.ack_allowance`). A command still unanswered
-  :func:`~helmcheck.judge.timing.ack_fail_after` its send is missing (RH-ACK-1) — if the vehicle
+  :func:`~helmcheck.judge.timing.ack_give_up_after` its send is missing (RH-ACK-1) — if the vehicle
   still says anything; an ACK that comes after that belongs to it (RH-ACK-2), not to the next
   command. A line the vehicle must discard passes its clause (RH-FRM-2/4/5/6/7) when the window
   passes unanswered, and fails it when answered;
@@ -39,7 +39,7 @@ from ...grammar.capture import escape
 from ...model import plant as P
 from ...profile import Profile
 from ..ledger import Evidence, Ledger, Reason
-from ..timing import JITTER_S, ack_allowance, ack_fail_after
+from ..timing import JITTER_S, ack_allowance, ack_give_up_after
 from ..wire import FROM_VEHICLE, NOTE, TO_VEHICLE, WireEvent, parse_note
 from . import osichecks
 from .belief import Beliefs
@@ -284,6 +284,12 @@ class VehicleObserver(Answers):
             return
         d = self.decode(fe.raw)
         evd = self._evidence(ev, fe.raw, "<")
+        if (d.sentence is None and d.sentence_id == "ACK" and d.error is not None
+                and not d.error.clause.startswith("RH-FRM") and self._invalid_ack(fe.raw, evd)):
+            # a malformed $ACK answering a line the vehicle must discard: booked on that line's
+            # clause (whatever else is wrong with the answer); the bytes before it are still read
+            self.out._prefix(evd, self.case)
+            return
         sent = self.out.line(d, evd, self.case)
         if sent is not None:
             self.alive_t = ev.t
@@ -361,7 +367,7 @@ class VehicleObserver(Answers):
             if t - p.t <= window:
                 continue  # inside the bare window: inside every allowance (ack_allowance ≥ the window)
             allowance = ack_allowance(window, len(p.raw), self.vbytes - p.vbytes0, self.baud, self.res)
-            if t - p.t > ack_fail_after(allowance):
+            if t - p.t > ack_give_up_after(allowance):
                 over.append((p, allowance))
         for p, allowance in over:  # in order (each one's allowance does not depend on the others)
             self.pending.remove(p)
@@ -390,7 +396,7 @@ class VehicleObserver(Answers):
         sent, or at the record's end — an ACK that comes before that belongs to it (RH-ACK-2),
         never to a later command."""
         p.state = "missing"
-        p.waited = ack_fail_after(allowance)
+        p.waited = ack_give_up_after(allowance)
         self.gave_up.append(p)
         if self.alive_t is not None and self.alive_t > p.t:
             self._book_late(p)

@@ -6,13 +6,26 @@ A report carries more, and these checks use it:
 * **fins and motor** (field 1): in ``M`` the commanded bytes upper-cased (RH-PRM-3); in ``S``
   reached by ``$OMSTOP`` (RH-MSN-3) or a primitive timeout from ``S`` (RH-PRM-4) neutral
   ``8080808080``;
-* **on station** (field 7, the distance to the navigation target, RH-RD-5): a vehicle counting
-  an ``$OPK`` park down must be on station (RH-PK-2: checked on the first report that shows the
-  count, allowing the distance it may have moved since the count began); a vehicle that reports
-  itself within ``on_station_m`` of its target for longer than :data:`~helmcheck.judge.timing.
-  PLANT_REACT_S` (+ RH-TIM-1 tolerance and slack) without acting fails the clause of the act it
-  owes: the ``$OPK`` count (RH-PK-2), the queued waypoint (RH-OMW-4), the mission's end at its
+* **the ``$OPK`` park** (RH-PK-2), judged from each ``mP`` report after an accepted ``$OPK`` —
+  its minutes and the report's fields 7 and 10 alone, so the verdict does not wait on the mirror
+  (:class:`_OpkPark`): field 10 below minutes×60 says when the count began (it is rounded up,
+  RH-RD-5, within the RH-TIM-1 tolerance). The count must not have begun before the ``$OPK``; it
+  must have begun on station: a report showing the count while field 7 is over ``on_station_m``,
+  with no report on station since the ``$OPK``, fails when no moment of that interval is one at
+  which the vehicle can have been on station, given every such report and the fastest it can go
+  (``max_speed_kn``, or the speed it reports): a vehicle that arrived between two reports and
+  drifted a little since is not failed — the profile does not say it must stay within
+  ``on_station_m`` while it counts. Seen on station, it must count within
+  :data:`~helmcheck.judge.timing.PLANT_REACT_S` (+ tolerance and slack);
+* **on station** (field 7, the distance to the navigation target, RH-RD-5): a vehicle that
+  reports itself within ``on_station_m`` of its target for longer than
+  :data:`~helmcheck.judge.timing.PLANT_REACT_S` (+ RH-TIM-1 tolerance and slack) without acting
+  fails the clause of the act it owes: the queued waypoint (RH-OMW-4), the mission's end at its
   last waypoint (RH-MSN-4; a waypoint of a mission of unknown length: RH-OUT-4);
+* **the way made** (fields 4, 5, 6 and 7): every report's position, and field 7 in ``N``/``P`` at
+  the mission's next waypoint, are kept on the mirror's candidates (``fix_seen``, ``nav_seen``)
+  for the closure to tell whether an unseen waypoint reached is physically possible (RH-INT-2:
+  released to the waypoint it was heading for, which it cannot have reached yet);
 * **at the surface** (field 15, depth): the at-surface action must be taken at the surface
   (RH-SAF-4: checked on the report that shows it), and a vehicle at the surface in the ascent for
   longer than the same allowance without taking it fails RH-SAF-4;
@@ -44,6 +57,49 @@ __all__ = ["OsiChecks"]
 _KN = 1852.0 / 3600.0
 #: Metres below which an ``$OPOS`` position cannot be told from where the vehicle already was.
 _POS_DECIDABLE_M = 30.0
+#: Reports away from the park position kept per ``$OPK`` (the latest; enough to time a count).
+_AWAY_KEPT = 32
+#: Accepted commands after which the ``mP`` reports are no longer about the ``$OPK`` park.
+_ENDS_PARK = (s.OMS, s.OMP, s.OMW, s.OMWClear, s.OJW, s.OMSTOP, s.OMSTART, s.OMSTARTPaper)
+
+
+class _OpkPark:
+    """An accepted ``$OPK`` (RH-PK-2): its park seconds, when it was sent (vehicle seconds), the
+    reports that showed the vehicle away from its position ``(earliest, latest, metres)``, the
+    fastest the vehicle can go (knots), when it was first reported on station."""
+
+    __slots__ = ("seconds", "v0", "away", "knots", "on", "passed", "failed")
+
+    def __init__(self, seconds: int, v0: float):
+        self.seconds, self.v0 = seconds, v0
+        self.away: list[tuple[float, float, float]] = []
+        self.knots = 0.0
+        self.on: Optional[float] = None
+        self.passed = self.failed = False
+
+
+def _possible(begin: tuple[float, float], away: list, mps: float, radius: float) -> bool:
+    """Whether some moment of ``begin`` is one at which the vehicle can have been within
+    ``radius`` of a point it was reported ``metres`` from (made between ``earliest`` and
+    ``latest``), moving at most ``mps``: never closer than ``metres - radius`` of way to it."""
+    lo, hi = begin
+    if lo > hi + 1e-9:
+        return True  # no interval to judge (the count and the $OPK disagree: judged apart)
+    if mps <= 0:
+        return not any(m > radius for _, _, m in away)
+    cut = []
+    for early, late, metres in away:
+        r = (metres - radius) / mps  # the time it takes to come within radius
+        if r > 0 and late - r < early + r:
+            cut.append((late - r, early + r))  # on station at none of these moments
+    at = lo
+    for a, b in sorted(cut):
+        if a >= at:  # a moment not cut (open intervals: their ends are possible)
+            break
+        at = max(at, b)
+        if at > hi:
+            return False
+    return at <= hi
 
 
 class OsiChecks:
@@ -56,7 +112,8 @@ class OsiChecks:
         self.pos: Optional[dict] = None
         self.known: dict[str, tuple[str, ...]] = {}
         self.watch: Optional[tuple] = None  #: (key, first v on station/at surface, clause, what)
-        self.counting_checked = False
+        self.park: Optional[_OpkPark] = None  #: the accepted $OPK the mP reports are judged on (RH-PK-2)
+        self.shown_code = ""  #: field 8 of the last report (a code newly shown without $OXFLT: RH-SAF-5)
 
     # ------------------------------------------------------------------ answers
     def oxflt_sent(self, code: str, t: float) -> None:
@@ -68,6 +125,11 @@ class OsiChecks:
 
     def answered(self, p, a: s.ACK, res, ev: list) -> None:
         item = p.kind.item
+        if a.status == 0:
+            if isinstance(item, s.OPK):  # RH-RD-3: a new $OPK in mP replaces the park, restarts its count
+                self.park = _OpkPark(item.minutes * 60, self.o.v(p.t) - self.o.slack_v())
+            elif isinstance(item, _ENDS_PARK):
+                self.park = None
         if a.status != 0 or not res.matched:
             return
         if isinstance(item, s.ORWSET):
@@ -142,11 +204,18 @@ class OsiChecks:
     # ------------------------------------------------------------------ reports
     def after_osi(self, osi: s.OSI, p, t: float, ev: list, judged: bool, passes=frozenset()) -> None:
         o = self.o
+        shown_before, self.shown_code = self.shown_code, osi.error_state
+        self._way_made(osi, p, t)
+        self._opk_park(osi, p, t, ev)
         if self.oxflt is not None:
             code, _ = self.oxflt
             self.oxflt = None
             if judged and osi.error_state == code:
                 o.ledger.passed("RH-SAF-5", f"$OXFLT,{code} raised the violation at once, with no ACK", ev, p.case)
+        elif judged and shown_before == "N" and osi.error_state not in ("N", ""):
+            # raised by the vehicle itself (its own rule, a sensor): judged like any other (RH-SAF-5)
+            o.ledger.passed("RH-SAF-5", f"the vehicle raised {osi.error_state} by itself (no $OXFLT) and "
+                                        f"field 8 shows it; the lockout is judged as for any violation", ev, p.case)
         if not judged:
             self.watch = None
             return
@@ -158,7 +227,6 @@ class OsiChecks:
         self._surface_action(osi, passes, p, ev)
         if "RH-MSN-4" in passes:
             o.ledger.passed("RH-MSN-4", "S at the mission's end", ev, p.case)
-        self._counting(osi, m, p, ev)
         self._watch(osi, m, p, t, ev)
 
     def _actuators(self, osi: s.OSI, m, p, ev: list) -> None:
@@ -223,24 +291,79 @@ class OsiChecks:
             o.book("fail", ("RH-SAF-4",), f"the at-surface action ({osi.mode}) taken at {depth:g} m, not at "
                                           f"the surface (≤ {fix:g} m)", ev, at=p)
 
-    def _counting(self, osi: s.OSI, m, p, ev: list) -> None:
-        """RH-PK-2: an ``$OPK`` count shown for the first time must be shown on station."""
+    def _way_made(self, osi: s.OSI, p, t: float) -> None:
+        """Keep the report's position, and its distance to the mission's next waypoint, on every
+        candidate (module docstring; read by :mod:`.closure`)."""
         o = self.o
-        if not (m.mode == "mP" and osi.mode == "mP" and m.opk_counting):
-            self.counting_checked = False
+        # when the report can have been made — the earliest less the observer's slack once more,
+        # for the report judged against it (its own time is known only to within that)
+        v, late = o.v(p.t) - 2 * o.slack_v(), o.v(t) + o.slack_v()
+        lat, lon, speed = float(osi.lat), float(osi.lon), float(osi.speed)
+        nav = osi.mode in ("N", "P")
+        for c in o.beliefs.cands:
+            c.fix_seen = (v, late, lat, lon, speed)
+            m = c.model
+            if nav and m.mission is not None and m.mode == osi.mode and m.mission_wp == osi.next_waypoint:
+                c.nav_seen = (m.mission.name, m.mission_wp, float(osi.distance), v, lat, lon, speed)
+
+    def _opk_park(self, osi: s.OSI, p, t: float, ev: list) -> None:
+        """RH-PK-2 from an ``mP`` report after an accepted ``$OPK`` (module docstring)."""
+        park = self.park
+        if park is None:
             return
-        if self.counting_checked or osi.park_time >= m.opk_seconds:
+        if osi.mode != "mP":
+            self.park = None  # the park is over (or never began): nothing more to judge of it
             return
-        self.counting_checked = True
+        o = self.o
+        prof = o.profile
+        slack = o.slack_v()
+        lo, hi = o.v(p.t) - slack, o.v(t) + slack  # when the report was made
         d = float(osi.distance)
-        since = max(0.0, (m.opk_seconds - osi.park_time) + 1.0)
-        allow = o.profile.on_station_m + float(osi.speed) * _KN * since + 1.0
-        if d <= allow:
-            o.ledger.passed("RH-PK-2", f"counting down from {m.opk_seconds} s on station ({d:g} m from the "
-                                       f"park position)", ev, p.case)
-        else:
-            o.book("fail", ("RH-PK-2",), f"the $OPK park counts down (P{osi.park_time}) {d:g} m from its "
-                                         f"position, not on station (≤ {o.profile.on_station_m:g} m)", ev, at=p)
+        near = d <= prof.on_station_m  # RH-RD-5: field 7 as reported, inclusive
+        secs, shown = park.seconds, osi.park_time
+        park.knots = max(park.knots, prof.max_speed_kn, float(osi.speed))
+        if not near:
+            park.away.append((lo, hi, d))
+            del park.away[:-_AWAY_KEPT]
+        counted = secs - shown  # whole seconds field 10 has counted: it is rounded up (RH-RD-5)
+        what = f"the $OPK park counts down (P{shown} of {secs} s)"
+        if counted > 0:
+            # the count began between these many seconds before the report (RH-TIM-1 tolerance)
+            least, most = counted - tolerance(secs), counted + 1.0 + tolerance(secs)
+            if hi - least < park.v0 and not park.failed:
+                park.failed = True
+                o.book("fail", ("RH-PK-2",), f"{what} {counted} s, but the $OPK was accepted only "
+                                             f"{max(0.0, hi - park.v0):.1f} s before the report (it counts "
+                                             f"down from minutes×60 = {secs} s)", ev, at=p)
+                return
+            if not near and park.on is None and not park.failed:
+                begin = (max(park.v0, lo - most), hi - least)
+                if not _possible(begin, park.away, park.knots * _KN, prof.on_station_m):
+                    park.failed = True
+                    far = max(park.away, key=lambda a: a[2])
+                    o.book("fail", ("RH-PK-2",), f"{what} {d:g} m from its position, not on station "
+                                                 f"(≤ {prof.on_station_m:g} m): it began {counted} s before "
+                                                 f"this report, when the vehicle cannot have been on station "
+                                                 f"(reported {far[2]:g} m away at v={far[0]:.1f} s, at most "
+                                                 f"{park.knots:g} kn)", ev, at=p)
+                    return
+        if near and park.on is None:
+            park.on = hi  # seen on station: the count must run from here on (RH-PK-2)
+        if park.on is not None and not park.failed:
+            waited = lo - park.on
+            allow = PLANT_REACT_S + tolerance(PLANT_REACT_S) + o.k * (JITTER_S + o.res)
+            ran = max(0, counted) + 1.0  # the most field 10 can have run (it is rounded up)
+            if waited - ran - max(0.5, 0.05 * ran) > allow:
+                park.failed = True
+                o.book("fail", ("RH-PK-2",), f"on station since v={park.on:.1f} s ({d:g} m now), the $OPK "
+                                             f"park has counted only {max(0, counted)} s (P{shown} of {secs} s) "
+                                             f"in {waited:.1f} s of vehicle time (a vehicle counts down within "
+                                             f"{allow:.1f} s of being on station)", ev, at=p)
+                return
+        if counted > 0 and (near or park.on is not None) and not park.passed and not park.failed:
+            park.passed = True
+            o.ledger.passed("RH-PK-2", f"counting down from {secs} s on station ({d:g} m from the park "
+                                       f"position)", ev, p.case)
 
     def _watch(self, osi: s.OSI, m, p, t: float, ev: list) -> None:
         """On station or at the surface, and not acting (module docstring)."""
@@ -258,9 +381,6 @@ class OsiChecks:
             clause, what = ("RH-SAF-4",), f"at the surface ({depth:g} m) without its SafetyAction"
         elif m.phase != "none" or not near:
             key = None
-        elif osi.mode == "mP" and not m.opk_counting and osi.park_time >= m.opk_seconds:
-            key = ("mP", m.control_generation)
-            clause, what = ("RH-PK-2",), f"on station ({d:g} m) without counting its $OPK park down"
         elif osi.mode == "W" and not m.queue_parking:
             key = ("W", m.control_generation)
             clause, what = ("RH-OMW-4",), f"on its queued waypoint ({d:g} m) without going on"

@@ -1,0 +1,149 @@
+"""Run facts: what a run's verdict depends on besides the judges' findings, as wire-log notes.
+
+A clause verdict is the ledger's (:mod:`.ledger`); the run verdict and the certificate flag
+also depend on how the run went. Every such fact is a note in the wire log, written by the
+driver that knows it, so that ``helmcheck verify`` (and ``check-log``) read the very facts the
+live run was assembled from (:func:`helmcheck.reports.assemble.assemble`). The notes (their words
+are part of the wire-log format, ``docs/contracts.md``):
+
+==========================================  ===================================================
+``selection: RH-SRV-*,RH-INT-*``            the run selected only these clauses (``--select``):
+                                            the others are NOT-TESTED "not selected", except a
+                                            violation observed anyway, which stands
+``not judged RH-X,RH-Y: <reason>``          whatever was observed, these clauses are not judged
+                                            (NOT-TESTED with the reason), except a violation,
+                                            which stands (a backseat whose exit cut short the
+                                            scenarios exercising them, one that never connected)
+``process: {…}``                            the implementation under test helmcheck started
+                                            (``--exec``), as it ended: the ``process`` object of
+                                            ``results.json`` as JSON (exit code, signal, time,
+                                            last output, ``ended_early``)
+``run partial: <reason>``                   the run was cut short before it finished
+                                            (interrupted, never connected, …): it cannot
+                                            certify a pass
+``run resumed: <what>``                     an interrupted run goes on: the ``run partial`` and
+                                            ``process`` facts before it no longer hold
+==========================================  ===================================================
+
+(Bench safety refusing a step is a ``not tested RH-X: …`` note of :mod:`.wire`, booked by the
+observers like any finding; a log with one direction only is a fact of the log itself.)
+
+:class:`RunFacts` collects the facts from notes — fed live like an observer
+(:meth:`RunFacts.feed`), or read back from a wire log (:meth:`RunFacts.from_wire_log`) — and
+books the clause facts into a ledger (:meth:`RunFacts.book`, :meth:`.Ledger.withdraw`). The
+``*_note`` functions make the notes' text.
+"""
+
+from __future__ import annotations
+
+import json
+import re
+from dataclasses import dataclass, field
+from fnmatch import fnmatchcase
+from pathlib import Path
+from typing import Any, Iterable, Mapping, Optional
+
+from .wire import NOTE
+
+__all__ = ["RunFacts", "selection_note", "not_judged_note", "process_note", "partial_note",
+           "NOT_SELECTED", "NOT_SELECTED_OBSERVED"]
+
+NOT_SELECTED = "not selected (--select)"
+NOT_SELECTED_OBSERVED = "not selected, but observed: "
+
+_SELECTION = "selection: "
+_PROCESS = "process: "
+_PARTIAL = "run partial: "
+_RESUMED = "run resumed: "
+_NOT_JUDGED = re.compile(r"^not judged ((?:RH-[A-Z]+-\d+,?)+): (.*)$")
+
+
+def selection_note(patterns: Iterable[str]) -> str:
+    return _SELECTION + ",".join(patterns)
+
+
+def not_judged_note(clauses: Iterable[str], reason: str) -> str:
+    return f"not judged {','.join(clauses)}: {reason}".replace("\n", " ")
+
+
+def process_note(process: Mapping[str, Any]) -> str:
+    return _PROCESS + json.dumps(dict(process), sort_keys=True, ensure_ascii=True, separators=(",", ":"))
+
+
+def partial_note(reason: str) -> str:
+    return (_PARTIAL + reason).replace("\n", " ")
+
+
+@dataclass
+class RunFacts:
+    """The run facts of one record (module docstring)."""
+
+    select: tuple[str, ...] = ()  #: ``--select`` patterns; empty: every clause was selected
+    not_judged: dict[str, str] = field(default_factory=dict)  #: clause → reason (the first note holds)
+    process: Optional[dict] = None  #: the ``process`` object, when helmcheck started the implementation
+    partial: Optional[str] = None  #: why the run was cut short, or None
+    unreadable: list[str] = field(default_factory=list)  #: fact notes that could not be read
+
+    # ------------------------------------------------------------------ reading
+    def feed(self, ev: Any) -> None:
+        """An observer's ``feed``: a wire event (only notes matter)."""
+        if ev.dir == NOTE:
+            self.note(ev.note)
+
+    def note(self, text: str) -> bool:
+        """Take one note; True when it is a run fact."""
+        if text.startswith(_SELECTION):
+            self.select = tuple(p for p in text[len(_SELECTION):].strip().split(",") if p)
+            return True
+        if text.startswith(_PROCESS):
+            try:
+                doc = json.loads(text[len(_PROCESS):])
+            except ValueError:
+                doc = None
+            if isinstance(doc, dict):
+                self.process = doc
+            else:
+                self.unreadable.append(text[:120])
+            return True
+        if text.startswith(_PARTIAL):
+            self.partial = text[len(_PARTIAL):]
+            return True
+        if text.startswith(_RESUMED):
+            self.partial = None
+            self.process = None
+            return True
+        m = _NOT_JUDGED.match(text)
+        if m:
+            for cid in filter(None, m.group(1).split(",")):
+                self.not_judged.setdefault(cid, m.group(2))
+            return True
+        return False
+
+    @classmethod
+    def from_wire_log(cls, path: Path | str) -> "RunFacts":
+        """The facts of a wire log (format 1); ``OSError`` if it cannot be read. Only note lines
+        are looked at; any other line is skipped."""
+        facts = cls()
+        with open(path, "rb") as f:
+            for raw in f:
+                parts = raw.split(b" ", 2)
+                if len(parts) == 3 and parts[1] == b"!" and not raw.startswith(b"#"):
+                    facts.note(parts[2].rstrip(b"\r\n").decode("utf-8", "replace"))
+        return facts
+
+    # ------------------------------------------------------------------ using
+    def selected(self, cid: str) -> bool:
+        return not self.select or any(fnmatchcase(cid, p) for p in self.select)
+
+    @property
+    def ended_early(self) -> bool:
+        return isinstance(self.process, dict) and self.process.get("ended_early") is True
+
+    def book(self, ledger: Any) -> None:
+        """Book the clause facts into *ledger* (:meth:`~helmcheck.judge.ledger.Ledger.withdraw`):
+        a clause not selected, a clause not judged. Booking again changes nothing."""
+        for cid in ledger.order:
+            if not self.selected(cid):
+                ledger.withdraw(cid, NOT_SELECTED, NOT_SELECTED_OBSERVED)
+            elif cid in self.not_judged:
+                ledger.withdraw(cid, self.not_judged[cid])

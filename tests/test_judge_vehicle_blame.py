@@ -1,0 +1,286 @@
+"""Where the vehicle judge books a fault it sees: the clause that says what the vehicle did wrong.
+
+Short hand-made wire logs (the exact bytes a vehicle and a backseat could exchange), checked
+offline with ``check_log`` — the observer ``certify vehicle`` uses too. Each fault has a
+conforming counterpart that passes the same clause:
+
+* a command accepted with a field out of its range — whether the grammar (ten hex digits, an
+  integer timeout) or the range check finds it — is booked on the clause that sets the range
+  (README, "Error clauses"), not only on RH-ACK-3;
+* an ``$OPK`` park that counts down before the vehicle is on station is RH-PK-2's FAIL, judged from
+  what each report shows (field 7, the distance; field 10, the park time), even where the mirror
+  has lost the vehicle's state; a vehicle that arrived between two reports and drifted a little
+  since is not failed;
+* released from remote control, a vehicle that heads for the waypoint after the one it was heading
+  for (it cannot have reached that one in the time) fails RH-INT-2; one that was close to it, or
+  was driven close to it under remote control, and reaches it passes.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from helmcheck.conformance.checklog.checker import check_log
+from helmcheck.grammar import checksum_hex
+from helmcheck.profile import DEFAULT
+
+PROFILE = DEFAULT
+LAT, LON = 41.520000, -71.320000
+#: a point about 166 m east of (LAT, LON)
+FAR_LON = LON + 0.002
+
+
+def osi(mode: str, wp: int = 0, park: int = 0, err: str = "N", lat: float = LAT, lon: float = LON,
+        dist: float = 0.0, speed: float = 0.0, act: str = "8080808080") -> str:
+    return (f"OSI,{act},{mode},{wp},{lat:.8f},{lon:.8f},{speed:.2f},{dist:.2f},{err},38.00,P{park},-14.5000,"
+            f"conformance.mis,4.5,75.5,0.00,94.3,False,IVER3-EMU,0.0,False,False")
+
+
+def write(tmp_path: Path, records: list[tuple]) -> Path:
+    lines = ["# helmcheck wire-log 1", "# hand-made  baud 19200  time_scale 1"]
+    for t, d, body in records:
+        text = body if d == "!" else f"${body}*{checksum_hex(body)}"
+        lines.append(f"{t:.6f} {d} {text}")
+    p = tmp_path / "made.log"
+    p.write_text("\n".join(lines) + "\n")
+    return p
+
+
+def poll(t: float, **fields) -> list[tuple]:
+    """``$OSD,S`` at ``t``, its ``$OSI`` 10 ms later, its ACK 20 ms later."""
+    return [(t, ">", "OSD,S"), (t + 0.01, "<", osi(**fields)), (t + 0.02, "<", "ACK,8,0,0")]
+
+
+def send(t: float, body: str, ack: str) -> list[tuple]:
+    return [(t, ">", body), (t + 0.01, "<", ack)]
+
+
+def start(t: float = 0.0, dist: float = 150.0) -> list[tuple]:
+    """The test mission started: N, heading for waypoint 0, ``dist`` metres from it."""
+    return (poll(t, mode="S") + send(t + 0.1, "OMSTART,0,0,0,0,conformance.mis,", "ACK,3,0,0")
+            + poll(t + 0.2, mode="N", dist=dist, speed=2.0))
+
+
+def judge(tmp_path, records) -> dict:
+    out = check_log(write(tmp_path, records), profile=PROFILE, role="vehicle")
+    return {c["id"]: c for c in out.clauses}
+
+
+def verdict(v: dict, cid: str) -> str:
+    return v[cid]["verdict"]
+
+
+def failed(v: dict) -> set:
+    return {c for c, e in v.items() if e["verdict"] in ("fail", "non-strict")}
+
+
+# ============================================================ a range's clause (RH-PRM-2 and kin)
+
+@pytest.mark.parametrize("cmd,clause,mode", [
+    ("OMP,808080808,00,10", "RH-PRM-2", "M"),      # nine hex digits (the grammar finds it)
+    ("OMP,80808080GG,00,10", "RH-PRM-2", "M"),     # not hex
+    ("OMP,8080808080,00,1.5", "RH-PRM-2", "M"),    # a timeout that is not an integer
+    ("OMP,8080808080,01,10", "RH-PRM-2", "M"),     # field 2 is not 00 (the range check finds it)
+    ("OMP,8080808080,00,0", "RH-PRM-2", "M"),
+    ("OMP,8080808080,00,121", "RH-PRM-2", "M"),
+    ("OMS,90,2,20,1,1.5", "RH-SRV-2", "A"),        # the analogous ranges
+    ("OMS,90,2,20,1,121", "RH-SRV-2", "A"),
+    (f"OPK,{LAT},{LON},1.5,1", "RH-PK-1", "mP"),
+    (f"OPK,{LAT},{LON},0,1", "RH-PK-1", "mP"),
+    ("OJW,1.5", "RH-JW-1", "N"),
+    ("OJW,-1", "RH-JW-1", "N"),
+])
+def test_a_value_out_of_range_accepted_is_booked_on_the_clause_that_sets_the_range(tmp_path, cmd, clause, mode):
+    ack_type = {"OMP": 10, "OMS": 9, "OPK": 11, "OJW": 7}[cmd[:3]]
+    rec = start() + send(1.0, cmd, f"ACK,{ack_type},0,0") + poll(1.5, mode=mode, dist=150.0, speed=1.0)
+    v = judge(tmp_path, rec)
+    assert verdict(v, clause) == "fail", v[clause]
+    assert "a conforming vehicle" in v[clause]["reason"]
+    assert verdict(v, "RH-ACK-3") != "fail", v["RH-ACK-3"]  # the range's own clause, not only RH-ACK-3
+
+
+@pytest.mark.parametrize("cmd,ack_type,mode", [
+    ("OMP,8080808080,00", 10, "M"),                 # a field count: RH-ACK-3's own
+    (f"OPOS,{LAT},{LON},9,,", 6, "N"),              # ranges only a reading sets (RH-RD-9)
+    ("ODVL,9,0,5", 15, "N"),
+    (f"OMW,{LAT},{LON},2,,15,1,-1,", 16, "W"),
+])
+def test_a_field_count_or_a_range_only_a_reading_sets_stays_RH_ACK_3(tmp_path, cmd, ack_type, mode):
+    rec = start() + send(1.0, cmd, f"ACK,{ack_type},0,0") + poll(1.5, mode=mode, dist=150.0, speed=1.0)
+    v = judge(tmp_path, rec)
+    assert verdict(v, "RH-ACK-3") == "fail", v["RH-ACK-3"]
+
+
+def test_inside_an_RH_ACK_3_case_the_same_fault_is_the_case_s(tmp_path):
+    rec = start() + [(0.5, "!", "case V-12 RH-ACK-3: bad fields")]
+    rec += send(1.0, "OMP,808080808,00,10", "ACK,10,0,0") + poll(1.5, mode="M", dist=150.0)
+    v = judge(tmp_path, rec)
+    assert verdict(v, "RH-ACK-3") == "fail"
+    assert verdict(v, "RH-PRM-2") != "fail"
+
+
+def test_out_of_range_OMP_refused_with_err_21_passes_RH_PRM_2(tmp_path):
+    rec = start()
+    for i, cmd in enumerate(("OMP,808080808,00,10", "OMP,80808080GG,00,10", "OMP,8080808080,01,10",
+                             "OMP,8080808080,00,0", "OMP,8080808080,00,121")):
+        rec += send(1.0 + i, cmd, "ACK,10,1,21")
+    rec += poll(7.0, mode="N", dist=140.0, speed=2.0)
+    v = judge(tmp_path, rec)
+    assert failed(v) == set()
+    assert verdict(v, "RH-PRM-2") == "pass"
+
+
+def test_out_of_range_OMP_refused_with_a_wrong_error_number_is_RH_ACK_3(tmp_path):
+    rec = start() + send(1.0, "OMP,808080808,00,10", "ACK,10,1,20") + poll(1.5, mode="N", dist=148.0)
+    v = judge(tmp_path, rec)
+    assert verdict(v, "RH-ACK-3") == "fail"  # refused, as RH-PRM-2 wants, with another command's error
+    assert verdict(v, "RH-PRM-2") != "fail"
+
+
+# ============================================================ RH-PK-2: counting before on station
+
+def opk(t: float = 1.0, lon: float = FAR_LON, minutes: int = 2) -> list[tuple]:
+    return send(t, f"OPK,{LAT:.6f},{lon:.6f},{minutes},1", "ACK,11,0,0")
+
+
+def test_RH_PK_2_a_count_begun_off_station_fails_even_with_the_state_unknown(tmp_path):
+    """The record begins with the vehicle under servo control (a capture started mid-run): the
+    mirror cannot know its state, and the $OPK's acceptance and the reports are not judged
+    against it. What each report shows still proves the fault: 166 m from the park position, no
+    report on station since the $OPK, and field 10 has counted from it."""
+    rec = poll(0.0, mode="A", dist=0.0, speed=2.0)
+    rec += opk()
+    rec += poll(1.5, mode="mP", park=120, dist=166.0, speed=2.0)
+    rec += poll(5.5, mode="mP", park=116, dist=164.0, speed=2.0)
+    v = judge(tmp_path, rec)
+    assert verdict(v, "RH-PK-2") == "fail", v["RH-PK-2"]
+    assert "not on station" in v["RH-PK-2"]["reason"]
+
+
+def test_RH_PK_2_a_count_begun_off_station_fails_and_is_not_explained_away(tmp_path):
+    """In step with the vehicle, the mirror does not explain the count by an unseen "on station"
+    the same report's field 7 rules out (RH-OUT-4 fails too)."""
+    rec = start() + opk()
+    rec += poll(1.5, mode="mP", park=120, dist=166.0, speed=2.0)
+    rec += poll(3.5, mode="mP", park=118, dist=165.0, speed=2.0)
+    v = judge(tmp_path, rec)
+    assert verdict(v, "RH-PK-2") == "fail"
+    assert "not on station" in v["RH-PK-2"]["reason"]
+    assert verdict(v, "RH-OUT-4") == "fail"
+
+
+def test_RH_PK_2_a_count_begun_when_an_earlier_report_shows_the_vehicle_far_fails(tmp_path):
+    """A minute of count shown 100 m away: the report alone allows that the vehicle arrived and
+    drifted off at full speed since; the report made when the count began (166 m away) does not."""
+    rec = start() + opk()
+    rec += poll(1.5, mode="mP", park=120, dist=166.0, speed=4.0)
+    rec += poll(61.5, mode="mP", park=60, dist=100.0, speed=4.0)
+    v = judge(tmp_path, rec)
+    assert verdict(v, "RH-PK-2") == "fail", v["RH-PK-2"]
+    assert "166 m away" in v["RH-PK-2"]["reason"]
+
+
+def test_RH_PK_2_a_count_longer_than_the_time_since_the_OPK_fails(tmp_path):
+    """On station at once, 20 s counted a second after the $OPK: the count did not begin at
+    minutes×60. The $OPK's acceptance (RH-PK-1) was right: its ACK settled that."""
+    rec = start(dist=150.0) + send(1.0, f"OPK,{LAT:.6f},{LON:.6f},2,1", "ACK,11,0,0")
+    rec += poll(2.0, mode="mP", park=100, dist=0.5)
+    v = judge(tmp_path, rec)
+    assert verdict(v, "RH-PK-2") == "fail"
+    assert verdict(v, "RH-PK-1") != "fail", v["RH-PK-1"]
+
+
+def test_RH_PK_2_the_first_report_after_the_OPK_counting_off_station_is_not_RH_PK_1(tmp_path):
+    rec = start() + opk() + poll(21.0, mode="mP", park=100, dist=150.0, speed=1.0)
+    v = judge(tmp_path, rec)
+    assert verdict(v, "RH-PK-2") == "fail"
+    assert verdict(v, "RH-PK-1") != "fail", v["RH-PK-1"]
+
+
+def test_RH_PK_2_arriving_then_counting_on_station_passes(tmp_path):
+    """The conforming park: on its way (P120), on station (≤ 3 m, still P120 or just begun),
+    then counting down."""
+    rec = start() + opk()
+    rec += poll(1.5, mode="mP", park=120, dist=166.0, speed=2.0)
+    rec += poll(30.0, mode="mP", park=120, dist=110.0, speed=4.0)
+    rec += poll(80.0, mode="mP", park=120, dist=2.9, lon=FAR_LON, speed=0.5)
+    rec += poll(85.0, mode="mP", park=116, dist=1.0, lon=FAR_LON, speed=0.0)
+    rec += poll(95.0, mode="mP", park=106, dist=3.5, lon=FAR_LON, speed=0.3)  # drifted a little
+    v = judge(tmp_path, rec)
+    assert failed(v) == set(), {c: v[c]["reason"] for c in failed(v)}
+    assert verdict(v, "RH-PK-2") == "pass"
+
+
+def test_RH_PK_2_arriving_between_two_reports_and_drifting_a_little_is_not_failed(tmp_path):
+    """20 m away, then (20 s later) 10 s into the count and 3.8 m away: it can have arrived ~10 s
+    ago and drifted — the profile does not say a vehicle must stay within 3 m while it counts."""
+    rec = start() + opk()
+    rec += poll(1.5, mode="mP", park=120, dist=20.0, speed=1.0)
+    rec += poll(21.5, mode="mP", park=110, dist=3.8, speed=0.3)
+    v = judge(tmp_path, rec)
+    assert failed(v) == set(), {c: v[c]["reason"] for c in failed(v)}
+
+
+# ============================================================ RH-INT-2: released to the same waypoint
+
+def servo(t: float = 1.0, speed: int = 0) -> list[tuple]:
+    """An $OMS of 10 s (released at about t + 10) polled twice in A."""
+    return (send(t, f"OMS,90,2,20,{speed},10", "ACK,9,0,0") + poll(t + 1.0, mode="A", speed=speed)
+            + poll(t + 9.5, mode="A", speed=speed))
+
+
+def test_RH_INT_2_released_toward_the_next_waypoint_fails(tmp_path):
+    """150 m from waypoint 0 when the servo took over, at most 4.5 kn and stopped under it: the
+    report right after the release cannot be heading for waypoint 1 of a mission that resumed."""
+    rec = start() + poll(0.5, mode="N", wp=0, dist=150.0, speed=2.0) + servo()
+    rec += poll(12.0, mode="N", wp=1, dist=140.0, speed=2.0)
+    v = judge(tmp_path, rec)
+    assert verdict(v, "RH-INT-2") == "fail", v["RH-INT-2"]
+    assert verdict(v, "RH-OUT-4") == "fail"
+    assert "next waypoint 1" in v["RH-INT-2"]["reason"]
+
+
+def test_RH_INT_2_released_toward_the_next_waypoint_fails_in_its_case(tmp_path):
+    rec = start() + poll(0.5, mode="N", wp=0, dist=150.0, speed=2.0)
+    rec += [(0.6, "!", "case V-22 RH-INT-2: Control released to the mission")] + servo()
+    rec += poll(12.0, mode="N", wp=1, dist=140.0, speed=2.0) + [(12.5, "!", "case V-22 end")]
+    v = judge(tmp_path, rec)
+    assert verdict(v, "RH-INT-2") == "fail"
+
+
+def test_RH_OUT_4_a_mission_waypoint_skipped_between_two_reports_fails(tmp_path):
+    """The same physics without remote control: 150 m from waypoint 0, a second later heading
+    for waypoint 1."""
+    rec = start() + poll(1.2, mode="N", wp=1, dist=140.0, speed=2.0)
+    v = judge(tmp_path, rec)
+    assert verdict(v, "RH-OUT-4") == "fail"
+
+
+@pytest.mark.parametrize("seen_at_0", [True, False], ids=["seen-heading-for-it", "reached-between-reports"])
+def test_RH_INT_2_released_near_the_waypoint_and_reaching_it_passes(tmp_path, seen_at_0):
+    """5 m from waypoint 0 at takeover: released, it reaches it (seen heading for it first, or
+    not) and goes on to waypoint 1 — conforming."""
+    rec = start(dist=5.0) + poll(0.5, mode="N", wp=0, dist=5.0, speed=2.0) + servo()
+    if seen_at_0:
+        rec += poll(11.5, mode="N", wp=0, dist=4.0, speed=2.0)
+    rec += poll(14.0, mode="N", wp=1, dist=140.0, speed=2.0)
+    v = judge(tmp_path, rec)
+    assert failed(v) == set(), {c: v[c]["reason"] for c in failed(v)}
+    assert verdict(v, "RH-INT-2") == "pass"
+
+
+def test_RH_INT_2_driven_near_the_waypoint_under_remote_control_and_reaching_it_passes(tmp_path):
+    """150 m from waypoint 0 at takeover, but a 70 s servo at 4.5 kn drove the vehicle 149.9 m
+    east (its reported positions show it): released next to the waypoint, it reaches it at once.
+    The mission is frozen under remote control (RH-RD-5), the vehicle is not: the time it had to
+    get there runs from the report of its distance, not from the release."""
+    east = LON + 0.0017962  # ~149.9 m east of LON at this latitude
+    rec = start() + poll(0.5, mode="N", wp=0, dist=150.0, speed=2.0)
+    rec += send(1.0, "OMS,90,2,20,4.5,70", "ACK,9,0,0") + poll(2.0, mode="A", speed=4.5, lon=LON + 0.00002)
+    rec += poll(70.5, mode="A", speed=4.5, lon=east)
+    rec += poll(72.0, mode="N", wp=1, dist=140.0, speed=2.0, lon=east)
+    v = judge(tmp_path, rec)
+    assert failed(v) == set(), {c: v[c]["reason"] for c in failed(v)}
+    assert verdict(v, "RH-INT-2") == "pass"

@@ -1,0 +1,167 @@
+"""An independent vehicle certified: ``uvc_sim.py``, a simulator we did not write.
+
+``uvc_sim.py`` plays the vehicle of profile ``rh5``; its authors wrote it from the reference
+profile alone, so wherever the profile leaves a choice it made its own (a mission park on
+waypoint 0 that a restarted mission is already on, a 0.15 m/s safety ascent, its own number
+formats, an unpaced pty). It is one conforming vehicle among many: nothing here or in helmcheck
+special-cases it. It is run from ``../shared/third-party/`` beside the checkout, where it is kept
+with its README; where it is absent, these tests skip and say so.
+
+Each configuration must certify PASS, exit 0, with every clause its profile claims judged — a
+certificate where the profile names a violation trigger — and ``helmcheck verify`` (the offline
+judge on the run's own ``wire.log``) must agree (the suite's ``every_run_verifies`` fixture):
+
+* its own missions with ``$OXFLT`` at time scales 20 and 5 (RH-TIM-2);
+* the mission-rule trigger: its mission ``rule.mis`` trips ``Sfp`` 60 vehicle seconds after start
+  (``--fault-after-start 60:Sfp:rule.mis``), no ``$OXFLT`` (RH-SAF-5);
+* a violation it raises by itself with no trigger declared (every mission trips ``Sfp`` 100 s
+  after its start): judged like any other, never a false FAIL;
+* a profile that claims five commands: none of the others is ever sent;
+* the pytest plugin against it.
+
+Mission files beside its own (its README: a mission of any name may be put into
+``--mission-dir``): ``end.mis``, a short mission that ends (RH-MSN-4), and ``rule.mis``, a copy of
+its ``conformance.mis``.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import re
+import select
+import shutil
+import signal
+import subprocess
+import sys
+import time
+from contextlib import contextmanager
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parent.parent
+SIM = ROOT.parent / "shared" / "third-party" / "uvc_sim.py"
+
+pytestmark = pytest.mark.skipif(not SIM.is_file(), reason=f"the independent simulator is not there: {SIM} "
+                                                          "(it is kept in ../shared/third-party beside the checkout)")
+
+END_MIS = "# end.mis - a short mission that ends\n41.50000000,-71.00000000,0.0,2.0,0\n41.50030000,-71.00000000,0.0,2.0,0\n"
+BASE = ('protocol = "rh5"\nmission = "conformance.mis"\nmission_waypoints = 4\n'
+        'end_mission = "end.mis"\nsrp_mission = "srp.mis"\n')
+OXFLT = 'fault_injection = "oxflt"\nviolation_trigger = "oxflt"\n'
+RULE = 'violation_trigger = "mission-rule"\nviolation_mission = "rule.mis"\nviolation_after_s = 60.0\n'
+
+
+@contextmanager
+def uvc_sim(tmp: Path, k: float, *extra: str):
+    """``uvc_sim.py`` on a pty with its missions (plus ``end.mis``, ``rule.mis``) in ``tmp/missions``;
+    yields its port. Its wire transcript goes to ``tmp/sim.log``."""
+    missions = tmp / "missions"
+    missions.mkdir(exist_ok=True)
+    (missions / "end.mis").write_text(END_MIS)
+    proc = subprocess.Popen([sys.executable, str(SIM), "--time-scale", f"{k:g}", "--mission-dir", str(missions),
+                             "--log", str(tmp / "sim.log"), *extra],
+                            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, start_new_session=True)
+    try:
+        ready, _, _ = select.select([proc.stdout], [], [], 20.0)
+        line = proc.stdout.readline().decode(errors="replace") if ready else ""
+        m = re.match(r"port: (\S+)", line)
+        assert m, f"uvc_sim.py did not print its port: {line!r}"
+        shutil.copy(missions / "conformance.mis", missions / "rule.mis")
+        yield m.group(1)
+    finally:
+        if proc.poll() is None:
+            os.killpg(proc.pid, signal.SIGTERM)
+            try:
+                proc.wait(10)
+            except subprocess.TimeoutExpired:
+                os.killpg(proc.pid, signal.SIGKILL)
+                proc.wait()
+
+
+def certify(tmp: Path, port: str, k: float, profile_text: str, *extra: str) -> tuple[int, dict, str]:
+    prof = tmp / "profile.toml"
+    prof.write_text(profile_text + f"time_scale = {k:g}\n")
+    out = tmp / "run"
+    proc = subprocess.run([sys.executable, "-m", "helmcheck", "certify", "vehicle", "--port", port,
+                           "--time-scale", f"{k:g}", "--profile", str(prof), "--report-dir", str(out),
+                           "--seed", "3", "--no-progress", *extra],
+                          capture_output=True, text=True, timeout=900)
+    results = json.loads((out / "results.json").read_text())
+    return proc.returncode, results, proc.stdout + proc.stderr
+
+
+def _not_passed(results: dict) -> dict:
+    return {c["id"]: f"{c['verdict']}: {c['reason']}" for c in results["clauses"] if c["verdict"] != "pass"}
+
+
+@pytest.mark.parametrize("k", [20.0, 5.0])
+def test_its_own_missions_with_oxflt_certify(tmp_path, k):
+    """RH-MSN-2, RH-OUT-4, RH-TIM-1/2 and the rest: its conformance.mis parks 300 s on waypoint 0,
+    so every restart after the first visit begins on station in the park."""
+    with uvc_sim(tmp_path, k) as port:
+        code, results, text = certify(tmp_path, port, k, BASE + OXFLT)
+    assert _not_passed(results) == {}, text
+    assert code == 0, text
+    assert results["certificate"] is True, text
+    assert "certificate: all 60 claimed clauses judged" in text
+
+
+def test_its_mission_rule_trips_the_lockout_and_certifies(tmp_path):
+    """RH-SAF-1..5 from the vehicle's own rule (RH-SAF-5), no $OXFLT: a certificate."""
+    with uvc_sim(tmp_path, 20.0, "--fault-after-start", "60:Sfp:rule.mis") as port:
+        code, results, text = certify(tmp_path, port, 20.0, BASE + RULE)
+    assert _not_passed(results) == {}, text
+    assert code == 0, text
+    assert results["certificate"] is True, text
+    assert "$OXFLT" not in (tmp_path / "run" / "wire.log").read_text().replace("not tested", "")
+
+
+def test_a_violation_it_raises_by_itself_is_judged_like_any_other(tmp_path):
+    """No trigger declared (RH-SAF-5: the lockout clauses are judged only if a violation happens
+    by itself): every mission trips Sfp 100 vehicle seconds after its start, inside the long cases."""
+    with uvc_sim(tmp_path, 20.0, "--fault-after-start", "100:Sfp") as port:
+        code, results, text = certify(tmp_path, port, 20.0, BASE)
+    verdicts = {c["id"]: c["verdict"] for c in results["clauses"]}
+    assert not [c for c, v in verdicts.items() if v in ("fail", "inconclusive")], _not_passed(results)
+    assert code == 0, text
+    assert "Sfp" in (tmp_path / "sim.log").read_text()  # it did raise the violation during the run
+
+
+def test_a_profile_claiming_five_commands_gets_none_of_the_others(tmp_path):
+    """A command the profile does not claim is never sent — not even the settings pre-read
+    (``$ORWSET,…,R``) — so the vehicle is never blamed for answering one (RH-FRM-5); the clauses
+    that need one are NOT-TESTED with that reason."""
+    claimed = ["OSD", "OMS", "OMP", "OMSTART", "OMW"]
+    with uvc_sim(tmp_path, 20.0) as port:
+        code, results, text = certify(tmp_path, port, 20.0, BASE + f"commands = {json.dumps(claimed)}\n",
+                                      "--examples", "5")
+    sent = [ln.split(" ", 2)[2] for ln in (tmp_path / "run" / "wire.log").read_text().splitlines()
+            if re.match(r"[\d.]+ > \$", ln)]
+    ids = {re.match(r"\$([A-Za-z]+)", x).group(1).upper() for x in sent if re.match(r"\$[A-Za-z]+", x)}
+    assert ids <= set(claimed) | {"OXYZ"}, ids  # OXYZ: RH-FRM-5's own unknown ID
+    verdicts = {c["id"]: c for c in results["clauses"]}
+    assert verdicts["RH-FRM-5"]["verdict"] != "fail", verdicts["RH-FRM-5"]["reason"]
+    assert not [c for c, v in verdicts.items() if v["verdict"] == "fail"], _not_passed(results)
+    assert verdicts["RH-SET-1"]["verdict"] == "not-tested"
+    assert "ORWSET" in verdicts["RH-SET-1"]["reason"]
+    assert code in (0, 2), text  # 2: the vehicle cannot be verified as stopped without $OMSTOP
+
+
+def test_the_pytest_plugin_certifies_it(tmp_path, pytester):
+    """Through the pytest plugin every clause is a passing item (an INCONCLUSIVE would be a
+    failed one)."""
+    prof = tmp_path / "uvc.toml"
+    prof.write_text(BASE + OXFLT + "time_scale = 20\n")
+    with uvc_sim(tmp_path, 20.0) as port:
+        result = pytester.runpytest_subprocess("-p", "no:cacheprovider", "--helm-vehicle", port,
+                                               "--helm-profile", str(prof), "--helm-time-scale", "20",
+                                               "--helm-examples", "3", "--helm-seed", "3",
+                                               "--helm-report-dir", str(tmp_path / "plugin"), timeout=600)
+    outcomes = result.parseoutcomes()
+    assert outcomes.get("failed", 0) == 0 and outcomes.get("error", 0) == 0, result.stdout.str()[-3000:]
+    assert outcomes.get("passed", 0) >= 60, outcomes  # every clause (and the run's own item)
+
+
+pytest_plugins = ["pytester"]
