@@ -9,7 +9,7 @@ STAMP  := $(VENV)/.installed
 #: The property tests, for `make fuzz`.
 FUZZ_TESTS := tests/test_grammar_fastpath.py tests/test_grammar_framer.py tests/test_grammar_roundtrip.py \
               tests/test_model_observe.py tests/test_model_stateful.py tests/test_reports_results.py \
-              tests/test_certify_backseat_judge.py tests/test_cli_contracts.py
+              tests/test_certify_backseat_judge.py tests/test_cli_contracts.py tests/test_emulator_freedoms.py
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)

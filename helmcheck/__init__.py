@@ -1,7 +1,10 @@
 """helmcheck: the formal model and conformance suite for the Iver3 remote helm protocol.
 
 Subpackages: ``grammar`` (wire format), ``model`` (reference state machine, sans-IO),
-``conformance`` (emulator, certifiers, log checking), ``reports`` (compliance reports).
+``judge`` (the observers and the verdict ledger, sans-IO), ``reports`` (compliance reports),
+``conformance`` (emulator, certifiers, log checking), ``commands`` (one module per CLI
+subcommand, dispatched by ``cli``), ``spec`` (the reference profile). Imports run one way,
+grammar ← model ← judge ← reports ← conformance ← commands (``tests/test_layering.py``).
 """
 
 __version__ = "0.1.0"

@@ -28,7 +28,7 @@ from pathlib import Path
 from typing import Optional
 
 from . import __version__, exitcodes
-from .failures import Failure, UsageError, describe_interrupt
+from .failures import TRACEBACK_NAME, Failure, UsageError, describe_interrupt
 from .signals import ending_signals
 from .streams import GuardedStream
 
@@ -49,7 +49,6 @@ SUBCOMMANDS = {
 
 #: Exit code of a command stopped by a signal before it could end its run itself.
 INTERRUPT_CODE = {"emulate": exitcodes.OK}
-TRACEBACK_NAME = "tester-error.txt"
 
 DESCRIPTION = """\
 helmcheck — the formal model and conformance suite for the Iver3 remote helm protocol.

@@ -20,16 +20,19 @@ prints, and nothing here imports more than the standard library, so any layer ma
 - :class:`Interrupted`: SIGINT, SIGTERM or SIGHUP, a :class:`KeyboardInterrupt`, so code that
   already ends a run cleanly on Ctrl-C does the same.
 
-Any other exception is a tester error: exit 2, with the traceback saved to a file.
+Any other exception is a tester error: exit 2, with the traceback saved to a file
+(:data:`TRACEBACK_NAME` in the command's report directory).
 """
 
 from __future__ import annotations
 
 __all__ = ["Failure", "UsageError", "PathError", "LinkFault", "OutputLost",
-           "Interrupted", "USAGE", "TESTER", "describe_interrupt"]
+           "Interrupted", "USAGE", "TESTER", "TRACEBACK_NAME", "describe_interrupt"]
 
 USAGE = 64  #: EX_USAGE: the run did not start
 TESTER = 2  #: inconclusive: the tester or its surroundings failed
+#: A tester error's traceback, in the report directory (:mod:`helmcheck.cli`, the vehicle runner).
+TRACEBACK_NAME = "tester-error.txt"
 
 
 class Failure(Exception):

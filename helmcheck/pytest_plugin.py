@@ -10,9 +10,11 @@ protocol code, adds no item and changes no outcome. With one of
 it adds one item per clause of that role, named by clause ID (``helmcheck.vehicle::RH-SRV-4``,
 ``helmcheck.backseat::RH-BS-1``), then the item ``run-verdict``. The certification runs once per
 session, in the setup of the first helmcheck item that runs (its time is charged to that item),
-through the public runner APIs; the report directory (``--helm-report-dir``) gets
-``results.json``, the wire log and every report format, as the commands write them. The
-directory belongs to the plugin: each session replaces the previous session's run in it.
+through :func:`helmcheck.conformance.vehicle.runner.certify` for a vehicle and the ``certify
+backseat`` command (:mod:`helmcheck.commands.certify_backseat_cmd`) for a backseat; the report
+directory (``--helm-report-dir``) gets ``results.json``, the wire log and every report format,
+as the commands write them. The directory belongs to the plugin: each session replaces the
+previous session's run in it.
 
 Item outcomes (decisions where the issue left a choice):
 
@@ -151,7 +153,7 @@ class _Certification:
     def _backseat_argv(self) -> list[str]:
         import argparse
 
-        from .conformance.backseat import cli
+        from .commands import certify_backseat_cmd as cli
 
         opt = self.config.getoption
         argv = ["--port", opt("helm_exec_port"), "--duration", str(opt("helm_duration")),
@@ -205,7 +207,7 @@ class _Certification:
     def _run_backseat(self) -> None:
         import argparse
 
-        from .conformance.backseat import cli
+        from .commands import certify_backseat_cmd as cli
         from .reports.results import load_results
 
         p = argparse.ArgumentParser()

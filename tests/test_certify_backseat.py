@@ -1,6 +1,6 @@
 """``certify backseat`` end to end over real ptys: example backseats in ``tests/backseats/``.
 
-Every certification runs the real command (:func:`helmcheck.conformance.backseat.cli.run`, in
+Every certification runs the real command (:func:`helmcheck.commands.certify_backseat_cmd.run`, in
 a thread of this process so the grammar is built once) on its own pty, with the backseat a real
 subprocess (pyserial) that opens the printed port. The good backseat and every faulty one run
 at two time scales (5 and 10), each batch at once, for 18 s of judged run each (every scenario);
@@ -29,7 +29,7 @@ from pathlib import Path
 
 import pytest
 
-from helmcheck.conformance.backseat import cli
+from helmcheck.commands import certify_backseat_cmd as cli
 from helmcheck.conformance.checklog.checker import check_log
 from helmcheck.profile import DEFAULT
 from helmcheck.reports.results import load_results

@@ -21,7 +21,7 @@ from helmcheck.conformance.transport import PtyLink
 from helmcheck.conformance.vehicle import runner as runner_mod
 from helmcheck.conformance.vehicle.runner import Options, certify
 from helmcheck.conformance.vehicle.safety import BenchGuard
-from helmcheck.grammar.capture import read_records
+from helmcheck.grammar.wirelog import read_records
 from helmcheck.profile import DEFAULT
 from helmcheck.reports.results import load_results
 from tests.faulty_vehicles import EMU_PROFILE, MUTANTS, make_core, serve
@@ -37,8 +37,8 @@ def _opts(port, tmp_path, **kw):
 
 
 def _sent_lines(path: Path):
-    with open(path, encoding="utf-8") as f:
-        return [r.raw for r in read_records(f) if r.direction == ">"]
+    with open(path, "rb") as f:
+        return [r.data for r in read_records(f) if r.dir == ">"]
 
 
 def _assert_bench_safe(path: Path, max_motor=0x90, max_speed=Decimal("0.5")):
@@ -238,7 +238,7 @@ def test_exploration_counts_only_the_sequences_that_ran(tmp_path):
     ex = out.results["stats"]["explore"]
     assert ex["budget_spent"] is True, ex
     assert 0 < ex["ran"] < 500, ex
-    notes = [r.note for r in read_records(open(tmp_path / "r" / "wire.log", encoding="utf-8")) if r.is_note]
+    notes = [r.note for r in read_records(open(tmp_path / "r" / "wire.log", "rb")) if r.dir == "!"]
     assert any(f"exploration: {ex['ran']} sequence(s) ran; the 1 s budget was spent" in n for n in notes), notes
     stops = sum(1 for raw in _sent_lines(tmp_path / "r" / "wire.log") if raw.startswith(b"$OMSTOP,0*"))
     assert stops >= ex["ran"], (stops, ex)  # every counted sequence began with its reset

@@ -18,15 +18,15 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from helmcheck.cli import main as cli_main
+from helmcheck.commands.verify_cmd import verify_run
 from helmcheck.conformance.emulator.core import EmulatorCore
 from helmcheck.conformance.emulator.process import EmulatorProcess
 from helmcheck.conformance.vehicle.clockprobe import MAX_WALL_S
 from helmcheck.conformance.vehicle.clockrate import (CLEAR_FACTOR, Sample, gprmc_clock, judge_rate, measure,
                                                      rate_text)
 from helmcheck.conformance.vehicle.runner import Options, certify
-from helmcheck.grammar.capture import read_records
+from helmcheck.grammar.wirelog import read_records
 from helmcheck.reports.results import load_results
-from helmcheck.reports.verify import verify_run
 from tests.faulty_vehicles import EMU_PROFILE, make_core, serve
 
 
@@ -239,8 +239,8 @@ def test_a_vehicle_that_never_answers_g_costs_at_most_the_budget_and_is_not_meas
         out = _certify(port, tmp_path, EMU_PROFILE.replace(time_scale=20.0))
     cc = out.results["settings"]["clock_check"]
     assert cc["status"] == "not-measured" and cc["reason"] == "no answer to $OSD,G"
-    with open(tmp_path / "r" / "wire.log", encoding="utf-8") as f:
+    with open(tmp_path / "r" / "wire.log", "rb") as f:
         recs = list(read_records(f))
-    asked = [r.t for r in recs if r.direction == ">" and r.raw.startswith(b"$OSD,G*")]
+    asked = [r.t for r in recs if r.dir == ">" and r.data.startswith(b"$OSD,G*")]
     noted = next(r.t for r in recs if r.note.startswith("clock check: "))
     assert asked and noted - asked[0] <= MAX_WALL_S + 0.6, (asked, noted)

@@ -23,7 +23,7 @@ import pytest
 from helmcheck.conformance.emulator.core import EmulatorCore
 from helmcheck.conformance.emulator.missionfile import DirectoryCatalog, builtin_dir
 from helmcheck.conformance.vehicle.runner import Options, certify
-from helmcheck.grammar.capture import read_records
+from helmcheck.grammar.wirelog import read_records
 from tests.faulty_vehicles import EMU_PROFILE, serve
 from tests.judging import not_passed
 
@@ -65,8 +65,8 @@ def _mission_dir(tmp_path: Path, shape: str) -> Path:
 
 def _park_reports(log: Path) -> set[int]:
     """The waypoints (``$OSI`` field 3) at which the vehicle reported a mission park ``P``."""
-    with log.open(encoding="utf-8") as f:
-        sent = b"".join(r.raw for r in read_records(f) if r.direction == "<")
+    with log.open("rb") as f:
+        sent = b"".join(r.data for r in read_records(f) if r.dir == "<")
     out = set()
     for line in sent.split(b"\r\n"):
         f3 = line.split(b"*")[0].split(b",")

@@ -16,10 +16,10 @@ from pathlib import Path
 
 import pytest
 
+from helmcheck.commands import certify_backseat_cmd as backseat_cli
+from helmcheck.commands import certify_vehicle_cmd as vehicle_cli
 from helmcheck.commands import matrix_cmd
-from helmcheck.conformance.backseat import cli as backseat_cli
 from helmcheck.conformance.launcher import build_argv
-from helmcheck.conformance.vehicle import cli as vehicle_cli
 
 ROOT = Path(__file__).resolve().parent.parent
 WORKFLOW = ROOT / "docs" / "ci" / "backseat-conformance.yml"

@@ -15,7 +15,7 @@ from helmcheck.conformance.emulator.missionfile import (DirectoryCatalog, Missio
 from helmcheck.conformance.emulator.process import frame
 from helmcheck.grammar import Framer, Line, decode
 from helmcheck.grammar import sentences as s
-from helmcheck.grammar.capture import WireLogWriter, read_records
+from helmcheck.grammar.wirelog import WireLogWriter, read_records
 from helmcheck.model.missions import BadMission, MissingMission, Mission
 from helmcheck.profile import DEFAULT
 
@@ -301,12 +301,12 @@ def test_wire_log_records_both_directions_and_notes():
     core.feed(b"noise" + frame("OSD,S"), 0.25)
     core.feed(frame("OXFLT,Sop"), 0.5)
     core.disconnect(0.75, "test")
-    recs = list(read_records(buf.getvalue().splitlines()))
-    dirs = [r.direction for r in recs]
+    recs = list(read_records(buf.getvalue().encode().splitlines()))
+    dirs = [r.dir for r in recs]
     assert ">" in dirs and "<" in dirs and "!" in dirs
-    assert any(r.raw == b"noise" for r in recs if r.direction == ">")
-    assert any("fault injected" in r.note for r in recs if r.is_note)
-    assert any("SafetyRaised" in r.note for r in recs if r.is_note)
+    assert any(r.data == b"noise" for r in recs if r.dir == ">")
+    assert any("fault injected" in r.note for r in recs if r.dir == "!")
+    assert any("SafetyRaised" in r.note for r in recs if r.dir == "!")
 
 
 def test_RH_LOG_2_ologd_rows_go_to_the_main_log():

@@ -8,10 +8,10 @@ served behind real ptys:
   ``FlakyFailure`` — is a finding; anything else (a bug in helmcheck) is a tester error, which
   ends the run with exit 2 and its traceback in ``tester-error.txt`` beside ``results.json``.
 
-The INCONCLUSIVE half of the first rule is marked ``xfail``: the exploration's violations are on
-the wire, and the offline judge (``helmcheck verify``, the agreement check of ``conftest.py``)
-books them as FAIL, so they can become INCONCLUSIVE only when the record itself says they were
-not confirmed — a wire-log note the vehicle judge acts on, which it does not have yet.
+The exploration's violations are on the wire, so the record itself says whether they were
+confirmed: a ``held:`` note before the exploration, then ``confirmed:`` or ``unconfirmed:`` after
+the re-runs (``helmcheck/judge/wire.py``); the vehicle judge books the held violations at that
+note, live and offline alike (``helmcheck verify`` agrees).
 
 The fault is one only the exploration meets: an ``$OMS`` refused in ``S`` gets err 21 instead of
 20 when its timeout is not the 10 s that RH-ACK-4's own case (V-13) sends, so the case passes and
@@ -115,9 +115,6 @@ def test_a_fault_only_exploration_finds_fails_when_both_reruns_reproduce_it(tmp_
 
 # ---------------------------------------------------------------------------- else INCONCLUSIVE
 
-@pytest.mark.xfail(strict=True, raises=AssertionError,
-                   reason="2 of 2 = FAIL, else INCONCLUSIVE needs the vehicle judge to hold the exploration's "
-                          "violations until a confirmation note in the wire log (module docstring)")
 @pytest.mark.parametrize("reproduced", [0, 1])
 def test_a_failure_the_reruns_do_not_both_reproduce_is_inconclusive(reproduced, tmp_path, monkeypatch):
     """0 of 2: the vehicle misbehaves once only. 1 of 2: it misbehaves until the second re-run

@@ -15,7 +15,7 @@ import pytest
 
 from helmcheck.conformance.checklog.checker import check_log
 from helmcheck.grammar import checksum_hex
-from helmcheck.grammar.capture import escape
+from helmcheck.grammar.wirelog import escape
 from helmcheck.profile import DEFAULT
 
 PROFILE = DEFAULT  # no $OXFLT: a violation can only come from the vehicle itself
@@ -152,11 +152,22 @@ def test_RH_OUT_4_a_waypoint_then_a_mission_park_between_two_polls_is_adopted(tm
 
 
 def test_RH_INT_1_a_waypoint_reached_just_before_a_takeover_is_accepted(tmp_path):
-    """The vehicle reached waypoint 0 unseen just before the $OMS: A with the frozen waypoint 1."""
-    rec = start() + [(1.0, ">", "OMS,90,2,20,0.5,10"), (1.01, "<", "ACK,9,0,0")]
+    """The vehicle reached waypoint 0 unseen just before the $OMS: A with the frozen waypoint 1
+    (it was 4 m from it half a second before: it can have got there)."""
+    rec = start() + poll(0.5, mode="N", dist=4.0, speed=2.0) + [(1.0, ">", "OMS,90,2,20,0.5,10"),
+                                                                (1.01, "<", "ACK,9,0,0")]
     rec += poll(1.5, mode="A", wp=1)
     v = judge(tmp_path, rec)
     assert no_fail(v) == []
+
+
+def test_RH_INT_1_a_waypoint_it_cannot_have_reached_before_a_takeover_is_not_assumed(tmp_path):
+    """150 m from waypoint 0 0.8 s before the $OMS: it cannot have reached it (RH-RD-5: the
+    mission is frozen under remote control), so A with waypoint 1 is a finding."""
+    rec = start() + [(1.0, ">", "OMS,90,2,20,0.5,10"), (1.01, "<", "ACK,9,0,0")]
+    rec += poll(1.5, mode="A", wp=1)
+    v = judge(tmp_path, rec)
+    assert verdict(v, "RH-OUT-4") == "fail"
 
 
 # ------------------------------------------------------------------------- blame

@@ -17,7 +17,9 @@ judge on the run's own ``wire.log``) must agree (the suite's ``every_run_verifie
 * a violation it raises by itself with no trigger declared (every mission trips ``Sfp`` 100 s
   after its start): judged like any other, never a false FAIL;
 * a profile that claims five commands: none of the others is ever sent;
-* the pytest plugin against it.
+* the pytest plugin against it;
+* faulty variants of it, one defect each (``tests/third_party_faults.py``), each caught on the
+  clause it breaks, and the variants just inside a bound passing it.
 
 Mission files beside its own (its README: a mission of any name may be put into
 ``--mission-dir``): ``end.mis``, a short mission that ends (RH-MSN-4), and ``rule.mis``, a copy of
@@ -53,14 +55,18 @@ OXFLT = 'fault_injection = "oxflt"\nviolation_trigger = "oxflt"\n'
 RULE = 'violation_trigger = "mission-rule"\nviolation_mission = "rule.mis"\nviolation_after_s = 60.0\n'
 
 
+FAULTY = Path(__file__).resolve().parent / "third_party_faults.py"
+
+
 @contextmanager
-def uvc_sim(tmp: Path, k: float, *extra: str):
+def uvc_sim(tmp: Path, k: float, *extra: str, fault: str = ""):
     """``uvc_sim.py`` on a pty with its missions (plus ``end.mis``, ``rule.mis``) in ``tmp/missions``;
     yields its port. Its wire transcript goes to ``tmp/sim.log``."""
     missions = tmp / "missions"
     missions.mkdir(exist_ok=True)
     (missions / "end.mis").write_text(END_MIS)
-    proc = subprocess.Popen([sys.executable, str(SIM), "--time-scale", f"{k:g}", "--mission-dir", str(missions),
+    program = [str(FAULTY), fault] if fault else [str(SIM)]
+    proc = subprocess.Popen([sys.executable, *program, "--time-scale", f"{k:g}", "--mission-dir", str(missions),
                              "--log", str(tmp / "sim.log"), *extra],
                             stdout=subprocess.PIPE, stderr=subprocess.STDOUT, start_new_session=True)
     try:
@@ -86,7 +92,7 @@ def certify(tmp: Path, port: str, k: float, profile_text: str, *extra: str) -> t
     out = tmp / "run"
     proc = subprocess.run([sys.executable, "-m", "helmcheck", "certify", "vehicle", "--port", port,
                            "--time-scale", f"{k:g}", "--profile", str(prof), "--report-dir", str(out),
-                           "--seed", "3", "--no-progress", *extra],
+                           "--seed", "3", "--no-progress", *(extra or ("--examples", "5"))],
                           capture_output=True, text=True, timeout=900)
     results = json.loads((out / "results.json").read_text())
     return proc.returncode, results, proc.stdout + proc.stderr
@@ -161,6 +167,34 @@ def test_the_pytest_plugin_certifies_it(tmp_path, pytester):
     outcomes = result.parseoutcomes()
     assert outcomes.get("failed", 0) == 0 and outcomes.get("error", 0) == 0, result.stdout.str()[-3000:]
     assert outcomes.get("passed", 0) >= 60, outcomes  # every clause (and the run's own item)
+
+
+# ------------------------------------------------------------------ faulty variants of it
+
+@pytest.mark.parametrize("fault,k,select,clause,verdict", [
+    # RH-TIM-1: a servo timeout 0.7 s late (tolerance max(0.5 s, 5 %) of 10 s) fails; 0.3 s passes
+    ("timeout-late-0.7", 1.0, "RH-SRV-4", "RH-SRV-4", "fail"),
+    ("ok-timeout-late-0.3", 1.0, "RH-SRV-4", "RH-SRV-4", "pass"),
+    # RH-ACK-2: answers 0.3 s after the 1 s window fail; at 0.6 s they pass
+    ("ack-late-1.3", 20.0, "RH-ACK-2", "RH-ACK-2", "fail"),
+    ("ok-ack-at-0.6", 20.0, "RH-ACK-2", "RH-ACK-2", "pass"),
+    # RH-PK-2: an $OPK park counted from 7 m off station fails; from 2.5 m it passes
+    ("park-counts-7m-off", 20.0, "RH-PK-2", "RH-PK-2", "fail"),
+    ("ok-park-counts-2.5m-off", 20.0, "RH-PK-2", "RH-PK-2", "pass"),
+    ("release-to-next-waypoint", 20.0, "RH-INT-2", "RH-INT-2", "fail"),
+    ("omp-nine-hex", 20.0, "RH-PRM-2", "RH-PRM-2", "fail"),
+    ("omp-refused-after-lockout", 20.0, "RH-SAF-3", "RH-SAF-3", "fail"),
+    ("unknown-id-answered", 20.0, "RH-FRM-5", "RH-FRM-5", "fail"),
+])
+def test_a_faulty_variant_is_told_apart_on_its_clause(tmp_path, fault, k, select, clause, verdict):
+    """One defect of a vehicle we did not write, judged on the clause it breaks (and the variant
+    just inside the bound passing it)."""
+    with uvc_sim(tmp_path, k, fault=fault) as port:  # 115200 baud: a report every few ms if need be
+        code, results, text = certify(tmp_path, port, k, BASE + OXFLT + "baud = 115200\n", "--select", select,
+                                      "--examples", "0")
+    got = {c["id"]: c for c in results["clauses"]}
+    assert got[clause]["verdict"] == verdict, (got[clause]["reason"], text)
+    assert code == (1 if verdict == "fail" else 0), text
 
 
 pytest_plugins = ["pytester"]

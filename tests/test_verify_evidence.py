@@ -302,7 +302,7 @@ def test_junit_of_a_failed_run_has_a_failing_run_verdict_and_a_partial_run_says_
 def test_every_results_directory_of_the_session_is_listed_and_verifies(runs, session_results_directories):
     """The runs above live under tmp_path_factory, not a test's tmp_path: the session's check
     (tests/conftest.py) lists them with every other run this worker wrote, and each verifies."""
-    from helmcheck.reports.verify import verify_run
+    from helmcheck.commands.verify_cmd import verify_run
 
     root, _ = runs
     listed = session_results_directories()

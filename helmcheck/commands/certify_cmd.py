@@ -1,7 +1,9 @@
 """``helmcheck certify vehicle|backseat``: dispatches to the two certifiers.
 
-Each role lives in its own subpackage (``helmcheck.conformance.vehicle`` and
-``helmcheck.conformance.backseat``) exposing ``add_arguments(parser)`` and ``run(args) -> int``.
+Each role's command line is its own module (:mod:`.certify_vehicle_cmd`,
+:mod:`.certify_backseat_cmd`) exposing ``add_arguments(parser)``, ``run(args) -> int`` and
+``EPILOG``; the certifiers they drive are ``helmcheck.conformance.vehicle`` and
+``helmcheck.conformance.backseat``.
 """
 
 from __future__ import annotations
@@ -12,9 +14,9 @@ import importlib
 from . import certificate_opts
 
 ROLES = {
-    "vehicle": ("helmcheck.conformance.vehicle.cli",
+    "vehicle": ("helmcheck.commands.certify_vehicle_cmd",
                 "certify a vehicle: helmcheck plays the backseat and judges every reply"),
-    "backseat": ("helmcheck.conformance.backseat.cli",
+    "backseat": ("helmcheck.commands.certify_backseat_cmd",
                  "certify a backseat: helmcheck plays the vehicle and judges every command"),
 }
 

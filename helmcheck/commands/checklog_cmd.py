@@ -19,6 +19,7 @@ import sys
 from pathlib import Path
 
 from .. import exitcodes
+from ..failures import UsageError
 
 EPILOG = """\
 formats (detected): helmcheck wire-log 1 (helmcheck emulate --log), socat -v, socat -x, socat -v -x.
@@ -65,10 +66,6 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     return p
 
 
-def _usage(msg: str) -> int:
-    return exitcodes.usage_error("helmcheck check-log", msg)
-
-
 def _report_dir(f: Path, args: argparse.Namespace, several: bool) -> Path:
     if args.report_dir is None:
         return Path("reports") / f"check-log-{f.stem}"
@@ -89,7 +86,7 @@ def run(args: argparse.Namespace) -> int:  # noqa: C901 - argument checks, then 
         # Without a declared profile, $OXFLT is taken as honoured, as helmcheck emulate does.
         profile = profile.replace(fault_injection="oxflt")
     if args.time_scale is not None and not (math.isfinite(args.time_scale) and args.time_scale > 0):
-        return _usage(f"--time-scale must be positive (got {args.time_scale})")
+        raise UsageError(f"--time-scale must be positive (got {args.time_scale})")
     catalog = None
     if args.missions is not None:
         from ..conformance.emulator.missionfile import DirectoryCatalog
@@ -104,8 +101,8 @@ def run(args: argparse.Namespace) -> int:  # noqa: C901 - argument checks, then 
     several = len(files) > 1
     rdirs = [_report_dir(f, args, several) for f in files]
     if len(set(map(str, rdirs))) < len(rdirs):
-        return _usage("two FILEs have the same name: their reports would share a directory; "
-                      "check them one at a time with --report-dir")
+        raise UsageError("two FILEs have the same name: their reports would share a directory; "
+                         "check them one at a time with --report-dir")
     for rdir in rdirs:  # every directory usable before any is cleared or written
         prepare_report_dir(rdir, args.overwrite, clear=False)
     worst = exitcodes.OK

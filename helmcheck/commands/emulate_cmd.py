@@ -20,6 +20,7 @@ from datetime import datetime, timezone
 from pathlib import Path
 
 from .. import exitcodes
+from ..failures import UsageError
 
 EPILOG = """\
 examples:
@@ -75,10 +76,6 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     return p
 
 
-def _usage(msg: str) -> int:
-    return exitcodes.usage_error("helmcheck emulate", msg)
-
-
 def _check_settings_file(path: str) -> None:
     """``--settings``: an existing file must be a settings file this emulator wrote (a JSON
     object); anything else is refused at start rather than silently replaced."""
@@ -112,16 +109,16 @@ def run(args: argparse.Namespace) -> int:  # noqa: C901 - argument checks, then 
     try:
         choices = _emulator_settings(args)
     except ValueError as e:
-        return _usage(str(e))
+        raise UsageError(str(e)) from None
     scale = args.time_scale if args.time_scale is not None else profile.time_scale
     if not (isinstance(scale, float) or isinstance(scale, int)) or not math.isfinite(scale) or scale <= 0:
-        return _usage(f"--time-scale must be a positive number (got {args.time_scale})")
+        raise UsageError(f"--time-scale must be a positive number (got {args.time_scale})")
     baud = args.baud if args.baud is not None else profile.baud
     if baud != 0 and baud not in BAUD_RATES:
-        return _usage(f"--baud must be 0 or one of {', '.join(map(str, BAUD_RATES))} (got {baud})")
+        raise UsageError(f"--baud must be 0 or one of {', '.join(map(str, BAUD_RATES))} (got {baud})")
     spec = port_spec(args.port)
     if spec.kind in ("device", "url") and baud == 0:
-        return _usage("--baud 0 (unpaced) needs --port pty or socket://")
+        raise UsageError("--baud 0 (unpaced) needs --port pty or socket://")
     missions_dir = None
     if args.missions is not None:
         missions_dir = Path(args.missions)
@@ -191,13 +188,16 @@ def _serve(args, profile, link, baud, missions_dir, log_file, main_log_file, cho
         from ..conformance.emulator.core import EmulatorCore, MainLog
         from ..conformance.emulator.missionfile import DirectoryCatalog, builtin_dir
         from ..conformance.emulator.server import Server
-        from ..grammar.capture import WireLogWriter
+        from ..grammar.wirelog import WireLogWriter
         dirs = ([missions_dir] if missions_dir is not None else []) + [builtin_dir()]
         catalog = DirectoryCatalog(dirs)
         started = datetime.now(timezone.utc)
         if log_file is not None:
+            # monotonic=False: a plant or model event is logged at the wall time it happened,
+            # which may come before bytes already logged (the core catches up in vehicle time)
             log = WireLogWriter(log_file, meta=(f"started {started.strftime('%Y-%m-%dT%H:%M:%S.%fZ')}  "
-                                                f"port {link.name}  baud {baud}  time_scale {profile.time_scale:g}"))
+                                                f"port {link.name}  baud {baud}  time_scale {profile.time_scale:g}",),
+                                monotonic=False)
         core = EmulatorCore(profile, catalog, start=time.monotonic(), baud=baud, log=log, settings=choices,
                             main_log=MainLog(main_log_file) if main_log_file is not None else None,
                             settings_path=Path(args.settings) if args.settings else None,

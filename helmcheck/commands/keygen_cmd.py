@@ -11,6 +11,7 @@ from __future__ import annotations
 import argparse
 
 from .. import exitcodes
+from ..failures import UsageError
 
 EPILOG = """\
 examples:
@@ -37,9 +38,9 @@ def run(args: argparse.Namespace) -> int:
     try:
         key, pub, kid = generate_keypair(args.out, overwrite=args.force)
     except FileExistsError as e:
-        return exitcodes.usage_error("helmcheck keygen", f"{e}; use --force to replace it")
+        raise UsageError(f"{e}; use --force to replace it") from None
     except OSError as e:
-        return exitcodes.usage_error("helmcheck keygen", f"cannot write {e.filename or args.out}: {e.strerror or e}")
+        raise UsageError(f"cannot write {e.filename or args.out}: {e.strerror or e}") from None
     print(f"private key: {key} (keep it secret)")
     print(f"public key:  {pub}")
     print(f"key id:      {kid}")

@@ -16,6 +16,7 @@ import sys
 from pathlib import Path
 
 from .. import exitcodes
+from ..failures import UsageError
 
 EPILOG = """\
 examples:
@@ -50,7 +51,7 @@ def run(args: argparse.Namespace) -> int:
 
     out_dir: Path = args.out
     if out_dir.exists() and not out_dir.is_dir():
-        return exitcodes.usage_error("helmcheck matrix", f"--out {out_dir}: not a directory")
+        raise UsageError(f"--out {out_dir}: not a directory")
     runs = []
     for d in args.directories:
         try:

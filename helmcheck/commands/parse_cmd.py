@@ -1,9 +1,10 @@
 """``helmcheck parse``: validate sentences line by line, from files, stdin or wire logs.
 
 Each input line is either a bare sentence (``$OMS,…*hh``) or a wire-log record
-(``12.345678 > $OMS,…*hh``, see :mod:`helmcheck.grammar.capture`); the format is detected per
-line, so a wire log can be validated as it is. Invalid lines print as
-``FILE:LINE: CLAUSE: message``; ``--json`` prints one JSON object per line instead.
+(``12.345678 > $OMS,…*hh``, read by :func:`helmcheck.grammar.wirelog.parse_record`, the one
+wire-log reader); the format is detected per line, so a wire log can be validated as it is.
+Invalid lines print as ``FILE:LINE: CLAUSE: message``; ``--json`` prints one JSON object per
+line instead.
 Exit 0 when every line is valid, 1 when any is not, 64 on usage errors or an unreadable file.
 
 Speed (the whole process is measured against a plain pynmea2 loop, ``benchmarks/parse_bench.py``):
@@ -106,7 +107,7 @@ def _check_lines(name: str, lines: Iterable[bytes], profile, as_json: bool, out:
 def _other_line(name: str, lineno: int, raw: bytes, profile, as_json: bool, emit) -> tuple[int, int]:
     """A line not starting with ``$``: blank, comment, wire-log record or junk; (checked, bad)."""
     from ..grammar import decode
-    from ..grammar.capture import WireLogError, parse_record
+    from ..grammar.wirelog import NOTE, WireLogError, parse_record
 
     stripped = raw.rstrip(b"\r\n")
     if not stripped.strip() or stripped.startswith(b"#"):
@@ -114,13 +115,13 @@ def _other_line(name: str, lineno: int, raw: bytes, profile, as_json: bool, emit
     direction = None
     if stripped[:1].isdigit():
         try:
-            rec = parse_record(raw.decode("latin-1"), lineno)
+            rec = parse_record(raw, lineno)
         except WireLogError as e:
             _emit(emit, as_json, name, lineno, None, None, f"WIRELOG: {e}")
             return 1, 1
-        if rec is None or rec.is_note:
+        if rec is None or rec.dir == NOTE:
             return 0, 0
-        raw, direction = rec.raw, rec.direction
+        raw, direction = rec.data, rec.dir
     d = decode(raw, profile)
     _emit(emit, as_json, name, lineno, d, direction, None)
     return 1, 0 if d.valid else 1

@@ -1,9 +1,11 @@
 """``helmcheck verify DIR [--public-key PUB]``: does a results directory follow from its evidence?
 
-The command owns the command line; the checks are :mod:`helmcheck.reports.verify`. It re-judges
-the wire log under the recorded profile and compares every clause verdict, the run verdict and
-the certificate flag with ``results.json``, checks the recorded digests, and checks the
-signature when the run is signed (against ``--public-key`` when given).
+:func:`verify_run` is the verification: it runs the checks of :mod:`helmcheck.reports.verify` in
+their order and re-judges the wire log under the recorded profile with the offline checker
+(:func:`helmcheck.conformance.checklog.check_log`, a driver, which is why this runs here and not
+in the reports package), then compares every clause verdict, the run verdict and the certificate
+flag with ``results.json``, checks the recorded digests, and checks the signature when the run
+is signed (against ``--public-key`` when given).
 
 Exit status: 0 verified; 1 something differs (one line per difference on standard output, each
 naming the clause or file); 64 usage (no such results directory, unreadable public key).
@@ -13,8 +15,10 @@ from __future__ import annotations
 
 import argparse
 import sys
+from pathlib import Path
 
 from .. import exitcodes
+from ..failures import UsageError
 
 EPILOG = """\
 what is checked:
@@ -46,21 +50,47 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     return p
 
 
+def verify_run(directory: Path | str, public_key=None, *, public_key_name: str = "the given public key"):
+    """Check the results directory *directory* against its evidence and, if signed, its signature
+    (the steps of :mod:`helmcheck.reports.verify`); a
+    :class:`~helmcheck.reports.verify.Verification` listing every difference.
+
+    *public_key*: a trusted Ed25519 public key, or ``None``. A directory that is not a results
+    directory raises :class:`~helmcheck.reports.verify.VerifyUsageError`."""
+    from ..conformance.checklog.checker import LogFormatError, check_log
+    from ..reports.verify import check_digests, check_profile, check_signature, compare_rejudged, open_run, rejudging
+
+    directory = Path(directory)
+    out, results = open_run(directory)
+    if results is not None:
+        check_digests(out, directory, results)
+        profile = check_profile(out, directory, results)
+        job = rejudging(out, directory, results, profile) if profile is not None else None
+        if job is not None:
+            try:
+                outcome = check_log(job.wire_path, profile=profile, role=job.role, time_scale=job.time_scale)
+            except (LogFormatError, OSError, ValueError) as e:
+                out.add(job.wire_name, f"cannot be re-judged: {e}")
+            else:
+                compare_rejudged(out, results, outcome.clauses, outcome.facts, job.role)
+    check_signature(out, directory, results, public_key, public_key_name)
+    return out
+
+
 def run(args: argparse.Namespace) -> int:
     from ..reports.signing import KeyFileError, load_public_key
-    from ..reports.verify import VerifyUsageError, verify_run
+    from ..reports.verify import VerifyUsageError
 
-    prog = "helmcheck verify"
     public = None
     if args.public_key is not None:
         try:
             public = load_public_key(args.public_key)
         except KeyFileError as e:
-            return exitcodes.usage_error(prog, str(e))
+            raise UsageError(str(e)) from None
     try:
         result = verify_run(args.directory, public, public_key_name=str(args.public_key))
     except VerifyUsageError as e:
-        return exitcodes.usage_error(prog, str(e))
+        raise UsageError(str(e)) from None
     for note in result.notes:
         print(f"note: {note}")
     if not result.ok:

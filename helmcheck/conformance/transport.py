@@ -22,10 +22,10 @@ every :meth:`Link.poll`). :meth:`Link.poll` reads what is there and returns
 without blocking. For simple synchronous use (a certifier's client side) there are blocking
 helpers :meth:`Link.read` and :meth:`Link.write_all`.
 
-:class:`LinePacer` is the sans-IO model of the line's capacity: 10 bits per byte (8N1) at the
-baud rate, so a sender can pace its output as a real UART would (RH-ACK-2's "serial transmit
-time", RH-BS-4's line budget). Pacing is wall time; it never scales with a time scale
-(RH-TIM-2).
+:class:`LinePacer` is the sans-IO model of the line's capacity: 10 bits per byte (8N1,
+:func:`helmcheck.grammar.wirelog.transmit_time`) at the baud rate, so a sender can pace its output
+as a real UART would (RH-ACK-2's "serial transmit time", RH-BS-4's line budget). Pacing is wall
+time; it never scales with a time scale (RH-TIM-2).
 
 Decisions: a pty link keeps its own slave descriptor open, so the master never sees a hang-up
 when a client closes the port (no busy loop on EIO, raw settings kept); bytes written while no
@@ -46,9 +46,10 @@ import tty
 from dataclasses import dataclass
 from typing import Optional
 
-__all__ = ["PortSpec", "parse_port_spec", "LinkEvent", "LinkClosed", "Link", "PtyLink",
-           "SerialLink", "TcpClientLink", "TcpServerLink", "open_link", "LinePacer",
-           "BAUD_RATES"]
+from ..grammar.wirelog import transmit_time
+
+__all__ = ["PortSpec", "parse_port_spec", "LinkEvent", "LinkClosed", "Link", "PtyLink", "SerialLink",
+           "TcpClientLink", "TcpServerLink", "open_link", "LinePacer", "BAUD_RATES"]
 
 #: Baud rates a serial device may be opened at (RH-FRM-9 plus 38400).
 BAUD_RATES = (9600, 19200, 38400, 57600, 115200)
@@ -479,18 +480,17 @@ def open_link(spec: str | PortSpec, role: str = "client", baud: int = 19200) -> 
 
 
 class LinePacer:
-    """Sans-IO model of a UART's capacity: ``baud`` / 10 bytes per second (8N1).
+    """Sans-IO model of a UART's capacity: a byte takes the 8N1 :func:`transmit_time` at ``baud``.
 
     ``reserve(n, now)`` books ``n`` bytes onto the line and returns when they may start; the
-    line is then busy until :attr:`free_at`. ``baud = 0`` means unpaced (everything at once).
-    """
+    line is then busy until :attr:`free_at`. ``baud = 0`` means unpaced (everything at once)."""
 
     __slots__ = ("baud", "free_at", "_per_byte")
 
     def __init__(self, baud: int):
         self.baud = baud
         self.free_at = 0.0
-        self._per_byte = 10.0 / baud if baud else 0.0
+        self._per_byte = transmit_time(1, baud)
 
     def transmit_time(self, n: int) -> float:
         return n * self._per_byte

@@ -11,18 +11,22 @@ Public API::
     checksum(body) -> int;  checksum_hex(body) -> str
     Framer(max_line=256).feed(bytes) -> [Line | Discard]
     prepare()                                          # build lazily-built parsers now (live use)
+    read_records(lines) -> [WireEvent];  WireLogWriter(stream)   # the wire log (wirelog.py)
+
+:mod:`.wirelog` is the wire-log (capture) format: its directions, records, one reader and one
+writer, and the line's 8N1 transmit time.
 """
 
-from .capture import WireLogError, WireLogWriter, WireRecord, read_records
 from .checksum import checksum, checksum_hex
 from .codec import KNOWN_IDS, Decoded, decode, format, format_body, parse, prepare
 from .errors import Finding, SentenceError
 from .framer import Discard, Framer, Line
 from .sentences import *  # noqa: F401,F403
 from .sentences import __all__ as _sentence_names
+from .wirelog import WireEvent, WireLogError, WireLogWriter, read_records
 
 __all__ = [
     "parse", "decode", "format", "format_body", "prepare", "Decoded", "KNOWN_IDS", "checksum",
-    "checksum_hex", "Framer", "Line", "Discard", "SentenceError", "Finding", "WireRecord",
+    "checksum_hex", "Framer", "Line", "Discard", "SentenceError", "Finding", "WireEvent",
     "WireLogError", "WireLogWriter", "read_records", *_sentence_names,
 ]

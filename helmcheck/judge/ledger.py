@@ -102,6 +102,8 @@ class Ledger:
         #: every failure in order: (serial, clause, reason) — drivers read :meth:`failures_since`
         self._fail_log: list[tuple[int, str, str]] = []
         self._serial = 0
+        #: violations waiting for their confirmation (:meth:`hold`), or None when none is awaited
+        self._held: Optional[list[tuple[str, str, list, str]]] = None
 
     def __contains__(self, cid: str) -> bool:
         return cid in self._e
@@ -166,7 +168,10 @@ class Ledger:
         """The clause was violated: ``fail`` for a MUST, ``non-strict`` for a SHOULD."""
         if cid not in self._e:
             return
-        self._add(cid, "fail", reason, evidence, case)
+        if self._held is not None:
+            self._held.append((cid, reason, list(evidence)[:MAX_EVIDENCE], case))
+        else:
+            self._add(cid, "fail", reason, evidence, case)
         self._serial += 1
         self._fail_log.append((self._serial, cid, reason))
 
@@ -185,6 +190,27 @@ class Ledger:
         e = self._e.get(cid)
         if e is not None and e.withdrawn is None:
             e.withdrawn = (reason, observed)
+
+    def hold(self) -> None:
+        """From now on a violation is held: it is in the failure log (a driver stops on it, see
+        :meth:`failures_since`) but booked only by :meth:`release` (an exploration's violations
+        wait for their re-runs after shrinking)."""
+        if self._held is None:
+            self._held = []
+
+    @property
+    def holding(self) -> bool:
+        return self._held is not None
+
+    def release(self, confirmed: bool, why: str) -> None:
+        """Book the held violations: as violations when *confirmed*, else INCONCLUSIVE with *why*
+        before their reason. Holding ends."""
+        held, self._held = self._held or [], None
+        for cid, reason, evidence, case in held:
+            if confirmed:
+                self._add(cid, "fail", reason, evidence, case)
+            else:
+                self._add(cid, "inconclusive", f"{why}: {reason}", evidence, case)
 
     def remark(self, cid: str, text: str) -> None:
         """A remark appended to the clause's reason (an inference its verdict rests on)."""

@@ -43,7 +43,7 @@ from fnmatch import fnmatchcase
 from pathlib import Path
 from typing import Any, Iterable, Mapping, Optional
 
-from .wire import NOTE
+from ..grammar.wirelog import NOTE, read_wire_log
 
 __all__ = ["RunFacts", "selection_note", "not_judged_note", "process_note", "partial_note",
            "NOT_SELECTED", "NOT_SELECTED_OBSERVED"]
@@ -121,14 +121,13 @@ class RunFacts:
 
     @classmethod
     def from_wire_log(cls, path: Path | str) -> "RunFacts":
-        """The facts of a wire log (format 1); ``OSError`` if it cannot be read. Only note lines
-        are looked at; any other line is skipped."""
+        """The facts of a wire log (format 1, read by :func:`helmcheck.grammar.wirelog.read_wire_log`);
+        ``OSError`` if it cannot be read. Only notes are looked at; any other line is skipped."""
         facts = cls()
         with open(path, "rb") as f:
-            for raw in f:
-                parts = raw.split(b" ", 2)
-                if len(parts) == 3 and parts[1] == b"!" and not raw.startswith(b"#"):
-                    facts.note(parts[2].rstrip(b"\r\n").decode("utf-8", "replace"))
+            for rec in read_wire_log(f):
+                if rec.dir == NOTE:
+                    facts.note(rec.note)
         return facts
 
     # ------------------------------------------------------------------ using

@@ -13,9 +13,11 @@ Every judge takes its timing from here, so a duration is judged the same way liv
 * :func:`judgeable` — an observation whose slack exceeds half the duration cannot say whether
   the duration held: INCONCLUSIVE, never PASS or FAIL (RH-TIM-1's last sentence).
 * :func:`ack_allowance` — RH-ACK-2: the ACK window plus serial transmit time of the command and
-  of the replies up to its ACK at the line's baud (10 bits per byte, 8N1), plus what the observer
-  cannot see (:func:`ack_uncertainty`): two timestamp steps of the record (the command's stamp
-  and the ACK's, each up to a step off whichever way the recorder rounds) and :data:`JITTER_S`.
+  of the replies up to its ACK at the line's baud (:func:`transmit_time`, 10 bits per byte,
+  8N1: defined with the wire log in :mod:`helmcheck.grammar.wirelog`, re-exported here), plus
+  what the observer cannot see (:func:`ack_uncertainty`): two timestamp steps of the record (the
+  command's stamp and the ACK's, each up to a step off whichever way the recorder rounds) and
+  :data:`JITTER_S`.
   Wall time; never scaled (RH-TIM-2). No fixed grace: an ACK measured later than the allowance
   is late by more than the observer's own uncertainty, so it is a FAIL. Only when the
   timestamps are too coarse to bound the window (a step over a tenth of it) is an ACK within
@@ -37,6 +39,7 @@ window is still seen, and failed as late).
 
 from __future__ import annotations
 
+from ..grammar.wirelog import BITS_PER_BYTE, transmit_time
 from ..model.timers import tolerance
 
 __all__ = ["tolerance", "slack", "judgeable", "ack_allowance", "ack_uncertainty", "ack_verdict",
@@ -49,13 +52,6 @@ REACTION_S = 0.25
 #: Vehicle seconds a vehicle may take to act on being on station or at the surface (decision:
 #: the spec gives no figure; a UVC's control loop runs several times a second).
 PLANT_REACT_S = 2.0
-#: 8N1: one start bit, eight data bits, one stop bit (RH-FRM-9).
-BITS_PER_BYTE = 10
-
-
-def transmit_time(nbytes: int, baud: int) -> float:
-    """Wall seconds the line needs for ``nbytes`` at ``baud`` (0 for an unpaced link)."""
-    return nbytes * BITS_PER_BYTE / baud if baud else 0.0
 
 
 def slack(k: float, t_sent: float, t_recv: float, resolution: float = 0.0, extra_v: float = 0.0) -> float:

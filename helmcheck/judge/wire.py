@@ -7,9 +7,11 @@ offline log check — hands it the same :class:`WireEvent` s, in order:
   (``"<"``), split anywhere, with the time they were seen (wall seconds since the record began);
 * notes (``"!"``): what the recorder knew besides the bytes.
 
-A live run writes every event to its wire log *and* feeds it to the judge with the time and
-line number it was written with (:class:`helmcheck.conformance.recorder.Recorder`); an offline
-check reads the same records back. So one log gives one verdict, whoever reads it.
+A :class:`WireEvent` is a wire-log record: it and the directions are defined with the format
+in :mod:`helmcheck.grammar.wirelog`, and re-exported here for the judges. A live run writes every
+event to its wire log *and* feeds it to the judge with the time and line number it was written
+with (:class:`helmcheck.conformance.recorder.Recorder`); an offline check reads the same records
+back with the same module's reader. So one log gives one verdict, whoever reads it.
 
 Notes a judge acts on (anything else is kept as evidence only); the words are part of the
 wire-log format (``docs/contracts.md``):
@@ -30,6 +32,11 @@ wire-log format (``docs/contracts.md``):
 ``operator: <instruction>``                 an operator was asked to act (RH-SAF-5)
 ``run aborted: <reason>``                   the run ended early: what was not judged is
                                             INCONCLUSIVE with this reason
+``held: <why>``                             from here on a violation is held: booked only at
+                                            the next ``confirmed``/``unconfirmed`` note
+``confirmed: <how>``                        the held violations are booked as violations
+``unconfirmed: <how>``                      the held violations are INCONCLUSIVE with ``<how>``
+                                            (also when the record ends, or resumes, first)
 ``run resumed: <what>``                     an interrupted run goes on (``--resume``): the
                                             vehicle's state is unknown again; commands left
                                             unanswered at the interruption are not judged
@@ -41,27 +48,13 @@ from __future__ import annotations
 import ast
 import re
 from dataclasses import dataclass
-from typing import Any, NamedTuple, Optional
+from typing import Any, Optional
 
+from ..grammar.wirelog import FROM_VEHICLE, NOTE, TO_VEHICLE, WireEvent
 from ..profile import SAFETY_CODES
 
 __all__ = ["WireEvent", "TO_VEHICLE", "FROM_VEHICLE", "NOTE", "Note", "parse_note", "case_note",
            "case_end_note", "tester_note", "parse_plant"]
-
-TO_VEHICLE = ">"
-FROM_VEHICLE = "<"
-NOTE = "!"
-
-
-class WireEvent(NamedTuple):
-    """One record: bytes one way, or a note, at ``t`` wall seconds since the record began.
-    (A named tuple: immutable, and cheap to make once per line of a long log.)"""
-
-    t: float
-    dir: str  #: ">", "<" or "!"
-    data: bytes = b""
-    note: str = ""
-    lineno: int = 0  #: the record's line in the wire log (0 when not known)
 
 
 @dataclass(frozen=True, slots=True)
@@ -145,6 +138,12 @@ def parse_note(text: str) -> Optional[Note]:
         return Note("operator", text=text[10:])
     if text.startswith("run aborted: "):
         return Note("aborted", text=text[13:])
+    if text.startswith("held: "):
+        return Note("held", text=text[6:])
+    if text.startswith("confirmed: "):
+        return Note("confirmed", text=text[11:])
+    if text.startswith("unconfirmed: "):
+        return Note("unconfirmed", text=text[13:])
     if text.startswith("run resumed: "):
         return Note("resumed", text=text[13:])
     return None

@@ -26,8 +26,9 @@ Certificates (issue: certificates anyone can verify):
 * :mod:`~helmcheck.reports.manifest` — file digests and the signed manifest;
 * :mod:`~helmcheck.reports.signing` — Ed25519 keys and signatures;
 * :mod:`~helmcheck.reports.certificate` — :func:`finish_run`, the end of every certification;
-* :mod:`~helmcheck.reports.verify` — re-judging a results directory (``helmcheck verify``): the
-  assembly again, on the evidence, compared.
+* :mod:`~helmcheck.reports.verify` — the checks of ``helmcheck verify``: digests, profile,
+  signature, and the assembly again, on the re-judged evidence, compared (the wire log is
+  re-judged by :func:`helmcheck.commands.verify_cmd.verify_run`, which runs these checks).
 """
 
 from .digest import Digest, digest_bytes, digest_dir

@@ -1,10 +1,11 @@
 """The ``results.json`` schema 1 validator: every departure, each named by its JSON path.
 
 :func:`validate` checks types, the closed vocabularies (roles, verdict words, levels, wire-log
-directions, event kinds), that clause IDs are clauses of the reference profile with the level
-the profile gives them, that replays referenced by clauses exist, that the timeline runs forward,
-that the wire log path stays inside the results directory, and that the run verdict follows from
-the clause verdicts (:func:`helmcheck.reports.verdicts.run_verdict`). Unknown keys are allowed.
+directions as :mod:`helmcheck.grammar.wirelog` defines them, event kinds), that clause IDs are
+clauses of the reference profile with the level the profile gives them, that replays referenced
+by clauses exist, that the timeline runs forward, that the wire log path stays inside the
+results directory, and that the run verdict follows from the clause verdicts
+(:func:`helmcheck.reports.verdicts.run_verdict`). Unknown keys are allowed.
 
 The optional ``process`` object describes an implementation under test that helmcheck started
 (``certify … --exec``): ``command``, ``pid``, ``exit_code`` (integer or null), ``signal`` (a
@@ -27,6 +28,7 @@ from pathlib import PurePosixPath
 from typing import Any
 
 from helmcheck.clauses import SPEC_NAME, catalogue
+from helmcheck.grammar.wirelog import DIRECTIONS
 
 from .scope import scope_of
 from .verdicts import CLAUSE_VERDICTS, VERDICTS, ended_early, run_verdict
@@ -36,7 +38,6 @@ __all__ = ["SCHEMA", "ROLES", "LEVELS", "DIRECTIONS", "EVENT_KINDS", "validate"]
 SCHEMA = 1
 ROLES = ("vehicle", "backseat", "log")
 LEVELS = ("MUST", "SHOULD")
-DIRECTIONS = (">", "<", ">~", "<~", "!")  # docs/contracts.md, wire-log format 1
 EVENT_KINDS = ("command", "ack-error", "lockout", "note")
 
 _CLAUSE_ID = re.compile(r"^RH-[A-Z]+-\d+$")

@@ -1,31 +1,37 @@
-"""Checking a results directory against its evidence (``helmcheck verify DIR``).
+"""The checks of ``helmcheck verify DIR``: does a results directory follow from its evidence?
 
-:func:`verify_run` trusts nothing in ``results.json`` that the evidence can decide. In order:
+:func:`helmcheck.commands.verify_cmd.verify_run` runs them in this order and trusts nothing in
+``results.json`` that the evidence can decide:
 
-1. ``results.json`` must parse and be a valid schema-1 document (:func:`~.schema.validate`);
+1. ``results.json`` must parse and be a valid schema-1 document (:func:`open_run`,
+   :func:`~.schema.validate`);
 2. the wire log and ``profile.toml`` must have the SHA-256 that ``results.json`` records
-   (``digests``), so one changed byte shows even in an unsigned run;
+   (``digests``), so one changed byte shows even in an unsigned run (:func:`check_digests`);
 3. ``profile.toml`` must load (:func:`helmcheck.profile.load_profile`) and be the profile
-   ``results.json`` records (``profile``, key by key);
-4. ``settings.time_scale`` must be the ``time_scale`` of ``profile.toml``;
-5. the wire log is **re-judged** under that profile by the offline observer
-   (:func:`helmcheck.conformance.checklog.check_log`, role ``vehicle`` or ``backseat`` as
-   recorded, the profile's time scale), which also reads the run facts of its notes
-   (:mod:`helmcheck.judge.runfacts`: the selection, the clauses not judged, the ``process``
-   note of an implementation helmcheck started, ``run partial``); then the one function that
-   assembled ``results.json`` (:func:`.assemble.assemble`) runs again on that evidence and
-   everything it decides is compared: ``settings.select`` with the wire log's selection note,
-   every clause verdict (inside and outside the selection), ``partial``, the ``process``
-   object key by key, the run verdict and the ``certificate`` flag. Only verdict words are
-   compared for the clauses, not reasons or evidence. A document saved while the run was still
-   going (``finished`` null, the run never closed it) is assembled as partial, as it was saved;
+   ``results.json`` records (``profile``, key by key) (:func:`check_profile`);
+4. ``settings.time_scale`` must be the ``time_scale`` of ``profile.toml``; :func:`rejudging`
+   says which wire log to re-judge, as which role (``vehicle`` or ``backseat`` as recorded) and
+   at which time scale (the profile's);
+5. the wire log is **re-judged** under that profile by the offline observer (the command calls
+   :func:`helmcheck.conformance.checklog.check_log`: a driver, which this package does not
+   import), which also reads the run facts of its notes (:mod:`helmcheck.judge.runfacts`: the
+   selection, the clauses not judged, the ``process`` note of an implementation helmcheck
+   started, ``run partial``); then :func:`compare_rejudged` runs the one function that
+   assembled ``results.json`` (:func:`.assemble.assemble`) again on that evidence and compares
+   everything it decides: ``settings.select`` with the wire log's selection note, every clause
+   verdict (inside and outside the selection), ``partial``, the ``process`` object key by key,
+   the run verdict and the ``certificate`` flag. Only verdict words are compared for the
+   clauses, not reasons or evidence. A document saved while the run was still going
+   (``finished`` null, the run never closed it) is assembled as partial, as it was saved;
 6. if the run is signed (``signature.json``, :mod:`.certificate`), the signature and manifest
    formats must be the ones this helmcheck writes, the Ed25519 signature must hold over the
    manifest and the manifest must name the files as they are now; with a trusted public key
-   (``--public-key``) the signature must be that key's, and an unsigned run fails.
+   (``--public-key``) the signature must be that key's, and an unsigned run fails
+   (:func:`check_signature`).
 
-Every difference is a :class:`Finding` naming the file or clause. A directory that is not a
-results directory at all raises :class:`VerifyUsageError` (exit 64).
+Every difference is a :class:`Finding` naming the file or clause, added to one
+:class:`Verification`. A directory that is not a results directory at all raises
+:class:`VerifyUsageError` (exit 64).
 """
 
 from __future__ import annotations
@@ -43,7 +49,8 @@ from .schema import validate
 from .signing import ALGORITHM, key_id, public_key_from_b64
 from .view import VERDICT_LABEL
 
-__all__ = ["Finding", "Verification", "VerifyUsageError", "verify_run"]
+__all__ = ["Finding", "Verification", "VerifyUsageError", "Rejudging", "open_run", "check_digests",
+           "check_profile", "rejudging", "compare_rejudged", "check_signature"]
 
 _SIGNATURE_NAME = "signature.json"
 _SIGNATURE_FORMAT = "helmcheck-signature-1"  #: :data:`helmcheck.reports.certificate.SIGNATURE_FORMAT`
@@ -67,7 +74,7 @@ class Finding:
 
 @dataclass
 class Verification:
-    """The outcome of :func:`verify_run`."""
+    """The outcome of :func:`helmcheck.commands.verify_cmd.verify_run`: every finding, in the order found."""
 
     directory: Path
     findings: list[Finding] = field(default_factory=list)
@@ -89,9 +96,10 @@ def _word(verdict: Any) -> str:
     return VERDICT_LABEL.get(verdict, str(verdict)) if verdict is not None else "absent"
 
 
-def verify_run(directory: Path | str, public_key=None, *, public_key_name: str = "the given public key") -> Verification:
-    """Check *directory* (module docstring). *public_key*: a trusted Ed25519 public key or ``None``."""
-    directory = Path(directory)
+def open_run(directory: Path) -> tuple[Verification, Optional[dict[str, Any]]]:
+    """Step 1: the :class:`Verification` of *directory*, and its ``results.json`` if that is a
+    valid results document (``None``: the findings say why). :class:`VerifyUsageError` if
+    *directory* is not a results directory at all."""
     if not directory.is_dir():
         raise VerifyUsageError(f"{directory}: no such results directory")
     res_path = directory / RESULTS_NAME
@@ -118,18 +126,13 @@ def verify_run(directory: Path | str, public_key=None, *, public_key_name: str =
             results = doc
     elif doc is not None:
         out.add(RESULTS_NAME, "not a results document (not a JSON object)")
-    if results is not None:
-        _check_digests(out, directory, results)
-        profile = _check_profile(out, directory, results)
-        if profile is not None:
-            _rejudge(out, directory, results, profile)
-    _check_signature(out, directory, results, public_key, public_key_name)
-    return out
+    return out, results
 
 
 # --------------------------------------------------------------------------- digests, profile
 
-def _check_digests(out: Verification, directory: Path, results: Mapping[str, Any]) -> None:
+def check_digests(out: Verification, directory: Path, results: Mapping[str, Any]) -> None:
+    """Step 2: the wire log and ``profile.toml`` have the digests ``results.json`` records."""
     recorded = results.get("digests")
     wire_name, _ = evidence_files(results)
     if not isinstance(recorded, Mapping):
@@ -152,7 +155,9 @@ def _normal(value: Any) -> Any:
     return json.loads(json.dumps(value))
 
 
-def _check_profile(out: Verification, directory: Path, results: Mapping[str, Any]):
+def check_profile(out: Verification, directory: Path, results: Mapping[str, Any]):
+    """Step 3: ``profile.toml`` loads and is the profile ``results.json`` records; the loaded
+    profile, or ``None`` (nothing can be re-judged)."""
     from ..profile import ProfileError, load_profile
 
     path = directory / PROFILE_NAME
@@ -181,13 +186,22 @@ def _check_profile(out: Verification, directory: Path, results: Mapping[str, Any
 
 # --------------------------------------------------------------------------- re-judging
 
-def _rejudge(out: Verification, directory: Path, results: Mapping[str, Any], profile) -> None:
-    from ..conformance.checklog.checker import LogFormatError, check_log
+@dataclass(frozen=True)
+class Rejudging:
+    """What step 5 re-judges: the wire log, the role to judge it as, the time scale."""
 
+    wire_name: str  #: the evidence file's name in the directory (a finding's subject)
+    wire_path: Path
+    role: str  #: ``vehicle``, ``backseat`` or ``both`` (a log check of both roles)
+    time_scale: float
+
+
+def rejudging(out: Verification, directory: Path, results: Mapping[str, Any], profile) -> Optional[Rejudging]:
+    """Step 4: ``settings.time_scale`` is the profile's, and what to re-judge (``None``: there is
+    no wire log to re-judge; the finding says so)."""
     role = results["role"]
     judge_role = role if role != "log" else ((results.get("log") or {}).get("role") or "both")
-    settings = results["settings"]
-    recorded_k = settings.get("time_scale")
+    recorded_k = results["settings"].get("time_scale")
     time_scale = float(profile.time_scale or 1.0)
     if role in ("vehicle", "backseat") and not _same_number(recorded_k, time_scale):
         out.add("settings.time_scale", f"results.json says {recorded_k}, but profile.toml (the profile the run "
@@ -198,21 +212,23 @@ def _rejudge(out: Verification, directory: Path, results: Mapping[str, Any], pro
     wire_path = directory / wire_name
     if not wire_path.is_file():
         out.add(wire_name, "missing: there is no evidence to re-judge")
-        return
-    try:
-        outcome = check_log(wire_path, profile=profile, role=judge_role, time_scale=time_scale)
-    except (LogFormatError, OSError, ValueError) as e:
-        out.add(wire_name, f"cannot be re-judged: {e}")
-        return
-    facts = outcome.facts
+        return None
+    return Rejudging(wire_name, wire_path, judge_role, time_scale)
+
+
+def compare_rejudged(out: Verification, results: Mapping[str, Any], clauses: list, facts: RunFacts,
+                     role: str) -> None:
+    """Step 5, after the wire log was re-judged as *role* (its clause verdicts *clauses* and run
+    *facts*, as :func:`helmcheck.conformance.checklog.check_log` returns them): the assembly
+    again, on that evidence, compared with *results*."""
     for text in facts.unreadable:
-        out.add(wire_name, f"a run-fact note cannot be read: {text}")
+        out.add(evidence_files(results)[0], f"a run-fact note cannot be read: {text}")
     # the one function, again, on the evidence (:mod:`.assemble`); a document saved while the run
     # was still going (``finished`` null: the run never closed it) is partial, as it was saved
     in_progress = results.get("finished") is None
-    got = assemble(role, outcome.clauses, facts, strict=bool(settings.get("strict", False)),
+    got = assemble(results["role"], clauses, facts, strict=bool(results["settings"].get("strict", False)),
                    partial=True if in_progress else None)
-    _compare(out, results, got, facts, judge_role)
+    _compare(out, results, got, facts, role)
     tool = results.get("tool") or {}
     from helmcheck import __version__
     if tool.get("version") != __version__:
@@ -289,8 +305,10 @@ def _ending(process: Mapping[str, Any]) -> str:
 
 # --------------------------------------------------------------------------- signature
 
-def _check_signature(out: Verification, directory: Path, results: Optional[Mapping[str, Any]], public_key,
-                     public_key_name: str) -> None:
+def check_signature(out: Verification, directory: Path, results: Optional[Mapping[str, Any]], public_key,
+                    public_key_name: str) -> None:
+    """Step 6: the signature, if the run is signed; with *public_key* (a trusted Ed25519 public
+    key, named *public_key_name* in findings) the run must be signed by it."""
     path = directory / _SIGNATURE_NAME
     declared = results.get("signature") if results is not None else None
     if not path.exists():

@@ -8,7 +8,11 @@ observer ``check-log`` feeds from a wire log. Modules, one concern each:
 * :mod:`.runner` — the I/O loop: one link, one reference vehicle
   (:class:`~helmcheck.conformance.emulator.core.EmulatorCore`), the recorder (wire log and
   observer) and the scenario plan; it owns the clock and the descriptors.
+* :mod:`.link` — the certifier's pty, which notices the backseat going away.
+* :mod:`.process` — the backseat under test when helmcheck starts it (``--exec CMD``).
 * :mod:`.report` — turns the verdict ledger into a ``results.json`` (schema 1,
   ``"role": "backseat"``) and renders every report format.
-* :mod:`.cli` — the command line (``add_arguments``, ``run``, ``EPILOG``).
+
+The command line (``add_arguments``, ``run``, ``EPILOG``) is
+:mod:`helmcheck.commands.certify_backseat_cmd`.
 """

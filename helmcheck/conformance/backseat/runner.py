@@ -46,7 +46,7 @@ from typing import IO, Any, Callable, Iterable, Optional
 
 from ...grammar import Discard, Framer, decode
 from ...grammar import sentences as s
-from ...grammar.capture import FROM_VEHICLE, TO_VEHICLE
+from ...grammar.wirelog import FROM_VEHICLE, TO_VEHICLE
 from ...judge.backseat import BS_CLAUSES, BackseatObserver
 from ...judge.ledger import Ledger
 from ...judge.runfacts import RunFacts, not_judged_note, partial_note

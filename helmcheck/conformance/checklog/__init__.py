@@ -8,7 +8,8 @@ certifiers' verdicts, in a results directory of role ``log``.
 
 Modules, one concern each:
 
-* :mod:`.readers` — format detection, timestamp resolution, and the helmcheck wire-log 1 reader;
+* :mod:`.readers` — format detection, timestamp resolution, and one reader per format (a wire
+  log by the one wire-log reader, :func:`helmcheck.grammar.wirelog.read_wire_log`);
 * :mod:`.socat` — the ``socat -v`` / ``-x`` / ``-v -x`` reader and its timestamp unit;
 * :mod:`.records` — what the readers yield (:data:`~.records.Chunk`) and learn (:class:`~.records.LogMeta`);
 * :mod:`.checker` — :func:`~.checker.check_log`: one pass over the records, each fed to the role's

@@ -4,7 +4,8 @@ This module owns :func:`check_log` — Jepsen's ``analyze`` / TLA+ trace validat
 helm line: the whole log is consumed, in order, and every byte is attributed. Its steps:
 
 1. detect the format and the timestamp resolution from the first 64 KiB (:mod:`.readers`);
-2. stream the records (:class:`~helmcheck.judge.wire.WireEvent` s, with their time and log line)
+2. stream the records (:class:`~helmcheck.grammar.wirelog.WireEvent` s, with their time and log
+   line; a wire log through the one wire-log reader, :mod:`helmcheck.grammar.wirelog`)
    and feed each to the role's observer: the vehicle observer
    (:class:`~helmcheck.judge.vehicle.VehicleObserver`, the judge ``certify vehicle`` uses) for
    §1–8 and the backseat observer (:class:`~helmcheck.judge.backseat.BackseatObserver`, the judge
@@ -35,6 +36,7 @@ from pathlib import Path
 from typing import BinaryIO, Callable, Optional
 
 from ...clauses import vehicle_clauses
+from ...grammar.wirelog import FROM_VEHICLE, HEADER_LINES, TO_VEHICLE
 from ...judge.backseat import BS_CLAUSES, BackseatObserver
 from ...judge.ledger import Evidence as LedgerEvidence, Ledger
 from ...judge.runfacts import RunFacts
@@ -143,7 +145,7 @@ def _head(f: BinaryIO, path: Path, size: int) -> tuple[str, LogMeta]:
     f.seek(0)
     meta = LogMeta(format=fmt, resolution=timestamp_resolution(head, fmt))
     if fmt == "wirelog":
-        for ln in head.split(b"\n")[:16]:
+        for ln in head.split(b"\n")[:HEADER_LINES]:
             if ln.startswith(b"#"):
                 header_comment(ln.decode("utf-8", "replace"), meta)
     meta.header = meta.header[:8]
@@ -287,8 +289,8 @@ class _Checker:
         self.mission_known = catalog is not None
         self.findings: list = []
         self.finding_count = 0
-        self._records = {">": 0, "<": 0, NOTE: 0, UNREADABLE: 0}  #: per direction
-        self._bytes = {">": 0, "<": 0}
+        self._records = {TO_VEHICLE: 0, FROM_VEHICLE: 0, NOTE: 0, UNREADABLE: 0}  #: per direction
+        self._bytes = {TO_VEHICLE: 0, FROM_VEHICLE: 0}
         self.last_t = 0.0
 
     @property
@@ -296,15 +298,15 @@ class _Checker:
         """Counts for the report (a new dict each time)."""
         n, b = self._records, self._bytes
         return {"records": sum(n.values()), "notes": n[NOTE], "unreadable": n[UNREADABLE],
-                "records_to_vehicle": n[">"], "records_from_vehicle": n["<"], "bytes_to_vehicle": b[">"],
-                "bytes_from_vehicle": b["<"]}
+                "records_to_vehicle": n[TO_VEHICLE], "records_from_vehicle": n[FROM_VEHICLE],
+                "bytes_to_vehicle": b[TO_VEHICLE], "bytes_from_vehicle": b[FROM_VEHICLE]}
 
     def chunk(self, c: Chunk) -> None:
         d = c.dir
         self._records[d] += 1
         if c.t > self.last_t:
             self.last_t = c.t
-        if d == ">" or d == "<":
+        if d == TO_VEHICLE or d == FROM_VEHICLE:
             self._bytes[d] += len(c.data)
         elif d != NOTE:
             self.finding_count += 1

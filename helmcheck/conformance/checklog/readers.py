@@ -1,8 +1,8 @@
-"""Log readers: one streaming reader per capture format, and the format detector.
+"""Log readers: the format detector, and one streaming reader per capture format.
 
 This module owns turning a capture file into a stream of records (:data:`Chunk`): timed runs of
-wire bytes with the log line they came from, as the :class:`~helmcheck.judge.wire.WireEvent` s the
-observers are fed, without keeping the file in memory. It judges nothing; the checker
+wire bytes with the log line they came from, as the :class:`~helmcheck.grammar.wirelog.WireEvent` s
+the observers are fed, without keeping the file in memory. It judges nothing; the checker
 (:mod:`.checker`) hands the records to the observers, which re-frame the bytes (RH-FRM-6/7) and
 judge them.
 
@@ -10,7 +10,8 @@ Formats (detected from the first non-blank lines, :func:`detect_format`):
 
 ``wirelog``
     helmcheck wire-log 1 (``docs/contracts.md``): ``<seconds> <dir> <payload>`` per line,
-    ``#`` comments (the header may carry ``time_scale K`` and ``baud N``), ``!`` notes.
+    ``#`` comments (the header may carry ``time_scale K`` and ``baud N``), ``!`` notes. Read by
+    the one wire-log reader, :func:`helmcheck.grammar.wirelog.read_wire_log`.
 
 ``socat-v`` and ``socat-x``
     ``socat -v`` text dumps and ``socat -x`` hex dumps (also ``socat -v -x``), read by
@@ -22,11 +23,9 @@ record (direction ``?``) with a reason (the checker reports it as a finding with
 
 from __future__ import annotations
 
-import re
 from typing import BinaryIO, Iterator, Optional
 
-from ...grammar.capture import unescape
-from ...judge.wire import WireEvent
+from ...grammar.wirelog import RECORD_HEAD, TAG, read_wire_log
 from .records import (HEAD_BYTES, NOTE, UNREADABLE, Chunk, LogMeta, Progress, Unreadable, decimals_resolution,
                       header_comment)
 from .socat import HEX_LINE, SOCAT_HEADER, TimeUnit, read_socat, socat_resolution, socat_time_unit
@@ -36,9 +35,8 @@ __all__ = ["Chunk", "Unreadable", "LogMeta", "TimeUnit", "detect_format", "socat
 
 FORMATS = ("wirelog", "socat-v", "socat-x")
 
-#: A record's head: seconds, direction, one optional space; the payload is the rest of the line
-#: less its line end (a "\n", then a "\r").
-_WIRE_HEAD = re.compile(rb"(\d+(?:\.(\d+))?) (>~|<~|>|<|!) ?")
+_TAG = TAG.encode()
+_NOTE = NOTE.encode()
 
 
 def detect_format(head: bytes) -> Optional[str]:
@@ -46,7 +44,7 @@ def detect_format(head: bytes) -> Optional[str]:
     lines = [ln for ln in head.split(b"\n")[:50] if ln.strip()]
     if not lines:
         return None
-    if lines[0].startswith(b"# helmcheck wire-log"):
+    if lines[0].startswith(_TAG):
         return "wirelog"
     for i, ln in enumerate(lines):
         if ln.startswith(b"#"):
@@ -56,7 +54,7 @@ def detect_format(head: bytes) -> Optional[str]:
             if HEX_LINE.match(nxt) or (len(nxt) > 50 and nxt[:1] == b" " and b"  " in nxt[48:]):
                 return "socat-x"
             return "socat-v"
-        if _WIRE_HEAD.match(ln):
+        if RECORD_HEAD.match(ln):
             return "wirelog"
         return None
     return None
@@ -70,8 +68,8 @@ def timestamp_resolution(head: bytes, fmt: str) -> float:
     best = 1.0
     if fmt == "wirelog":
         for ln in head.split(b"\n")[:2000]:
-            m = _WIRE_HEAD.match(ln)
-            if m and m.group(3) != b"!":
+            m = RECORD_HEAD.match(ln)
+            if m and m.group(3) != _NOTE:
                 best = min(best, decimals_resolution(m.group(2)))
         return best
     return socat_resolution(head)
@@ -90,48 +88,7 @@ def read_chunks(f: BinaryIO, fmt: str, meta: LogMeta, *, swap: bool = False,
 
 
 def _read_wirelog(f: BinaryIO, meta: LogMeta, swap: bool, progress: Progress) -> Iterator[Chunk]:
-    """helmcheck wire-log 1 records (docs/contracts.md)."""
+    """helmcheck wire-log 1 records (docs/contracts.md), by the one wire-log reader."""
     meta.time_unit = "decimal"
     meta.time_unit_basis = "wire-log 1 times are decimal seconds since the log began"
-    n = 0
-    match = _WIRE_HEAD.match
-    dirs = _SWAPPED_DIRS if swap else _DIRS
-    for raw in f:
-        n += 1
-        if progress is not None:
-            progress(len(raw))
-        m = match(raw)
-        if m is None:
-            if raw[:1] == b"#":
-                if n <= 16:
-                    header_comment(raw.decode("utf-8", "replace").rstrip("\r\n"), meta)
-                continue
-            if not raw.strip():
-                continue
-            yield Unreadable(0.0, UNREADABLE, b"", "not a wire-log record (want '<seconds> <dir> <payload>')",
-                             n, raw.decode("utf-8", "replace").rstrip("\r\n")[:200])
-            continue
-        stamp, _, d = m.groups()
-        t = float(stamp)
-        payload = raw[m.end():-1] if raw[-1:] == b"\n" else raw[m.end():]
-        if payload[-1:] == b"\r":
-            payload = payload[:-1]
-        if d == b"!":
-            yield WireEvent(t, NOTE, b"", payload.decode("utf-8", "replace"), n)
-            continue
-        if not payload.isascii():
-            yield Unreadable(t, UNREADABLE, b"", "payload is not ASCII (bytes must be escaped as \\xNN)", n,
-                             payload.decode("utf-8", "replace")[:200])
-            continue
-        if b"\\" in payload:
-            payload = unescape(payload.decode("ascii"))
-        direction, whole = dirs[d]
-        if whole:
-            yield WireEvent(t, direction, payload + b"\r\n", "", n)
-        else:
-            yield WireEvent(t, direction, payload, "", n)
-
-
-#: wire-log direction → (the chunk's direction, a whole CR LF line); as written, and swapped
-_DIRS = {b">": (">", True), b"<": ("<", True), b">~": (">", False), b"<~": ("<", False)}
-_SWAPPED_DIRS = {b">": ("<", True), b"<": (">", True), b">~": ("<", False), b"<~": (">", False)}
+    return read_wire_log(f, swap=swap, progress=progress, comment=lambda text: header_comment(text, meta))

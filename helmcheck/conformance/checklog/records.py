@@ -1,48 +1,34 @@
 """What a log reader yields, and what it learns about the log as it reads.
 
-* a record: the :class:`~helmcheck.judge.wire.WireEvent` the observers are fed, or an
-  :class:`Unreadable` line (:data:`Chunk` is either);
+* a record: the :class:`~helmcheck.grammar.wirelog.WireEvent` the observers are fed, or an
+  :class:`~helmcheck.grammar.wirelog.Unreadable` line (:data:`Chunk` is either) — the wire log's
+  own record types (:mod:`helmcheck.grammar.wirelog`), re-exported here for the socat reader;
 * :class:`LogMeta`: what the log says about itself (header, time scale, baud, timestamp unit);
-* :func:`header_comment`: a wire-log ``#`` header line read into the :class:`LogMeta`.
+* :func:`header_comment`: a ``#`` header line read into the :class:`LogMeta`.
 
-Shared by the wire-log reader (:mod:`.readers`) and the socat reader (:mod:`.socat`).
+Shared by the format dispatch (:mod:`.readers`) and the socat reader (:mod:`.socat`).
 """
 
 from __future__ import annotations
 
 import re
 from dataclasses import dataclass
-from typing import Callable, NamedTuple, Optional, Union
+from typing import Callable, Optional
 
-from ...judge.wire import WireEvent
+from ...grammar.wirelog import NOTE, UNREADABLE, Record, Unreadable
 
 __all__ = ["Chunk", "Unreadable", "LogMeta", "Progress", "header_comment", "decimals_resolution", "UNREADABLE",
            "NOTE", "HEAD_BYTES"]
 
-UNREADABLE = "?"
-NOTE = "!"
 #: How much of a file decides its format and timestamp unit (the checker reads as much first).
 HEAD_BYTES = 64 * 1024
 #: Called with the size of each line read (a progress display).
 Progress = Optional[Callable[[int], None]]
 
-
-class Unreadable(NamedTuple):
-    """A log line that could not be read (``dir`` is ``?``): ``note`` says why, ``text`` is the
-    line as written (for evidence). Its first fields are a :class:`~helmcheck.judge.wire.WireEvent`'s."""
-
-    t: float
-    dir: str
-    data: bytes
-    note: str
-    lineno: int
-    text: str
-
-
-#: What a reader yields: a record as the :class:`~helmcheck.judge.wire.WireEvent` the observers
-#: are fed (bytes ``>`` to or ``<`` from the vehicle at ``t`` seconds since the log began, or a
-#: ``!`` note), or an :class:`Unreadable` line.
-Chunk = Union[WireEvent, Unreadable]
+#: What a reader yields: a record as the :class:`~helmcheck.grammar.wirelog.WireEvent` the
+#: observers are fed (bytes ``>`` to or ``<`` from the vehicle at ``t`` seconds since the log
+#: began, or a ``!`` note), or an :class:`~helmcheck.grammar.wirelog.Unreadable` line.
+Chunk = Record
 
 
 @dataclass

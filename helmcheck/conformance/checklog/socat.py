@@ -13,7 +13,8 @@
     ``socat -v -x`` combination: lines of at most 16 hex bytes (48 columns) plus two spaces and
     an ASCII column, each block ended by a ``--`` line.
 
-Direction: by default ``>`` (socat's left-to-right) is backseat→vehicle, as in the wire log;
+Direction: by default ``>`` (socat's left-to-right) is backseat→vehicle, as in the wire log
+(the records carry the wire log's directions, :mod:`helmcheck.grammar.wirelog`);
 ``swap=True`` (``--swap-directions``) exchanges them for a socat started with the vehicle side as
 its first address.
 
@@ -60,7 +61,7 @@ from dataclasses import dataclass
 from datetime import datetime
 from typing import BinaryIO, Iterable, Iterator, Optional
 
-from ...judge.wire import WireEvent
+from ...grammar.wirelog import FROM_VEHICLE, SWAPPED, TO_VEHICLE, WireEvent
 from .records import HEAD_BYTES, NOTE, UNREADABLE, Chunk, LogMeta, Progress, Unreadable, decimals_resolution, \
     header_comment
 
@@ -173,9 +174,10 @@ def socat_resolution(head: bytes) -> float:
     return best
 
 
-_SWAP = {">": "<", "<": ">"}
-
-
+#: socat's arrow → the record's direction (:mod:`helmcheck.grammar.wirelog`): left to right is
+#: backseat→vehicle unless the directions are swapped.
+_ARROWS = {b">": TO_VEHICLE, b"<": FROM_VEHICLE}
+_SWAPPED_ARROWS = {arrow: SWAPPED[d] for arrow, d in _ARROWS.items()}
 
 _V_ESC = {ord("r"): 13, ord("a"): 7, ord("b"): 8, ord("v"): 11, ord("f"): 12, ord("\\"): 92,
           ord("n"): 10, ord("t"): 9}
@@ -240,11 +242,10 @@ def read_socat(f: BinaryIO, meta: LogMeta, swap: bool, progress: Progress, hex_m
     n = 0
     block: Optional[dict] = None  # direction, t, lineno, want, got(bytearray)
 
+    arrows = _SWAPPED_ARROWS if swap else _ARROWS
+
     def new_block(m: re.Match, lineno: int) -> dict:
-        d = m.group(1).decode()
-        if swap:
-            d = _SWAP[d]
-        return {"dir": d, "t": clock.t(m, lineno), "lineno": lineno, "want": int(m.group(9)),
+        return {"dir": arrows[m.group(1)], "t": clock.t(m, lineno), "lineno": lineno, "want": int(m.group(9)),
                 "got": bytearray(), "text": []}
 
     def finish(b: dict, short_reason: str = "") -> Iterator[Chunk]:

@@ -5,12 +5,15 @@ Modules, one concern each:
 * :mod:`.core` — :class:`~.core.EmulatorCore`, the sans-IO core (model + plant + framer + logs).
 * :mod:`.plant` — plant dynamics (motion, depth, battery) that feed the model's plant events.
 * :mod:`.missionfile` — the mission file format and the directory catalogue (RH-MSN-1).
+* :mod:`.freedoms` — settings for the choices the reference profile leaves a conforming vehicle.
+* :mod:`.rules` — the emulated vehicle's own safety rules that trip by themselves (RH-SAF-5).
 * :mod:`.server` — the I/O loop on a pty, serial device or TCP serial server.
 * :mod:`.tui` — the optional live view in the spirit of the UVC remote-helm debug window.
 * :mod:`.process` — start an emulator subprocess and learn its port (tests, benchmarks, tools).
 
-The protocol behaviour is the model's (:mod:`helmcheck.model`), exactly; this package adds only
-physics, files, logs and I/O.
+The protocol behaviour is the model's (:mod:`helmcheck.model`), exactly, except where the profile
+leaves a vehicle room and a setting of :mod:`.freedoms` chooses otherwise (timing, the spelling of
+reports); this package adds only physics, files, logs and I/O.
 """
 
 from .core import EmulatorCore, HistoryEntry, MainLog

@@ -19,6 +19,14 @@ seconds, any monotonic origin) into every call and writes what comes back.
 The model is built by ``model_factory(profile, missions)`` (default
 :class:`~helmcheck.model.vehicle.VehicleModel`; a test may pass a deliberately faulty one).
 
+Freedoms (``settings``, :class:`~.freedoms.EmulatorSettings`; defaults: the behaviour described
+here): where the profile lets a conforming vehicle choose, the core can choose otherwise — a
+reply delay (lines wait in an inbox until their processing time, in arrival order), a serial
+loop that turns periodically (``pacing = "burst"``), a control tick (the vehicle clock the model
+and plant reach is rounded down to a tick, timer deadlines up to one, plant events land on the
+next tick), skewed timers (:class:`~.freedoms.SkewedTimers` in place of the model's), the
+plant's physics, and the spelling of its reports (:class:`~.freedoms.ReplyShaper`).
+
 Input handling: the framer cuts lines (RH-FRM-6/7); each line is decoded against the profile.
 A valid command goes to the model; a well-framed known command with bad fields goes to the
 model as its :class:`~helmcheck.grammar.errors.SentenceError` so it is answered with the
@@ -29,7 +37,7 @@ vehicle time, so every protocol duration shrinks by the time scale in wall time.
 (10 bits per byte at ``baud``, RH-ACK-2's transmit time) is wall time. ``baud = 0`` sends
 everything at once.
 
-Logs: the wire log (``helmcheck.grammar.capture`` format) records every input line or
+Logs: the wire log (``helmcheck.grammar.wirelog`` format) records every input line or
 discarded run (``>``/``>~``), every sentence sent (``<``) and notes (``!``) for plant and model
 events, injected faults and link changes; times are wall seconds since ``start``. Accepted
 ``$OLOGD`` rows (RH-LOG-2) go to the main log, a CSV file. Memory stays bounded: the model
@@ -51,7 +59,7 @@ from typing import IO, Any, Callable, Optional
 from ...grammar import Decoded, Discard, Framer, decode, prepare
 from ...grammar import format as format_sentence
 from ...grammar import sentences as s
-from ...grammar.capture import FROM_VEHICLE, NOTE, TO_VEHICLE, WireLogWriter, escape
+from ...grammar.wirelog import FROM_VEHICLE, NOTE, TO_VEHICLE, WireLogWriter, escape
 from ...grammar.errors import SentenceError
 from ...model.missions import MissionCatalog
 from ...model.plant import SafetyViolation

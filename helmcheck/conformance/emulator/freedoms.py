@@ -56,11 +56,12 @@ from decimal import Decimal
 from typing import Any, Optional
 
 from ...grammar import sentences as s
+from ...grammar.wirelog import transmit_time
 from ...model.timers import Timers, tolerance
 from ...profile import SAFETY_CODES, Profile
 
 __all__ = ["EmulatorSettings", "SettingsError", "settings_from_dict", "parse_assignment", "nonconforming",
-           "SkewedTimers", "ReplyShaper", "DEFAULT_SETTINGS", "DECIMAL_FIELDS", "skew_allowance"]
+           "SkewedTimers", "ReplyShaper", "ReplyDelay", "DEFAULT_SETTINGS", "DECIMAL_FIELDS", "skew_allowance"]
 
 #: Field names ``decimals`` may name: every Decimal field of a data sentence, and ``battery``.
 DECIMAL_FIELDS = ("lat", "lon", "speed", "distance", "altimeter", "declination", "remaining_time",
@@ -290,7 +291,7 @@ def nonconforming(st: EmulatorSettings, profile: Profile, replies_bytes: int = 6
     """Why these settings leave the bounds a conforming vehicle keeps (empty: they do not)."""
     out = []
     baud = profile.baud
-    tx = replies_bytes * 10.0 / baud if baud else 0.0
+    tx = transmit_time(replies_bytes, baud)
     late = st.reply_delay_s[1] + (st.burst_interval_s if st.pacing == "burst" else 0.0)
     if late + tx > profile.ack_window_s:
         out.append(f"reply_delay_s/burst_interval_s: replies up to {late:g} s after the command, plus "

@@ -34,6 +34,8 @@ Kinematics (a simple, deterministic vehicle; all times are *vehicle* seconds):
   ascent holds the depth while the motor and fins act horizontally).
 * Battery: ``capacity_wh`` drained by a hotel load plus a propulsion load growing with the
   square of the speed.
+* ``speed_factor`` scales every commanded speed into the speed made good (a freedom of the
+  vehicle, :mod:`.freedoms`; 1 by default).
 
 The ``$ODVL`` velocities are accepted and timed by the model but do not move the plant; the
 plant's position is ground truth, corrected only by an ``$OPOS`` the model applied (RH-POS-2).

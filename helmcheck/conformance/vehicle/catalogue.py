@@ -125,8 +125,9 @@ CASES: tuple[Case, ...] = (
        Send("OPK,{lat},{lon},5,{speed}"), Poll(mode="mP"), Send(FAR_OMW), Poll(mode="W"),
        Send(OMS0), Poll(mode="A"), Settle("remote"), Poll(mode="N|P")),
     _c("V-22", "RH-INT-2", "Control released to the mission",
-       "after a servo timeout the vehicle resumes the mission behaviour it had at takeover", "N",
-       Send("OJW,{wp_other}"), Send(OMS), Poll(mode="A"), Settle("remote"), Poll(mode="N|P")),
+       "after a servo timeout the vehicle resumes the mission behaviour it had at takeover: toward the "
+       "same next waypoint, whose distance a report showed before the takeover", "N",
+       Send("OJW,{wp_other}"), Poll(mode="N"), Send(OMS), Poll(mode="A"), Settle("remote"), Poll(mode="N|P")),
     _c("V-23", "RH-INT-2", "Control released to the mission park (P)",
        "a servo control taken 5 s into a mission park ends in P with the park time left at takeover",
        "P", Wait(5.0), Send(OMS), Poll(mode="A"), Wait(5.0), Settle("remote"), Poll(mode="P")),
@@ -195,6 +196,11 @@ CASES: tuple[Case, ...] = (
        "N", Send(OMS0), Poll(), Send("OPK,{lat},{lon},2,{speed}"), Poll(mode="mP"),
        Until("the $OPK countdown", mode="mP", park_below=120, budget_v=60.0),
        Wait(10.0), Poll(mode="mP", park_below=115)),
+    _c("V-64", "RH-PK-2", "$OPK counts only once on station",
+       "an $OPK 15 m away: mode mP at once, field 10 stays at minutes×60 while field 7 shows more than "
+       "3 m, then counts down once on station (RH-RD-5)", "N",
+       Send(OMS0), Poll(), Send("OPK,{stn_lat},{lon},2,{speed}"), Poll(mode="mP"),
+       Until("the $OPK countdown", mode="mP", park_below=120, budget_v=400.0), Poll(mode="mP")),
     _c("V-38", "RH-PK-3", "The mission resumes when the park time is up",
        "a 1-minute $OPK park at the vehicle's position ends in the mission within tolerance", "N",
        Send(OMS0), Poll(), Send("OPK,{lat},{lon},1,{speed}"),

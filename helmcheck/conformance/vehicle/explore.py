@@ -44,6 +44,7 @@ from hypothesis.errors import Flaky
 from hypothesis.stateful import RuleBasedStateMachine, initialize, precondition, rule, run_state_machine_as_test
 
 from ...grammar import checksum_hex
+from ...judge.timing import JITTER_S
 from .flow import CaseStop, LinkLost
 from .interpreter import _here, context, fill
 from .replay import save_replay
@@ -55,22 +56,40 @@ __all__ = ["explore", "PROFILES", "valid_commands", "control_commands", "invalid
 #: name -> (examples, steps per example, wall budget in seconds)
 PROFILES = {"fast": (20, 10, 25.0), "patient": (6, 8, 600.0)}
 
-_TIMEOUTS = st.sampled_from([2, 3, 5, 8, 12])
+#: Remote-control timeouts the exploration draws from (seconds), before :func:`timeouts` keeps those
+#: the observer can time at the time scale.
+TIMEOUT_CHOICES = (2, 3, 5, 8, 12, 20, 30)
+
+
+def timeouts(k: float, timeout_range=(1, 120)):
+    """The timeouts an exploration sends at time scale ``k``: those whose RH-TIM-1 judgement the
+    observer's own uncertainty cannot spoil (k × its jitter and a pty's transmit time, twice over
+    for margin, within half the duration: :func:`~helmcheck.judge.timing.judgeable`), within the
+    profile's ``timeout_range``. A case that cannot time its own timeout is the tester's defect."""
+    lo, hi = int(timeout_range[0]), int(timeout_range[1])
+    shortest = 4.0 * k * (JITTER_S + 0.01)
+    keep = [d for d in TIMEOUT_CHOICES if lo <= d <= hi and d >= shortest]
+    if not keep:
+        keep = [max(lo, min(hi, int(shortest) + 1))]
+    return st.sampled_from(keep[:5])
+
+
+_TIMEOUTS = timeouts(1.0)
 
 
 def _num(lo: float, hi: float, places: int = 1):
     return st.integers(int(lo * 10 ** places), int(hi * 10 ** places)).map(lambda n: f"{n / 10 ** places:g}")
 
 
-def valid_commands(nwp: int, speed: float, motor: int, oxflt: bool):
+def valid_commands(nwp: int, speed: float, motor: int, oxflt: bool, tos=_TIMEOUTS):
     """Bodies (with ``{lat}``-style templates) of well-formed commands, bench-safe."""
     spd = _num(0, speed)
     hexb = st.integers(0x60, 0xA0).map(lambda b: f"{b:02X}")
     mot = st.integers(0x80, max(0x80, motor)).map(lambda b: f"{b:02X}")
     return st.one_of(
         st.builds(lambda h, d, p, v, t: f"OMS,{h},{d},{p},{v},{t}", _num(0, 359), _num(0, 4), _num(0, 45, 0), spd,
-                  _TIMEOUTS),
-        st.builds(lambda a, b, m, t: f"OMP,{a}{a}{b}{b}{m},00,{t}", hexb, hexb, mot, _TIMEOUTS),
+                  tos),
+        st.builds(lambda a, b, m, t: f"OMP,{a}{a}{b}{b}{m},00,{t}", hexb, hexb, mot, tos),
         st.builds(lambda n: f"OJW,{n}", st.integers(0, nwp)),
         st.builds(lambda m, v: f"OPK,{{lat}},{{lon}},{m},{v}", st.integers(1, 2), spd),
         st.builds(lambda v, p: f"OMW,{{near_lat}},{{lon}},2,,15,{v},{p},", spd, st.sampled_from([0, 5])),
@@ -80,13 +99,13 @@ def valid_commands(nwp: int, speed: float, motor: int, oxflt: bool):
     )
 
 
-def control_commands(speed: float, motor: int):
+def control_commands(speed: float, motor: int, tos=_TIMEOUTS):
     """The remote-control commands (RH-INT-1), drawn more often than the rest."""
     spd = _num(0, speed)
     mot = st.integers(0x80, max(0x80, motor)).map(lambda b: f"{b:02X}")
     return st.one_of(
-        st.builds(lambda v, t: f"OMS,90,2,20,{v},{t}", spd, _TIMEOUTS),
-        st.builds(lambda m, t: f"OMP,80808080{m},00,{t}", mot, _TIMEOUTS),
+        st.builds(lambda v, t: f"OMS,90,2,20,{v},{t}", spd, tos),
+        st.builds(lambda m, t: f"OMP,80808080{m},00,{t}", mot, tos),
         st.builds(lambda v: f"OPK,{{lat}},{{lon}},1,{v}", spd),
         st.builds(lambda v: f"OMW,{{near_lat}},{{lon}},2,,15,{v},0,", spd),
     )
@@ -154,7 +173,7 @@ class _State:
             self.error = e
 
 
-def _machine(state: _State, start_states, nwp, speed, motor, oxflt):
+def _machine(state: _State, start_states, nwp, speed, motor, oxflt, tos=_TIMEOUTS):
     session = state.run.session
 
     class VehicleMachine(RuleBasedStateMachine):
@@ -216,11 +235,11 @@ def _machine(state: _State, start_states, nwp, speed, motor, oxflt):
                 self.ctx = context(session)
             self._guard(go)
 
-        @rule(body=valid_commands(nwp, speed, motor, oxflt))
+        @rule(body=valid_commands(nwp, speed, motor, oxflt, tos))
         def send_valid(self, body):
             self._guard(lambda: session.exchange(frame(fill(body, self.ctx))))
 
-        @rule(body=control_commands(speed, motor))
+        @rule(body=control_commands(speed, motor, tos))
         def control(self, body):
             self._guard(lambda: session.exchange(frame(fill(body, self.ctx))))
 
@@ -287,7 +306,8 @@ def explore(run) -> None:
     bench = p.bench_safety
     speed = min(2.0, p.max_speed_kn, bench.max_speed_kn if not bench.in_water else 99.0)
     motor = min(0x90, bench.max_motor_byte) if not bench.in_water else 0x90
-    factory = _machine(state, ["N", "S"], p.mission_waypoints, speed, motor, p.fault_injection == "oxflt")
+    factory = _machine(state, ["N", "S"], p.mission_waypoints, speed, motor, p.fault_injection == "oxflt",
+                       timeouts(run.session.k, p.timeout_range))
     if o.seed is not None:
         factory = seed(o.seed)(factory)
     db = DirectoryBasedExampleDatabase(str(run.dir / ".hypothesis"))
@@ -296,6 +316,7 @@ def explore(run) -> None:
                    phases=(Phase.explicit, Phase.reuse, Phase.generate, Phase.shrink))
     session = run.session
     session.note(f"exploration: {examples} examples of up to {steps} steps, budget {budget:g} s")
+    session.note("held: the exploration's violations wait for their re-runs after shrinking")
     session.begin_case("explore", ("RH-OUT-4",), "hypothesis exploration of command sequences")
     t0 = time.monotonic()
     outcome = "pass"
@@ -331,6 +352,7 @@ def explore(run) -> None:
         raise LinkLost(state.lost)
     best = state.best
     if best is None:
+        session.note("confirmed: the exploration found no violation")
         return
     cid = best["clause"] or best["reason"].split(":", 1)[0]
     session.begin_case("explore-confirm", ("RH-OUT-4",), "the smallest failing sequence, driven again")
@@ -338,6 +360,8 @@ def explore(run) -> None:
         confirmed = _confirm(run, best)
     finally:
         session.end_case()
+    session.note(f"{'confirmed' if confirmed == 2 else 'unconfirmed'}: reproduced {confirmed} of 2 re-runs "
+                 f"after shrinking")
     flaky = confirmed < 2
     run.stats["explore"]["confirmed"] = f"{confirmed}/2"
     if cid not in run.ledger:

@@ -24,7 +24,7 @@ from dataclasses import dataclass
 from typing import Optional
 
 from ...grammar import Discard, Framer
-from ...grammar.capture import FROM_VEHICLE, TO_VEHICLE, escape
+from ...grammar.wirelog import FROM_VEHICLE, TO_VEHICLE, escape, transmit_time
 from ...profile import Profile
 from ..recorder import Recorder
 from ..transport import Link, LinkClosed
@@ -60,7 +60,7 @@ class TesterLink:
         self.bytes_out = 0
         self.lines_in = 0
         self.lost: Optional[str] = None
-        self.per_byte = 10.0 / profile.baud if profile.baud else 0.0
+        self.per_byte = transmit_time(1, profile.baud)
 
     # ------------------------------------------------------------------ time
     def now(self) -> float:

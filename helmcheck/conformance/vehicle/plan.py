@@ -32,6 +32,7 @@ from typing import Optional
 
 from ...clauses import vehicle_clauses
 from ...failures import Failure
+from ...grammar.wirelog import BITS_PER_BYTE
 from ...judge import Ledger
 from ...judge.vehicle import VehicleObserver
 from ...model.missions import Mission, MissingMission, normalise_name
@@ -327,5 +328,5 @@ def as_json(plan: Plan) -> dict:
             "cases": [x.as_dict() for x in plan.lines],
             "total_wall_s": plan.total_wall_s, "total_vehicle_s": plan.total_vehicle_s,
             "protocol_wait_s": plan.wait_s,
-            "line": {"baud": plan.baud, "bits_per_byte": 10, "vehicle_delay_s": VEHICLE_DELAY_S},
+            "line": {"baud": plan.baud, "bits_per_byte": BITS_PER_BYTE, "vehicle_delay_s": VEHICLE_DELAY_S},
             "missions": plan.missions, "assumptions": plan.assumptions}

@@ -20,7 +20,7 @@ import json
 from pathlib import Path
 from typing import Optional
 
-from ...grammar.capture import unescape
+from ...grammar.wirelog import unescape
 from ...profile import Profile
 from ...reports.atomic import write_text_atomic
 

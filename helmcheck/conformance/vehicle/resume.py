@@ -4,9 +4,10 @@ A bench session at time scale 1 lasts half an hour; an interruption (Ctrl-C, a l
 flat battery) should not send it back to the start. :func:`resume_into` prepares a
 :class:`~.runner.Run` to continue the run recorded in its report directory:
 
-* the record is the truth: ``DIR/wire.log`` is replayed through the run's (fresh) vehicle
-  observer, so the ledger holds exactly the verdicts the first part earned — the same way an
-  offline ``check-log`` or ``verify`` reads it;
+* the record is the truth: ``DIR/wire.log`` is read by the one wire-log reader
+  (:func:`helmcheck.grammar.wirelog.read_records`) and replayed through the run's (fresh)
+  vehicle observer, so the ledger holds exactly the verdicts the first part earned — the same
+  way an offline ``check-log`` or ``verify`` reads it;
 * the wire log is appended to, after a ``run resumed`` note (the observer takes the vehicle's
   state as unknown again, and does not judge commands the interruption cut off), with the record's
   time going on a second after its last record;
@@ -25,8 +26,7 @@ import time
 from dataclasses import dataclass, field
 from typing import Any
 
-from ...grammar.capture import read_records
-from ...judge.wire import WireEvent
+from ...grammar.wirelog import read_records
 from ...reports import results as R
 
 __all__ = ["Resumed", "resume_into"]
@@ -64,9 +64,9 @@ def resume_into(run: Any) -> Resumed:
     run.results = r
     run.stats = stats
     wire = run.dir / R.WIRE_LOG_NAME
-    with open(wire, encoding="utf-8", errors="surrogateescape") as f:
+    with open(wire, "rb") as f:
         for rec in read_records(f):
-            run.observer.feed(WireEvent(rec.t, rec.direction, rec.raw, rec.note, rec.lineno))
+            run.observer.feed(rec)
             out.last_t = max(out.last_t, rec.t)
     with open(wire, "rb") as f:
         out.lines = sum(1 for _ in f)

@@ -88,7 +88,7 @@ class Options:
     exec_ready_s: float = 30.0  #: how long it may take to open (or listen on) the port
     certificate: Optional[RunDeclaration] = None  #: identity and signing key (helmcheck.reports.certificate)
     clock_check: bool = True  #: measure the vehicle's clock rate at start (:mod:`.clockprobe`)
-    # Command-line hooks (helmcheck.conformance.vehicle.cli): the link the command already
+    # Command-line hooks (helmcheck.commands.certify_vehicle_cmd): the link the command already
     # opened (a port that cannot be opened is a usage error there), and how to open wire.log
     # (a stream that remembers a write error for the command to report).
     link: Optional[Any] = None
@@ -433,7 +433,7 @@ def _keep_traceback(run: Run, exc: BaseException) -> str:
     line writes it too): ``"; traceback in tester-error.txt"`` for the verdict reason, or ``""``."""
     import traceback
 
-    from ...cli import TRACEBACK_NAME
+    from ...failures import TRACEBACK_NAME
     text = (f"helmcheck {__version__} tester error\ncommand: {run.o.command or 'certify()'}\n"
             f"time: {time.strftime('%Y-%m-%dT%H:%M:%SZ', time.gmtime())}\n\n"
             + "".join(traceback.format_exception(exc)))

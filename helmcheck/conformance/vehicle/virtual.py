@@ -26,6 +26,7 @@ import heapq
 import math
 from typing import Callable, Optional
 
+from ...grammar.wirelog import transmit_time
 from ..transport import Link, LinkEvent
 
 __all__ = ["VirtualClock", "VirtualLine", "VEHICLE_DELAY_S"]
@@ -63,7 +64,7 @@ class VirtualLine(Link):
         self.core = core
         self.baud = baud
         self.clock = clock if clock is not None else VirtualClock(core.start)
-        self.per_byte = 10.0 / baud if baud else 0.0
+        self.per_byte = transmit_time(1, baud)
         self.vehicle_delay_s = vehicle_delay_s
         self._seq = 0
         self._to_vehicle: list[tuple[float, int, bytes]] = []  #: (when the vehicle acts, order, bytes)

@@ -19,6 +19,7 @@ from __future__ import annotations
 from collections import deque
 
 from ..ledger import Evidence, Ledger
+from ..timing import BITS_PER_BYTE
 from .common import Settings
 
 __all__ = ["LineBudget", "line_budget"]
@@ -26,7 +27,7 @@ __all__ = ["LineBudget", "line_budget"]
 
 def line_budget(baud: int) -> int:
     """RH-BS-4: bytes a line drains in one second, 10 bits per byte (8N1)."""
-    return baud // 10
+    return baud // BITS_PER_BYTE
 
 
 class _Window:

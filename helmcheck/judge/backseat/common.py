@@ -23,7 +23,7 @@ from typing import Optional
 
 from ...grammar import Decoded, Discard
 from ...grammar import sentences as s
-from ...grammar.capture import escape
+from ...grammar.wirelog import TO_VEHICLE, TO_VEHICLE_RUN, escape, is_line
 from ...model.vehicle import VehicleModel
 from ...profile import Profile
 from ..ledger import Evidence
@@ -95,9 +95,9 @@ class SentLine:
 
     def evidence(self) -> Evidence:
         raw = self.raw
-        if raw.endswith(b"\r\n") and b"\n" not in raw[:-1]:
-            return Evidence(self.t, ">", escape(raw[:-2][:300]), self.lineno)
-        return Evidence(self.t, ">~", escape(raw[:300]), self.lineno)
+        if is_line(raw):
+            return Evidence(self.t, TO_VEHICLE, escape(raw[:-2][:300]), self.lineno)
+        return Evidence(self.t, TO_VEHICLE_RUN, escape(raw[:300]), self.lineno)
 
 
 def spacing(measured: float, limit: float, r: float) -> str:

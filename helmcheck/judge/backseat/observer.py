@@ -33,7 +33,7 @@ from typing import Optional
 
 from ...grammar import Decoded, Discard, Framer, Line, decode
 from ...grammar import sentences as s
-from ...grammar.capture import escape
+from ...grammar.wirelog import TO_VEHICLE_RUN, escape, is_line
 from ...profile import Profile
 from ..facts import LOCKOUT_REFUSED, NEEDS_MISSION, NEEDS_RUNNING, NEEDS_STOPPED
 from ..ledger import Evidence, Ledger
@@ -174,8 +174,8 @@ class BackseatObserver:
         data = ev.data
         if not data:
             return
-        line_like = data.endswith(b"\r\n") and b"\n" not in data[:-1]
-        rec = Evidence(ev.t, ">" if line_like else ">~",
+        line_like = is_line(data)
+        rec = Evidence(ev.t, TO_VEHICLE if line_like else TO_VEHICLE_RUN,
                        escape((data[:-2] if line_like else data)[:200]), ev.lineno)
         if self.started is None:
             self.started = ev.t

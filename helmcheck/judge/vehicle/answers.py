@@ -20,7 +20,7 @@ judges replies, split out to keep one concern per module; it works on the observ
 from __future__ import annotations
 
 from ...grammar import sentences as s
-from ...grammar.capture import escape
+from ...grammar.wirelog import escape
 from ..ledger import Evidence
 from ..timing import JITTER_S, ack_allowance, ack_uncertainty, ack_verdict, transmit_time
 from .blame import command_clauses, passable

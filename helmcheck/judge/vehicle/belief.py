@@ -6,8 +6,11 @@ what was adopted to explain the wire), most plausible first (fewest unseen event
 * :meth:`Beliefs.command` — a command the vehicle answered, at the vehicle time its ACK went out
   (RH-RD-15; vehicle time is wall time × the declared time scale, RH-TIM-2). Each candidate
   answers it nominally and, when the command lands within the RH-TIM-1 tolerance of a model timer,
-  on both sides of the race; before a command that freezes the mission (RH-INT-1) a candidate in
-  ``N`` also offers the state where the next waypoint was reached unseen just before it. The
+  on both sides of the race (also of a timer the model already ran: from its checkpoint, the state
+  before it); an accepted ``$OPK`` also with its countdown waiting for on station (RH-PK-2: where
+  the vehicle is at the ACK, no report settles); before a command that freezes the mission
+  (RH-INT-1) a candidate in ``N`` also offers the state where the next waypoint was reached unseen
+  just before it, where it can have got there (:func:`~.closure.reachable`). The
   candidates whose answer is the vehicle's survive. When none does, unseen events that change the
   answer are tried (:func:`~.closure.explain_reply`); when that fails too, the answer is a
   finding, and the observer follows the nominal state marked *desynchronised* until a state that
@@ -40,7 +43,7 @@ from ...profile import Profile
 from ..facts import ASCENT_REFUSED, INTERRUPTS, LOCKOUT_REFUSED
 from ..timing import judgeable
 from .candidate import Candidate, Timed
-from .closure import explain_osi, explain_reply, osi_depth_m, reply_keys
+from .closure import explain_osi, explain_reply, osi_depth_m, reachable, reply_keys
 
 __all__ = ["Beliefs", "CommandResult", "OsiResult", "CAP"]
 
@@ -116,15 +119,39 @@ class Beliefs:
                 if m.now is None or before >= m.now:
                     times.append(before)
                 times.append(max(v, due + 1e-6))
-        out = []
+        out, late = [], []
+        base = m.checkpoint
+        fired = c.timed[-1] if (base is not None and c.timed) else None
+        if fired is not None and 0.0 <= v - fired.deadline <= tolerance(fired.duration, slack_v + c.extra_v):
+            # the model already ran a timer this command lands within RH-TIM-1's tolerance of: on
+            # a conforming vehicle it may not have run yet (the checkpoint is the state before it)
+            t = c.clone()
+            t.model = base.clone()
+            t.model.trace = []
+            t._mode, t._phase = base.mode, base.phase
+            t.timed = [x for x in t.timed if x is not fired and x.deadline != fired.deadline]
+            at = max(base.now if base.now is not None else fired.deadline, fired.deadline - 1e-6)
+            t.model.advance(at)
+            if (t.model.mode, t.model.phase) == (base.mode, base.phase):
+                before = (t.model.mode, t.model.phase)
+                row = None if isinstance(item, SentenceError) else t.model.row_for(item)
+                late.append((t, t.model.receive(item, at), row, before))
         for at in dict.fromkeys(times):
             t = c.clone()
             t.model.advance(at)
             before = (t.model.mode, t.model.phase)
             row = None if isinstance(item, SentenceError) else t.model.row_for(item)
-            out.append((t, t.model.receive(item, at), row, before))
+            replies = t.model.receive(item, at)
+            out.append((t, replies, row, before))
+            if isinstance(item, s.OPK) and t.model.mode == "mP" and t.model.timers.armed("opk"):
+                # RH-PK-2: on station or not at the ACK is where the vehicle is then, which the
+                # last report (made before it moved on) does not settle: the count may start later
+                w = t.clone()
+                w.model.await_on_station()
+                out.append((w, replies, row, before))
         if (isinstance(item, s.Command) and m.mode == "N" and m.phase == "none" and m.mission is not None
-                and VehicleModel.event_of(item) in _WP_ALT_EVENTS):
+                and VehicleModel.event_of(item) in _WP_ALT_EVENTS
+                and reachable(c, m.mission_wp, v, self.catalog)):  # only where it can have got there
             tp = min(max(c.seen_v if c.seen_v is not None else v, m.now or 0.0), v)
             t = c.clone()
             t.model.plant(_wp(), tp)
@@ -134,7 +161,7 @@ class Beliefs:
                 before = (t.model.mode, t.model.phase)
                 row = t.model.row_for(item)
                 out.append((t, t.model.receive(item, v), row, before))
-        return out
+        return out + late  # the nominal answer first: it is what a finding names
 
     def command(self, item, v: float, slack_v: float, observed: list) -> CommandResult:
         """Feed an answered command (module docstring); ``observed`` is the vehicle's replies."""

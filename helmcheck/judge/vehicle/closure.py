@@ -44,7 +44,8 @@ from ...profile import SAFETY_CODES
 from .candidate import Candidate
 from .catalog import UnknownMission, _LearntOpen
 
-__all__ = ["explain_osi", "explain_reply", "same_replies", "reply_keys", "MAX_WAYPOINTS", "osi_depth_m"]
+__all__ = ["explain_osi", "explain_reply", "same_replies", "reply_keys", "MAX_WAYPOINTS", "osi_depth_m",
+           "reachable"]
 
 #: The most mission (or queue) waypoints the observer assumes passed between two reports.
 MAX_WAYPOINTS = 8
@@ -155,33 +156,12 @@ def _motion_trials(c: Candidate, osi: s.OSI, tp: float, gap: float, catalog) -> 
       tolerance of the park) — the profile does not say it must stay on station while it counts.
       (What earlier reports show of where it was is judged by :mod:`.osichecks`, RH-PK-2.)
     """
-    from ...model.geo import distance_m
-    from ...model.timers import tolerance
-
     m = c.model
     out: list = []
-    prof = m.profile
-    knots = max([prof.max_speed_kn, float(osi.speed)]
-                + [x[-1] for x in (c.nav_seen, c.fix_seen) if x is not None])  # their speed is last
-    vmax = knots * 1852.0 / 3600.0  # m/s
     v = tp + gap
 
     def can_reach(k: int) -> bool:
-        run, nav, fix = m.mission, c.nav_seen, c.fix_seen
-        need = []  # (since when, metres it still had to make at least to be on station at k)
-        if nav is not None and nav[0] == run.name and nav[1] == k:  # type: ignore[union-attr]
-            _, _, d, t0, lat, lon, _ = nav
-            need.append((t0, d - prof.on_station_m))
-            if fix is not None and fix[0] > t0:  # the way made since (under remote control, say)
-                need.append((fix[0], d - distance_m(lat, lon, fix[2], fix[3]) - prof.on_station_m))
-        if fix is not None and not getattr(catalog, "learns", True) and not run.is_open:  # type: ignore[union-attr]
-            w = run.waypoints[k]  # type: ignore[union-attr]
-            need.append((fix[0], distance_m(fix[2], fix[3], w.lat, w.lon) - prof.on_station_m))
-        for since, metres in need:
-            left = max(0.0, v - since)
-            if metres > vmax * (left + tolerance(left)):
-                return False
-        return True
+        return reachable(c, k, v, catalog, float(osi.speed))
 
     if m.mode == "N" and m.mission is not None:
         k = m.mission_wp
@@ -211,6 +191,10 @@ def _motion_trials(c: Candidate, osi: s.OSI, tp: float, gap: float, catalog) -> 
     elif m.mode == "P" and m.mission is not None and osi.mode == "S":
         out += _park_and_end(c, osi, tp, gap, catalog)
     elif m.mode == "mP":
+        from ...model.timers import tolerance
+        prof = m.profile
+        knots = max([prof.max_speed_kn, float(osi.speed)] + [x[-1] for x in (c.nav_seen, c.fix_seen) if x is not None])
+        vmax = knots * 1852.0 / 3600.0  # m/s
         counted = max(0.0, m.opk_seconds - osi.park_time) + 1.0 + tolerance(m.opk_seconds)
         if float(osi.distance) <= prof.on_station_m + vmax * counted:
             def on_station(t: Candidate) -> Candidate:
@@ -230,6 +214,37 @@ def _motion_trials(c: Candidate, osi: s.OSI, tp: float, gap: float, catalog) -> 
             out.append(("queued waypoint reached" if n == 1 else f"{n} queued waypoints reached",
                         queue(n), n, None))
     return out
+
+
+def reachable(c: Candidate, k: int, v: float, catalog, speed_kn: float = 0.0) -> bool:
+    """Can the vehicle of candidate ``c`` have come within ``on_station_m`` of mission waypoint
+    ``k`` by vehicle time ``v`` (:func:`_motion_trials`' first rule)? Nothing moves faster than
+    the profile's ``max_speed_kn`` or the fastest speed reported (``speed_kn``, the last reports'
+    own); no distance reported is no evidence (True)."""
+    from ...model.geo import distance_m
+    from ...model.timers import tolerance
+
+    m = c.model
+    prof = m.profile
+    run, nav, fix = m.mission, c.nav_seen, c.fix_seen
+    if run is None:
+        return True
+    knots = max([prof.max_speed_kn, speed_kn] + [x[-1] for x in (nav, fix) if x is not None])
+    vmax = knots * 1852.0 / 3600.0  # m/s
+    need = []  # (since when, metres it still had to make at least to be on station at k)
+    if nav is not None and nav[0] == run.name and nav[1] == k:
+        _, _, d, t0, lat, lon, _ = nav
+        need.append((t0, d - prof.on_station_m))
+        if fix is not None and fix[0] > t0:  # the way made since (under remote control, say)
+            need.append((fix[0], d - distance_m(lat, lon, fix[2], fix[3]) - prof.on_station_m))
+    if fix is not None and not getattr(catalog, "learns", True) and not run.is_open:
+        w = run.waypoints[k]
+        need.append((fix[0], distance_m(fix[2], fix[3], w.lat, w.lon) - prof.on_station_m))
+    for since, metres in need:
+        left = max(0.0, v - since)
+        if metres > vmax * (left + tolerance(left)):
+            return False
+    return True
 
 
 def _park_and_end(c: Candidate, osi: s.OSI, tp: float, gap: float, catalog) -> list:

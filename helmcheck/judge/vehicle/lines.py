@@ -22,7 +22,7 @@ from typing import Optional
 
 from ...grammar import Decoded, decode
 from ...grammar import sentences as s
-from ...grammar.capture import escape
+from ...grammar.wirelog import escape
 from ...grammar.errors import SentenceError
 from ...profile import Profile
 from ..ledger import Evidence, Ledger

@@ -35,7 +35,7 @@ from typing import Optional
 
 from ...grammar import Discard, Framer, Line, decode
 from ...grammar import sentences as s
-from ...grammar.capture import escape
+from ...grammar.wirelog import escape
 from ...model import plant as P
 from ...profile import Profile
 from ..ledger import Evidence, Ledger, Reason
@@ -224,7 +224,13 @@ class VehicleObserver(Answers):
             self.baud = n.value  # the line's rate as the tester opened it: what transmit times use
         elif n.kind == "aborted":
             self.aborted = n.text
+        elif n.kind == "held":
+            self.ledger.hold()
+        elif n.kind in ("confirmed", "unconfirmed"):
+            self.ledger.release(n.kind == "confirmed", n.text)
         elif n.kind == "resumed":
+            if self.ledger.holding:
+                self.ledger.release(False, "not confirmed: the run was interrupted before the re-runs")
             self._resume(ev, n.text)
         elif n.kind in ("plant", "fault"):
             if n.kind == "fault":
@@ -489,6 +495,8 @@ class VehicleObserver(Answers):
                 self._book_missing(p)
         self._mission_unshown("the record ended")
         self.checks.close()
+        if self.ledger.holding:
+            self.ledger.release(False, "not confirmed: the record ended before the re-runs")
         if self.aborted:
             for cid in self.ledger.order:
                 if not self.ledger.judged(cid):

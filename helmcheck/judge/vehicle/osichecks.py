@@ -328,8 +328,11 @@ class OsiChecks:
         counted = secs - shown  # whole seconds field 10 has counted: it is rounded up (RH-RD-5)
         what = f"the $OPK park counts down (P{shown} of {secs} s)"
         if counted > 0:
-            # the count began between these many seconds before the report (RH-TIM-1 tolerance)
-            least, most = counted - tolerance(secs), counted + 1.0 + tolerance(secs)
+            # the count began between these many seconds before the report: field 10 starts at
+            # minutes×60 and is rounded up (RH-PK-2, RH-RD-5), so only the rate of the count has
+            # RH-TIM-1's tolerance, over the part counted — not the whole park's
+            least = counted - max(0.5, 0.05 * counted)
+            most = counted + 1.0 + max(0.5, 0.05 * (counted + 1.0))
             if hi - least < park.v0 and not park.failed:
                 park.failed = True
                 o.book("fail", ("RH-PK-2",), f"{what} {counted} s, but the $OPK was accepted only "

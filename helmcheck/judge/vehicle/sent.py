@@ -12,7 +12,7 @@ from functools import lru_cache
 from typing import Optional
 
 from ...grammar import sentences as s
-from ...grammar.capture import escape
+from ...grammar.wirelog import escape
 from ..ledger import Evidence
 from .lines import Kind
 

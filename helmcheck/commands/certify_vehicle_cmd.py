@@ -2,14 +2,16 @@
 
 ``add_arguments(parser)`` and ``run(args) -> int`` are what
 :mod:`helmcheck.commands.certify_cmd` dispatches to; :data:`EPILOG` is the ``--help`` epilog.
+The certification itself is the driver's library entry point,
+:func:`helmcheck.conformance.vehicle.runner.certify`; this module is its command line.
 Exit status: 0 pass (or non-strict without ``--strict``), 1 fail, 2 inconclusive, 64 usage.
-``--plan`` (:mod:`.plan`) estimates the run instead, and opens no port and writes no file.
-The port is opened here, once, before anything is written (``helmcheck.commands.ports``: one
-that cannot be opened is exit 64); the report directory is checked first and cleared with
-``--overwrite`` (:mod:`helmcheck.outputs`); the reports are rendered and ``--wire-log`` copied
-here after the run, and a file that cannot be written is exit 2 naming it.
+``--plan`` (:mod:`helmcheck.conformance.vehicle.plan`) estimates the run instead, and opens no
+port and writes no file. The port is opened here, once, before anything is written
+(:mod:`helmcheck.commands.ports`: one that cannot be opened is exit 64); the report directory is
+checked first and cleared with ``--overwrite`` (:mod:`helmcheck.outputs`); the reports are
+rendered and ``--wire-log`` copied here after the run, and a file that cannot be written is
+exit 2 naming it.
 """
-
 from __future__ import annotations
 
 import argparse
@@ -18,7 +20,8 @@ import shlex
 import sys
 from pathlib import Path
 
-from ... import exitcodes
+from .. import exitcodes
+from ..failures import UsageError
 
 __all__ = ["add_arguments", "run", "EPILOG"]
 
@@ -136,56 +139,52 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                       help="with --plan: the vehicle's mission files (default: the emulator's built-in ones)")
 
 
-def _usage(msg: str) -> int:
-    return exitcodes.usage_error("helmcheck certify vehicle", msg)
-
-
 def run(args: argparse.Namespace) -> int:  # noqa: C901 - argument checks, then one call
-    from ...failures import OutputLost
-    from ...outputs import OutputStream, check_writable, prepare_report_dir
-    from ...profile import load_profile
-    from ...commands.ports import open_port, port_spec
-    from ..transport import BAUD_RATES
-    from .runner import Options, certify
+    from ..failures import OutputLost
+    from ..outputs import OutputStream, check_writable, prepare_report_dir
+    from ..profile import load_profile
+    from ..conformance.transport import BAUD_RATES
+    from ..conformance.vehicle.runner import Options, certify
+    from .ports import open_port, port_spec
 
     if args.resume is not None:
         why = _resume_args(args)
         if why:
-            return _usage(why)
+            raise UsageError(why)
     profile = load_profile(args.profile)  # a ProfileError is exit 64 (helmcheck.cli)
     k = args.time_scale if args.time_scale is not None else profile.time_scale
     if not math.isfinite(k) or k <= 0:
-        return _usage(f"--time-scale must be a positive number (got {k})")
+        raise UsageError(f"--time-scale must be a positive number (got {k})")
     if args.baud is not None:
         if args.baud not in BAUD_RATES:
-            return _usage(f"--baud must be one of {', '.join(map(str, BAUD_RATES))}")
+            raise UsageError(f"--baud must be one of {', '.join(map(str, BAUD_RATES))}")
         profile = profile.replace(baud=args.baud)
     profile = profile.replace(time_scale=float(k))
     if args.plan or args.json or args.missions is not None:
         return _plan(args, profile, k)
     if args.exec_cmd is not None:
-        from ..launcher import check_command
+        from ..conformance.launcher import check_command
         why = check_command(args.exec_cmd)
         if why:
-            return _usage(f"--exec: {why}")
+            raise UsageError(f"--exec: {why}")
         for name in ("exec_grace", "exec_ready"):
             value = getattr(args, name)
             if not math.isfinite(value) or value <= 0:
-                return _usage(f"--{name.replace('_', '-')} must be a positive number of seconds (got {value})")
+                raise UsageError(f"--{name.replace('_', '-')} must be a positive number of seconds (got {value})")
         if args.port is None:
             args.port = "pty"
     elif args.port is None:
-        return _usage("--port is required (or --exec CMD to start the vehicle under test)")
+        raise UsageError("--port is required (or --exec CMD to start the vehicle under test)")
     spec = port_spec(args.port)
     if spec.kind == "pty" and args.exec_cmd is None:
-        return _usage("--port pty creates a new pseudo-terminal; give the vehicle's port (e.g. /dev/pts/N) "
-                      "or --exec CMD to start the vehicle on it")
+        raise UsageError("--port pty creates a new pseudo-terminal; give the vehicle's port (e.g. /dev/pts/N) "
+                         "or --exec CMD to start the vehicle on it")
     select = _selection(args)
-    from ...commands.certificate_opts import DeclarationError, declaration
+    from .certificate_opts import DeclarationError, declaration
     try:
         cert = declaration(args, "vehicle")
     except DeclarationError as e:
-        return _usage(str(e))
+        raise UsageError(str(e)) from None
     if args.wire_log:
         check_writable(args.wire_log, "--wire-log")
     resume = args.resume is not None
@@ -220,12 +219,12 @@ def run(args: argparse.Namespace) -> int:  # noqa: C901 - argument checks, then 
     finally:
         if link is not None:
             link.close()
-    from ...reports.scope import headline
+    from ..reports.scope import headline
     print(f"{headline(out.results)}. {out.reason} — report: {out.report_dir / 'report.html'}")
     sys.stdout.flush()
     restore = out.results.get("restore")
     if restore is not None and restore.get("attempted") and not restore.get("verified"):
-        from .restore import unverified_text
+        from ..conformance.vehicle.restore import unverified_text
         print(f"helmcheck certify vehicle: {unverified_text(restore)}", file=sys.stderr)
     _finish_outputs(out.report_dir, wire, args.wire_log)
     return out.exit_code
@@ -240,7 +239,7 @@ _RESUME_FIXED = {"profile": "--profile", "time_scale": "--time-scale", "baud": "
 def _resume_args(args: argparse.Namespace) -> str:
     """``--resume DIR``: check DIR holds an interrupted vehicle run and fill ``args`` with its
     profile, time scale, selection and seed; the usage error, or ``""``."""
-    from ...reports.results import ReportError, load_results
+    from ..reports.results import ReportError, load_results
 
     given = [flag for key, flag in _RESUME_FIXED.items() if getattr(args, key, None) not in (None, False)]
     if given:
@@ -284,13 +283,13 @@ def _selection(args: argparse.Namespace):
     if args.select:
         select = [x.strip() for item in args.select for x in item.split(",") if x.strip()]
         from fnmatch import fnmatchcase
-        from ...clauses import vehicle_clauses
+        from ..clauses import vehicle_clauses
         ids = [c.id for c in vehicle_clauses()]
         bad = [p for p in select if not any(fnmatchcase(cid, p) for cid in ids)]
         if bad:
-            _usage(f"--select: {', '.join(bad)} match no vehicle clause (e.g. RH-SRV-*, RH-ACK-2)")
+            raise UsageError(f"--select: {', '.join(bad)} match no vehicle clause (e.g. RH-SRV-*, RH-ACK-2)")
     if args.examples is not None and args.examples < 0:
-        _usage("--examples must be 0 or more")
+        raise UsageError("--examples must be 0 or more")
     return select
 
 
@@ -299,18 +298,18 @@ def _hypothesis_profile(args: argparse.Namespace, k: float) -> str:
 
 
 def _plan(args: argparse.Namespace, profile, k: float) -> int:
-    """``--plan``: the estimate (:mod:`.plan`) on standard output; no port, no file touched."""
+    """``--plan``: the estimate (:mod:`helmcheck.conformance.vehicle.plan`) on standard output; no port, no file touched."""
     import json
 
     if not args.plan:
-        return _usage(f"{'--json' if args.json else '--missions'} goes with --plan")
+        raise UsageError(f"{'--json' if args.json else '--missions'} goes with --plan")
     select = _selection(args)
     missions = None
     if args.missions is not None:
         missions = Path(args.missions)
         if not missions.is_dir():
-            return _usage(f"--missions: {args.missions} is not a directory")
-    from .plan import estimate, render_text, as_json
+            raise UsageError(f"--missions: {args.missions} is not a directory")
+    from ..conformance.vehicle.plan import estimate, render_text, as_json
     plan = estimate(profile, k, select=select, examples=args.examples,
                     hypothesis_profile=_hypothesis_profile(args, k), missions_dir=missions)
     if args.json:
@@ -322,10 +321,10 @@ def _plan(args: argparse.Namespace, profile, k: float) -> int:
 
 def _finish_outputs(report_dir: Path, wire: list, wire_copy) -> None:
     """Reports rendered, the wire log whole, its copy written — or :class:`OutputLost` (exit 2)."""
-    from ...failures import OutputLost
-    from ...outputs import copy_output
-    from ...reports.render import render_all
-    from ...reports.results import ReportError
+    from ..failures import OutputLost
+    from ..outputs import copy_output
+    from ..reports.render import render_all
+    from ..reports.results import ReportError
 
     for w in wire:
         w.check()

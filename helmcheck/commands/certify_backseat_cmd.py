@@ -3,7 +3,8 @@
 The command opens the port (``--port pty`` prints ``port: /dev/pts/N`` as its first line on
 standard output, flushed, for the backseat to open; a device path is opened 8N1 at the
 profile's baud; ``socket://HOST:PORT`` serves one client), plays the reference vehicle, stages
-the scenarios of :mod:`.scenarios` and judges every byte the backseat sends
+the scenarios of :mod:`helmcheck.conformance.backseat.scenarios` with the driver's
+:class:`~helmcheck.conformance.backseat.runner.Runner` and judges every byte the backseat sends
 (:class:`helmcheck.judge.backseat.BackseatObserver`, the judge ``check-log`` uses too).
 At the end (also after Ctrl-C, SIGTERM or SIGHUP — :mod:`helmcheck.signals` raises them as
 ``KeyboardInterrupt`` —, a backseat that never connected or one that went away) it writes
@@ -14,7 +15,8 @@ line on standard output and exits 0 (pass; non-strict without ``--strict``), 1 (
 earlier run without ``--overwrite``). Progress goes to standard error.
 
 With ``--exec CMD`` helmcheck starts the backseat itself once the port is open and stops it at
-the end (:mod:`.process`); a backseat that exits or dies before the end fails the run.
+the end (:mod:`helmcheck.conformance.backseat.process`); a backseat that exits or dies before
+the end fails the run.
 """
 
 from __future__ import annotations
@@ -28,9 +30,8 @@ from datetime import datetime, timezone
 from pathlib import Path
 from typing import Any, Callable, Optional
 
-from ... import exitcodes
-from ...failures import describe_interrupt
-from .scenarios import SCENARIOS
+from ..conformance.backseat.scenarios import SCENARIOS
+from ..failures import UsageError, describe_interrupt
 
 __all__ = ["add_arguments", "run", "EPILOG"]
 
@@ -98,10 +99,6 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                         "removed first); without it such a directory is refused")
 
 
-def _usage(msg: str) -> int:
-    return exitcodes.usage_error("helmcheck certify backseat", msg)
-
-
 def _positive(x: Optional[float]) -> bool:
     return x is not None and math.isfinite(x) and x > 0
 
@@ -143,43 +140,43 @@ class _Progress:
 def run(args: argparse.Namespace, *, on_port: Optional[Callable[[str], None]] = None) -> int:  # noqa: C901
     """Carry out ``certify backseat``; returns the exit status. ``on_port(name)`` is called
     once the port is open (after the ``port:`` line), for callers that start the backseat."""
-    from ...judge.timing import JITTER_S
-    from ...profile import ProfileError, load_profile
-    from ..transport import BAUD_RATES, parse_port_spec
-    from .scenarios import make_plan
+    from ..judge.timing import JITTER_S
+    from ..profile import ProfileError, load_profile
+    from ..conformance.backseat.scenarios import make_plan
+    from ..conformance.transport import BAUD_RATES, parse_port_spec
 
     try:
         profile = load_profile(args.profile)
     except ProfileError as e:
-        return _usage(str(e))
+        raise UsageError(str(e)) from None
     scale = args.time_scale if args.time_scale is not None else profile.time_scale
     if not _positive(scale):
-        return _usage(f"--time-scale must be a positive number (got {args.time_scale})")
+        raise UsageError(f"--time-scale must be a positive number (got {args.time_scale})")
     if not _positive(args.duration):
-        return _usage(f"--duration must be a positive number of seconds (got {args.duration})")
+        raise UsageError(f"--duration must be a positive number of seconds (got {args.duration})")
     if not _positive(args.connect_timeout):
-        return _usage(f"--connect-timeout must be a positive number of seconds (got {args.connect_timeout})")
+        raise UsageError(f"--connect-timeout must be a positive number of seconds (got {args.connect_timeout})")
     exec_cmd = getattr(args, "exec_cmd", None)
     if exec_cmd is not None:
-        from ..launcher import check_command
+        from ..conformance.launcher import check_command
         why = check_command(exec_cmd)
         if why:
-            return _usage(f"--exec: {why}")
+            raise UsageError(f"--exec: {why}")
         if not _positive(args.exec_grace):
-            return _usage(f"--exec-grace must be a positive number of seconds (got {args.exec_grace})")
+            raise UsageError(f"--exec-grace must be a positive number of seconds (got {args.exec_grace})")
     baud = args.baud if args.baud is not None else profile.baud
     if baud not in BAUD_RATES:
-        return _usage(f"--baud must be one of {', '.join(map(str, BAUD_RATES))} (got {baud})")
+        raise UsageError(f"--baud must be one of {', '.join(map(str, BAUD_RATES))} (got {baud})")
     try:
         spec = parse_port_spec(args.port)
     except ValueError as e:
-        return _usage(f"--port: {e}")
+        raise UsageError(f"--port: {e}") from None
     profile = profile.replace(time_scale=float(scale), baud=baud)
-    from ...commands.certificate_opts import DeclarationError, declaration
+    from .certificate_opts import DeclarationError, declaration
     try:
         cert = declaration(args, "backseat")
     except DeclarationError as e:
-        return _usage(str(e))
+        raise UsageError(str(e)) from None
     names = args.scenario or list(SCENARIOS)
     plan = make_plan(names, args.duration, time_scale=scale, lockout_s=profile.lockout_s)
     started_dt = datetime.now(timezone.utc)
@@ -202,9 +199,9 @@ def run(args: argparse.Namespace, *, on_port: Optional[Callable[[str], None]] = 
 
 def _open_outputs_and_port(args, spec, profile, report_dir: Path):
     """(link, wire-log stream): paths checked, port opened, report directory prepared."""
-    from ...commands.ports import open_port
-    from ...outputs import check_writable, open_output_stream, prepare_report_dir
-    from .link import HangupPty
+    from ..conformance.backseat.link import HangupPty
+    from ..outputs import check_writable, open_output_stream, prepare_report_dir
+    from .ports import open_port
 
     if args.wire_log:
         check_writable(args.wire_log, "--wire-log")
@@ -234,8 +231,8 @@ def _certify(args, profile, spec, plan, report_dir: Path, log_file, settings, co
                 sys.stdout.flush()
             except OSError:
                 pass
-            from ..emulator.missionfile import DirectoryCatalog, builtin_dir  # after the port line
-            from .runner import Runner
+            from ..conformance.emulator.missionfile import DirectoryCatalog, builtin_dir  # after the port line
+            from ..conformance.backseat.runner import Runner
             meta = [f"started {started_dt.strftime('%Y-%m-%dT%H:%M:%S.%fZ')}  port {link.name}  "
                     f"baud {profile.baud}  time_scale {profile.time_scale:g}"]
             print(f"helmcheck certify backseat: {link.description}, profile {profile.name}, time scale "
@@ -251,7 +248,7 @@ def _certify(args, profile, spec, plan, report_dir: Path, log_file, settings, co
                             missions=DirectoryCatalog([builtin_dir()]), log=log_file, meta=meta,
                             connect_timeout=args.connect_timeout, progress=progress)
             if getattr(args, "exec_cmd", None):
-                from .process import start_backseat
+                from ..conformance.backseat.process import start_backseat
                 try:
                     runner.child = child = start_backseat(args.exec_cmd, link.name, report_dir,
                                                           time_scale=profile.time_scale, grace_s=args.exec_grace)
@@ -276,13 +273,13 @@ def _certify(args, profile, spec, plan, report_dir: Path, log_file, settings, co
             log_file.close()
         except OSError:
             pass
-    from ...failures import OutputLost
-    from ...outputs import copy_output
-    from ...reports.certificate import finish_run
-    from ...reports.render import render_all
-    from ...reports.results import ReportError, exit_code
-    from ...reports.scope import headline
-    from .report import build_results
+    from ..failures import OutputLost
+    from ..outputs import copy_output
+    from ..reports.certificate import finish_run
+    from ..reports.render import render_all
+    from ..reports.results import ReportError, exit_code
+    from ..reports.scope import headline
+    from ..conformance.backseat.report import build_results
 
     results = build_results(outcome, profile=profile, settings=settings, command=command,
                             port=link.name if link is not None else args.port, started=started,
