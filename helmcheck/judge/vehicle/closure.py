@@ -90,16 +90,19 @@ def explain_osi(c: Candidate, osi: s.OSI, v: float, slack_v: float, tp: float, c
     depth = osi_depth_m(osi, depth_unit)
     at_surface = depth is not None and depth <= fix_depth
 
-    def ok(trial: Optional[Candidate]) -> bool:
-        return trial is not None and not trial.check(osi, v, slack_v + gap)
+    def ok(trial: Optional[Candidate], early: float = 0.0) -> bool:
+        return trial is not None and not trial.check(osi, v, slack_v + gap + early)
 
     def run(name: str, build: Callable[[Candidate], Optional[Candidate]], n: int = 1,
             learn: Optional[Callable[[], None]] = None) -> Optional[Candidate]:
+        # a countdown the last report showed full (field 10 is rounded up, RH-RD-5) may have begun
+        # up to a second before that report: the window of an on-station event reaches back as far
+        early = 1.0 if name.startswith("on station") else 0.0
         trial = build(c.clone())
-        if ok(trial):
+        if ok(trial, early):
             if learn is not None:
                 learn()
-            return trial.adopted(f"{name} between v={tp:.1f} and v={v:.1f}", tp, v, n)  # type: ignore[union-attr]
+            return trial.adopted(f"{name} between v={tp - early:.1f} and v={v:.1f}", tp - early, v, n)  # type: ignore[union-attr]
         return None
 
     def surfaced(t: Candidate) -> Candidate:
