@@ -18,39 +18,16 @@ conforming counterpart that passes the same clause:
 
 from __future__ import annotations
 
-from pathlib import Path
 
 import pytest
 
 from helmcheck.conformance.checklog.checker import check_log
-from helmcheck.grammar import checksum_hex
 from helmcheck.profile import DEFAULT
+from tests.test_judge_vehicle_readings import LAT, LON, osi, poll, write  # the hand-made wire logs
 
 PROFILE = DEFAULT
-LAT, LON = 41.520000, -71.320000
 #: a point about 166 m east of (LAT, LON)
 FAR_LON = LON + 0.002
-
-
-def osi(mode: str, wp: int = 0, park: int = 0, err: str = "N", lat: float = LAT, lon: float = LON,
-        dist: float = 0.0, speed: float = 0.0, act: str = "8080808080") -> str:
-    return (f"OSI,{act},{mode},{wp},{lat:.8f},{lon:.8f},{speed:.2f},{dist:.2f},{err},38.00,P{park},-14.5000,"
-            f"conformance.mis,4.5,75.5,0.00,94.3,False,IVER3-EMU,0.0,False,False")
-
-
-def write(tmp_path: Path, records: list[tuple]) -> Path:
-    lines = ["# helmcheck wire-log 1", "# hand-made  baud 19200  time_scale 1"]
-    for t, d, body in records:
-        text = body if d == "!" else f"${body}*{checksum_hex(body)}"
-        lines.append(f"{t:.6f} {d} {text}")
-    p = tmp_path / "made.log"
-    p.write_text("\n".join(lines) + "\n")
-    return p
-
-
-def poll(t: float, **fields) -> list[tuple]:
-    """``$OSD,S`` at ``t``, its ``$OSI`` 10 ms later, its ACK 20 ms later."""
-    return [(t, ">", "OSD,S"), (t + 0.01, "<", osi(**fields)), (t + 0.02, "<", "ACK,8,0,0")]
 
 
 def send(t: float, body: str, ack: str) -> list[tuple]:
