@@ -35,26 +35,17 @@ from helmcheck.conformance.emulator.missionfile import DirectoryCatalog, builtin
 from helmcheck.conformance.emulator.plant import PlantParams
 from helmcheck.conformance.emulator.process import EmulatorProcess, frame
 from helmcheck.conformance.vehicle.runner import Options, certify
-from helmcheck.grammar import Framer, Line, decode
+from helmcheck.grammar import Framer, Line
 from helmcheck.grammar import sentences as s
 from helmcheck.profile import load_emulator_table, load_profile
 from tests.faulty_vehicles import EMU_PROFILE
+from tests.test_emulator_core import replies as sentences  # every line decoded
 
 # ============================================================================ sans-IO
 
 
 def core(st: EmulatorSettings = DEFAULT_SETTINGS, k: float = 10.0, baud: int = 0) -> EmulatorCore:
     return EmulatorCore(EMU_PROFILE, DirectoryCatalog([builtin_dir()]), time_scale=k, baud=baud, settings=st)
-
-
-def sentences(data: bytes) -> list:
-    out = []
-    for ev in Framer(4096).feed(data):
-        assert isinstance(ev, Line), ev
-        d = decode(ev.raw)
-        assert d.sentence is not None, (ev.raw, d.error)
-        out.append(d.sentence)
-    return out
 
 
 def osi_of(data: bytes) -> s.OSI:

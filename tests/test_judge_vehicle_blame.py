@@ -23,7 +23,7 @@ import pytest
 
 from helmcheck.conformance.checklog.checker import check_log
 from helmcheck.profile import DEFAULT
-from tests.test_judge_vehicle_readings import LAT, LON, osi, poll, write  # the hand-made wire logs
+from tests.test_judge_vehicle_readings import LAT, LON, poll, write  # the hand-made wire logs
 
 PROFILE = DEFAULT
 #: a point about 166 m east of (LAT, LON)
