@@ -24,8 +24,8 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from helmcheck.conformance.emulator.process import EmulatorProcess  # noqa: E402
-from helmcheck.conformance.vehicle.runner import Options, certify  # noqa: E402
+from helmcheck.emulator.process import EmulatorProcess  # noqa: E402
+from helmcheck.certify.vehicle.runner import Options, certify  # noqa: E402
 from helmcheck.profile import emulator_profile  # noqa: E402
 
 

@@ -22,7 +22,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from helmcheck.conformance.checklog.checker import check_log  # noqa: E402
+from helmcheck.checklog.checker import check_log  # noqa: E402
 from helmcheck.grammar import checksum_hex  # noqa: E402
 from helmcheck.profile import DEFAULT  # noqa: E402
 

@@ -25,7 +25,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from helmcheck.conformance.emulator.process import EmulatorProcess, frame  # noqa: E402
+from helmcheck.emulator.process import EmulatorProcess, frame  # noqa: E402
 
 MIX = [(frame("OSD,S"), b"$ACK,8,"), (frame("OPOS,41.52,-71.32,1.5,42,15"), b"$ACK,6,"),
        (frame("OSD,C"), b"$ACK,8,"), (frame("ORWSET,Sle,R"), b"$ACK,12,")]

@@ -14,8 +14,8 @@ import shutil
 import sys
 from pathlib import Path
 
-from .conformance.emulator.process import EmulatorProcess
-from .conformance.vehicle.runner import Options, certify
+from .emulator.process import EmulatorProcess
+from .certify.vehicle.runner import Options, certify
 from .profile import EMULATOR_PROFILE, emulator_profile
 
 TIME_SCALE = 40.0

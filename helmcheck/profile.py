@@ -370,7 +370,7 @@ def _check_trigger(where: str, kw: dict[str, Any]) -> None:
 
 
 #: The table of a profile file that holds ``helmcheck emulate``'s own settings, the freedoms the
-#: profile leaves a vehicle (:mod:`helmcheck.conformance.emulator.freedoms`). Only the emulator
+#: profile leaves a vehicle (:mod:`helmcheck.emulator.freedoms`). Only the emulator
 #: reads it (:func:`load_emulator_table`); a profile never carries it, so a tester never learns it.
 EMULATOR_TABLE = "emulator"
 

@@ -10,7 +10,7 @@ protocol code, adds no item and changes no outcome. With one of
 it adds one item per clause of that role, named by clause ID (``helmcheck.vehicle::RH-SRV-4``,
 ``helmcheck.backseat::RH-BS-1``), then the item ``run-verdict``. The certification runs once per
 session, in the setup of the first helmcheck item that runs (its time is charged to that item),
-through :func:`helmcheck.conformance.vehicle.runner.certify` for a vehicle and the ``certify
+through :func:`helmcheck.certify.vehicle.runner.certify` for a vehicle and the ``certify
 backseat`` command (:mod:`helmcheck.commands.certify_backseat_cmd`) for a backseat; the report
 directory (``--helm-report-dir``) gets ``results.json``, the wire log and every report format,
 as the commands write them. The directory belongs to the plugin: each session replaces the
@@ -121,7 +121,7 @@ class _Certification:
             raise _usage(f"--helm-time-scale must be a positive number (got {k})")
         self.time_scale = float(k if k is not None else self.profile.time_scale)
         if self.exec_cmd is not None:
-            from .conformance.launcher import check_command
+            from .line.launcher import check_command
             why = check_command(self.exec_cmd)
             if why:
                 raise _usage(f"--helm-{self.role}-exec: {why}")
@@ -191,7 +191,7 @@ class _Certification:
         return "pytest " + shlex.join(self.config.invocation_params.args)
 
     def _run_vehicle(self) -> None:
-        from .conformance.vehicle.runner import Options, certify
+        from .certify.vehicle.runner import Options, certify
 
         opt = self.config.getoption
         examples = opt("helm_examples")

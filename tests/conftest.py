@@ -183,7 +183,7 @@ def full_emulator_run(tmp_path_factory):
     from importlib import resources
 
     from helmcheck.cli import main as cli_main
-    from helmcheck.conformance.emulator.process import EmulatorProcess
+    from helmcheck.emulator.process import EmulatorProcess
     from helmcheck.profile import EMULATOR_PROFILE
 
     root = tmp_path_factory.mktemp("full-run")

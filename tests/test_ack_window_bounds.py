@@ -20,9 +20,9 @@ import pytest
 
 from helmcheck.cli import main as cli_main
 from helmcheck.clauses import vehicle_clauses
-from helmcheck.conformance.checklog.checker import check_log
-from helmcheck.conformance.emulator.core import EmulatorCore
-from helmcheck.conformance.vehicle.runner import Options, certify
+from helmcheck.checklog.checker import check_log
+from helmcheck.emulator.core import EmulatorCore
+from helmcheck.certify.vehicle.runner import Options, certify
 from helmcheck.grammar import checksum_hex, decode
 from helmcheck.judge.ledger import Ledger
 from helmcheck.judge.timing import JITTER_S, ack_allowance, transmit_time

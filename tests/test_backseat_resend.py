@@ -15,7 +15,7 @@ from __future__ import annotations
 from hypothesis import given
 from hypothesis import strategies as st
 
-from helmcheck.conformance.checklog.checker import check_log
+from helmcheck.checklog.checker import check_log
 from helmcheck.grammar import checksum_hex
 from helmcheck.judge import Ledger, WireEvent
 from helmcheck.judge.backseat import BS_CLAUSES, RESEND_SPACING_S, BackseatObserver

@@ -30,7 +30,7 @@ from pathlib import Path
 import pytest
 
 from helmcheck.commands import certify_backseat_cmd as cli
-from helmcheck.conformance.checklog.checker import check_log
+from helmcheck.checklog.checker import check_log
 from helmcheck.profile import DEFAULT
 from helmcheck.reports.results import load_results
 

@@ -10,7 +10,7 @@ from __future__ import annotations
 from hypothesis import given
 from hypothesis import strategies as st
 
-from helmcheck.conformance.backseat.scenarios import SCENARIOS, make_plan
+from helmcheck.certify.backseat.scenarios import SCENARIOS, make_plan
 from helmcheck.grammar import checksum_hex
 from helmcheck.judge import Ledger, WireEvent
 from helmcheck.judge.backseat import BS_CLAUSES, POLL_INTERVAL_S, BackseatObserver, line_budget
@@ -440,8 +440,8 @@ def test_plan_fits_the_lockout_and_keeps_the_order():
 def test_results_document_strict_and_partial():
     """SHOULD missed: non-strict (exit 0), fail with --strict (exit 1); a cut-short run is
     inconclusive with its reason first; every document validates (schema 1, role backseat)."""
-    from helmcheck.conformance.backseat.report import build_results
-    from helmcheck.conformance.backseat.runner import Outcome
+    from helmcheck.certify.backseat.report import build_results
+    from helmcheck.certify.backseat.runner import Outcome
     from helmcheck.judge.runfacts import RunFacts
     from helmcheck.reports.results import exit_code, validate
 

@@ -17,10 +17,10 @@ from pathlib import Path
 import pytest
 
 from helmcheck.cli import main as cli_main
-from helmcheck.conformance.transport import PtyLink
-from helmcheck.conformance.vehicle import runner as runner_mod
-from helmcheck.conformance.vehicle.runner import Options, certify
-from helmcheck.conformance.vehicle.safety import BenchGuard
+from helmcheck.line.transport import PtyLink
+from helmcheck.certify.vehicle import runner as runner_mod
+from helmcheck.certify.vehicle.runner import Options, certify
+from helmcheck.certify.vehicle.safety import BenchGuard
 from helmcheck.grammar.wirelog import read_records
 from helmcheck.profile import DEFAULT
 from helmcheck.reports.results import load_results

@@ -1,6 +1,6 @@
 """The start-up time-scale check of ``certify vehicle`` (RH-TIM-2).
 
-The measurement → verdict part (:mod:`helmcheck.conformance.vehicle.clockrate`) is sans-IO and
+The measurement → verdict part (:mod:`helmcheck.certify.vehicle.clockrate`) is sans-IO and
 tested on made-up readings, among them a property: whatever the vehicle's rate, step and the
 observer's latencies, the measured interval holds the true rate, so a correct declaration is
 never stopped. The wire part runs against ``helmcheck emulate`` at a time scale other than the
@@ -19,12 +19,12 @@ from hypothesis import strategies as st
 
 from helmcheck.cli import main as cli_main
 from helmcheck.commands.verify_cmd import verify_run
-from helmcheck.conformance.emulator.core import EmulatorCore
-from helmcheck.conformance.emulator.process import EmulatorProcess
-from helmcheck.conformance.vehicle.clockprobe import MAX_WALL_S
-from helmcheck.conformance.vehicle.clockrate import (CLEAR_FACTOR, Sample, gprmc_clock, judge_rate, measure,
+from helmcheck.emulator.core import EmulatorCore
+from helmcheck.emulator.process import EmulatorProcess
+from helmcheck.certify.vehicle.clockprobe import MAX_WALL_S
+from helmcheck.certify.vehicle.clockrate import (CLEAR_FACTOR, Sample, gprmc_clock, judge_rate, measure,
                                                      rate_text)
-from helmcheck.conformance.vehicle.runner import Options, certify
+from helmcheck.certify.vehicle.runner import Options, certify
 from helmcheck.grammar.wirelog import read_records
 from helmcheck.reports.results import load_results
 from tests.faulty_vehicles import EMU_PROFILE, make_core, serve

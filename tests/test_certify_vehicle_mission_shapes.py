@@ -20,9 +20,9 @@ from pathlib import Path
 
 import pytest
 
-from helmcheck.conformance.emulator.core import EmulatorCore
-from helmcheck.conformance.emulator.missionfile import DirectoryCatalog, builtin_dir
-from helmcheck.conformance.vehicle.runner import Options, certify
+from helmcheck.emulator.core import EmulatorCore
+from helmcheck.emulator.missionfile import DirectoryCatalog, builtin_dir
+from helmcheck.certify.vehicle.runner import Options, certify
 from helmcheck.grammar.wirelog import read_records
 from tests.faulty_vehicles import EMU_PROFILE, serve
 from tests.judging import not_passed

@@ -5,7 +5,7 @@ vehicle, decides)."""
 
 from __future__ import annotations
 
-from helmcheck.conformance.vehicle.runner import Options, certify
+from helmcheck.certify.vehicle.runner import Options, certify
 from helmcheck.profile import DEFAULT
 from tests.faulty_vehicles import EMU_PROFILE, make_core, serve
 

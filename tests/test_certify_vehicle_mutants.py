@@ -12,7 +12,7 @@ from __future__ import annotations
 import pytest
 
 from helmcheck.clauses import vehicle_clauses
-from helmcheck.conformance.vehicle.runner import Options, certify
+from helmcheck.certify.vehicle.runner import Options, certify
 from tests.judging import not_passed
 from tests.faulty_vehicles import EMU_PROFILE, MUTANTS, make_core, serve
 

@@ -17,13 +17,13 @@ import pytest
 
 import helmcheck
 from helmcheck.cli import main as cli_main
-from helmcheck.conformance.emulator.core import EmulatorCore
-from helmcheck.conformance.emulator.missionfile import builtin_dir
-from helmcheck.conformance.emulator.process import EmulatorProcess
-from helmcheck.conformance.vehicle.catalogue import select_cases
-from helmcheck.conformance.vehicle.plan import OPERATOR_REACTION_S
-from helmcheck.conformance.vehicle.session import frame
-from helmcheck.conformance.vehicle.virtual import VEHICLE_DELAY_S, VirtualLine
+from helmcheck.emulator.core import EmulatorCore
+from helmcheck.emulator.missionfile import builtin_dir
+from helmcheck.emulator.process import EmulatorProcess
+from helmcheck.certify.vehicle.catalogue import select_cases
+from helmcheck.certify.vehicle.plan import OPERATOR_REACTION_S
+from helmcheck.certify.vehicle.session import frame
+from helmcheck.certify.vehicle.virtual import VEHICLE_DELAY_S, VirtualLine
 from helmcheck.profile import DEFAULT, EMULATOR_PROFILE, emulator_profile
 from helmcheck.reports.results import load_results
 
@@ -77,7 +77,7 @@ def test_plan_json_totals_are_the_sums_of_its_cases(capsys):
 
 def test_plan_opens_no_port_and_writes_nothing(tmp_path, capsys, monkeypatch):
     import helmcheck.commands.ports as ports
-    import helmcheck.conformance.transport as transport
+    import helmcheck.line.transport as transport
 
     def refuse(*a, **kw):
         raise AssertionError("a port was opened")

@@ -14,9 +14,9 @@ import subprocess
 import sys
 from pathlib import Path
 
-from helmcheck.conformance.emulator.process import EmulatorProcess, HelmClient
-from helmcheck.conformance.transport import open_link
-from helmcheck.conformance.vehicle.runner import Options, certify
+from helmcheck.emulator.process import EmulatorProcess, HelmClient
+from helmcheck.line.transport import open_link
+from helmcheck.certify.vehicle.runner import Options, certify
 from helmcheck.grammar import sentences as s
 from helmcheck.reports.results import load_results
 from tests.faulty_vehicles.base import EMU_PROFILE, EmulatorCore, Model, Mutant, make_core, reframe, serve

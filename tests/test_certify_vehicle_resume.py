@@ -14,7 +14,7 @@ import sys
 from pathlib import Path
 
 from helmcheck.cli import main as cli_main
-from helmcheck.conformance.emulator.process import EmulatorProcess
+from helmcheck.emulator.process import EmulatorProcess
 from helmcheck.reports.results import load_results
 from tests.judging import not_passed
 from tests.waiting import wait_for_text

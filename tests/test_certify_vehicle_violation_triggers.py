@@ -22,7 +22,7 @@ from pathlib import Path
 
 import pytest
 
-from helmcheck.conformance.emulator.process import EmulatorProcess
+from helmcheck.emulator.process import EmulatorProcess
 from helmcheck.reports.results import load_results
 
 K = 40.0

@@ -13,8 +13,8 @@ from pathlib import Path
 import pytest
 
 from helmcheck.cli import main as cli_main
-from helmcheck.conformance.checklog.checker import check_log
-from helmcheck.conformance.checklog.readers import detect_format
+from helmcheck.checklog.checker import check_log
+from helmcheck.checklog.readers import detect_format
 from helmcheck.profile import DEFAULT
 
 LOGS = Path(__file__).parent / "fixtures" / "logs"
@@ -152,7 +152,7 @@ def test_cli_writes_reports_and_exit_codes(tmp_path, capsys):
 
 def test_emulator_session_log_checks_clean(tmp_path):
     """A live session: helmcheck emulate --log on a pty at x20, driven over pyserial."""
-    from helmcheck.conformance.emulator.process import EmulatorProcess, HelmClient
+    from helmcheck.emulator.process import EmulatorProcess, HelmClient
 
     log = tmp_path / "session.log"
     with EmulatorProcess(["--log", str(log)], time_scale=20, baud=115200) as emu:
@@ -193,7 +193,7 @@ def test_committed_emulator_log_checks_clean():
     for catalog in (None, "missions"):
         cat = None
         if catalog:
-            from helmcheck.conformance.emulator.missionfile import DirectoryCatalog, builtin_dir
+            from helmcheck.emulator.missionfile import DirectoryCatalog, builtin_dir
             cat = DirectoryCatalog([builtin_dir()])
         out = check_log(LOGS / "emulator_session.log", profile=PROFILE, catalog=cat)
         assert out.time_scale == 20.0

@@ -1,5 +1,5 @@
 """``check_log(role="both")`` with the backseat role judged in a second process
-(:mod:`helmcheck.conformance.checklog.sidejob`): the verdicts are the same either way, the
+(:mod:`helmcheck.checklog.sidejob`): the verdicts are the same either way, the
 automatic choice (``parallel=None``), :class:`SideJob` itself, the in-process fallback when the
 side job is lost, and a file that changes while it is checked.
 
@@ -22,8 +22,8 @@ from pathlib import Path
 import pytest
 
 import helmcheck
-from helmcheck.conformance.checklog import checker
-from helmcheck.conformance.checklog.sidejob import SideJob, SideJobLost, cores
+from helmcheck.checklog import checker
+from helmcheck.checklog.sidejob import SideJob, SideJobLost, cores
 from helmcheck.profile import DEFAULT
 from tests.processes import descendants
 
@@ -34,7 +34,7 @@ FIXTURES = sorted(LOGS.glob("*.log")) + sorted(p for p in (LOGS / "socat").iterd
 #: what check_log returns that must not depend on where the backseat role was judged
 COMPARED = ("clauses", "stats", "findings", "sha256", "timeline", "events", "format", "role",
             "one_direction", "resolution", "time_scale", "notes", "meta")
-CHILD_CMD = "from helmcheck.conformance.checklog.sidejob import child"
+CHILD_CMD = "from helmcheck.checklog.sidejob import child"
 
 
 def _bench():

@@ -18,9 +18,9 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from helmcheck.conformance.checklog import checker as checker_mod
-from helmcheck.conformance.checklog.checker import check_log
-from helmcheck.conformance.checklog.readers import (HEAD_BYTES, NOTE, LogMeta, detect_format, read_chunks,
+from helmcheck.checklog import checker as checker_mod
+from helmcheck.checklog.checker import check_log
+from helmcheck.checklog.readers import (HEAD_BYTES, NOTE, LogMeta, detect_format, read_chunks,
                                                     socat_time_unit, timestamp_resolution)
 from helmcheck.grammar import Framer, Line, decode
 from helmcheck.profile import DEFAULT

@@ -19,7 +19,7 @@ import pytest
 from helmcheck.commands import certify_backseat_cmd as backseat_cli
 from helmcheck.commands import certify_vehicle_cmd as vehicle_cli
 from helmcheck.commands import matrix_cmd
-from helmcheck.conformance.launcher import build_argv
+from helmcheck.line.launcher import build_argv
 
 ROOT = Path(__file__).resolve().parent.parent
 WORKFLOW = ROOT / "docs" / "ci" / "backseat-conformance.yml"

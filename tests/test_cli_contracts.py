@@ -26,7 +26,7 @@ from hypothesis import HealthCheck, event, given, settings
 from hypothesis import strategies as st
 
 from helmcheck.cli import main
-from helmcheck.conformance.transport import PtyLink
+from helmcheck.line.transport import PtyLink
 from helmcheck.reports.results import load_results
 from tests.faulty_vehicles import make_core, serve
 
@@ -276,7 +276,7 @@ TESTER_BUG = {  # (argv, the function a bug is planted in)
     "emulate": (["emulate"], "helmcheck.profile.load_profile"),
     "certify vehicle": (["certify", "vehicle", "--port", "/dev/null"], "helmcheck.profile.load_profile"),
     "certify backseat": (["certify", "backseat"], "helmcheck.profile.load_profile"),
-    "replay": (["replay", "REPLAY", "--port", "/dev/null"], "helmcheck.conformance.vehicle.replay.load_replay"),
+    "replay": (["replay", "REPLAY", "--port", "/dev/null"], "helmcheck.certify.vehicle.replay.load_replay"),
     "check-log": (["check-log", LOGS / "nominal.log"], "helmcheck.profile.load_profile"),
     "report": (["report", PASS_RUN], "helmcheck.reports.rundir.load_run"),
     "docs": (["docs", "--check"], "helmcheck.grammar.docs.render_markdown"),
@@ -307,7 +307,7 @@ def test_row_tester_error_is_2_with_the_traceback_in_a_file(command, tmp_path, c
 
 def test_row_tester_error_mid_run_leaves_partial_results_and_the_traceback_beside_them(tmp_path, capsys,
                                                                                         monkeypatch):
-    from helmcheck.conformance.vehicle import runner as runner_mod
+    from helmcheck.certify.vehicle import runner as runner_mod
 
     monkeypatch.setattr(runner_mod, "run_case", _boom)
     with serve(lambda start: make_core(None, 20.0, start)) as port:
@@ -388,8 +388,8 @@ def _file_size_limit(limit: int):
 
 
 def test_row_output_emulate_settings_that_cannot_be_saved_stop_it_with_2(tmp_path):
-    from helmcheck.conformance.emulator.process import HelmClient
-    from helmcheck.conformance.transport import open_link
+    from helmcheck.emulator.process import HelmClient
+    from helmcheck.line.transport import open_link
 
     settings_file = tmp_path / "settings.json"
     proc = subprocess.Popen([sys.executable, "-m", "helmcheck", "emulate", "--settings", str(settings_file)],

@@ -17,7 +17,7 @@ from pathlib import Path
 
 import pytest
 
-from helmcheck.conformance.emulator.process import EmulatorProcess
+from helmcheck.emulator.process import EmulatorProcess
 from helmcheck.reports.results import load_results
 from tests.waiting import wait_for_text
 

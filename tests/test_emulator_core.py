@@ -9,10 +9,10 @@ from decimal import Decimal
 
 import pytest
 
-from helmcheck.conformance.emulator.core import MAX_OUTBOX_BYTES, EmulatorCore, MainLog
-from helmcheck.conformance.emulator.missionfile import (DirectoryCatalog, MissionFileError, builtin_dir,
+from helmcheck.emulator.core import MAX_OUTBOX_BYTES, EmulatorCore, MainLog
+from helmcheck.emulator.missionfile import (DirectoryCatalog, MissionFileError, builtin_dir,
                                                         format_mission, parse_mission)
-from helmcheck.conformance.emulator.process import frame
+from helmcheck.emulator.process import frame
 from helmcheck.grammar import Framer, Line, decode
 from helmcheck.grammar import sentences as s
 from helmcheck.grammar.wirelog import WireLogWriter, read_records
@@ -344,7 +344,7 @@ def test_disconnect_drops_a_partial_line():
 def test_live_view_renders_without_a_terminal():
     from rich.console import Console
 
-    from helmcheck.conformance.emulator.tui import FAULT_KEYS, LiveView
+    from helmcheck.emulator.tui import FAULT_KEYS, LiveView
 
     core = make_core()
     core.feed(frame("OMSTART,0,0,0,0,conformance.mis") + frame("OMS,90,2,20,2,10") + b"junk$X*00\r\n", 0.1)

@@ -2,7 +2,7 @@
 
 The judge must not have learnt the reference emulator's own choices where the profile leaves
 room. ``helmcheck emulate`` spans those freedoms as settings (the ``[emulator]`` table of its
-profile file, ``--set KEY=VALUE``; :mod:`helmcheck.conformance.emulator.freedoms`), and:
+profile file, ``--set KEY=VALUE``; :mod:`helmcheck.emulator.freedoms`), and:
 
 * the sans-IO tests check each setting does what it says on :class:`EmulatorCore`, and that the
   defaults are the reference emulator's behaviour;
@@ -27,14 +27,14 @@ import pytest
 from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 
-from helmcheck.conformance.emulator.core import EmulatorCore, plant_params
-from helmcheck.conformance.emulator.freedoms import (DEFAULT_SETTINGS, EmulatorSettings, SettingsError,
+from helmcheck.emulator.core import EmulatorCore, plant_params
+from helmcheck.emulator.freedoms import (DEFAULT_SETTINGS, EmulatorSettings, SettingsError,
                                                      SkewedTimers, nonconforming, parse_assignment,
                                                      settings_from_dict)
-from helmcheck.conformance.emulator.missionfile import DirectoryCatalog, builtin_dir
-from helmcheck.conformance.emulator.plant import PlantParams
-from helmcheck.conformance.emulator.process import EmulatorProcess, frame
-from helmcheck.conformance.vehicle.runner import Options, certify
+from helmcheck.emulator.missionfile import DirectoryCatalog, builtin_dir
+from helmcheck.emulator.plant import PlantParams
+from helmcheck.emulator.process import EmulatorProcess, frame
+from helmcheck.certify.vehicle.runner import Options, certify
 from helmcheck.grammar import Framer, Line
 from helmcheck.grammar import sentences as s
 from helmcheck.profile import load_emulator_table, load_profile
@@ -106,7 +106,7 @@ def test_settings_come_from_the_profile_table_and_set_flags(tmp_path):
 def test_helmcheck_emulate_reads_the_table_and_warns_outside_the_bounds(tmp_path):
     """``helmcheck emulate --profile`` takes the ``[emulator]`` table, ``--set`` overrides it, and a
     setting past a bound is obeyed with a warning naming the clause."""
-    from helmcheck.conformance.emulator.process import HelmClient
+    from helmcheck.emulator.process import HelmClient
 
     prof = tmp_path / "p.toml"
     prof.write_text('[emulator]\nosi_reserved = ["a", "b", "c"]\ndecimals = { lat = 3 }\n')
@@ -235,7 +235,7 @@ _STARTED: list[float] = []  #: when this test's first example ran
 def plan_cost(select: list[str], k: float, latency: float) -> float:
     """Planned wall seconds of certifying ``select`` at ``k`` (virtual time, on the reference
     vehicle), plus ``latency`` for every line the tester sends (a vehicle that answers later)."""
-    from helmcheck.conformance.vehicle.plan import estimate
+    from helmcheck.certify.vehicle.plan import estimate
 
     lines = [0]
     feed = EmulatorCore.feed

@@ -15,7 +15,7 @@ from decimal import Decimal
 
 import pytest
 
-from helmcheck.conformance.emulator.process import EmulatorProcess, HelmClient, frame
+from helmcheck.emulator.process import EmulatorProcess, HelmClient, frame
 from helmcheck.grammar import Framer, Line, decode
 from helmcheck.grammar import format as format_sentence
 from helmcheck.grammar import sentences as s
@@ -346,7 +346,7 @@ def test_wire_log_is_written_per_record(emulator, helm):
 
 
 def test_RH_FRM_9_device_path_opened_with_pyserial():
-    from helmcheck.conformance.transport import PtyLink
+    from helmcheck.line.transport import PtyLink
 
     line = PtyLink(19200)  # stands in for a serial cable: the emulator opens its device end
     emu = EmulatorProcess(["--port", line.name], baud=19200).start()

@@ -7,8 +7,8 @@ import socket
 
 import pytest
 
-from helmcheck.conformance.emulator.process import EmulatorProcess, HelmClient, frame
-from helmcheck.conformance.transport import open_link
+from helmcheck.emulator.process import EmulatorProcess, HelmClient, frame
+from helmcheck.line.transport import open_link
 
 #: The module-scoped run below is made once: all of this module's tests go to one worker.
 pytestmark = pytest.mark.xdist_group("test_emulator_tcp")

@@ -21,9 +21,9 @@ import time
 
 import pytest
 
-from helmcheck.conformance.emulator.process import HelmClient
-from helmcheck.conformance.emulator.tui import FAULT_KEYS, FAULT_WORDS, legend, legend_lines
-from helmcheck.conformance.transport import open_link
+from helmcheck.emulator.process import HelmClient
+from helmcheck.emulator.tui import FAULT_KEYS, FAULT_WORDS, legend, legend_lines
+from helmcheck.line.transport import open_link
 
 ROWS, COLS = 24, 80
 _CSI = re.compile(rb"\x1b\[[0-9;?]*[A-Za-z]")

@@ -1,4 +1,4 @@
-"""The exploration's rules (``helmcheck/conformance/vehicle/explore.py``), against faulty vehicles
+"""The exploration's rules (``helmcheck/certify/vehicle/explore.py``), against faulty vehicles
 served behind real ptys:
 
 * a failure the exploration found is re-driven twice after shrinking, from a verified reset:
@@ -29,10 +29,10 @@ import pytest
 from hypothesis.errors import FlakyFailure, FlakyStrategyDefinition
 
 from helmcheck.cli import main as cli_main
-from helmcheck.conformance.emulator.core import EmulatorCore
-from helmcheck.conformance.vehicle import explore as explore_mod
-from helmcheck.conformance.vehicle import replay as replay_mod
-from helmcheck.conformance.vehicle.runner import Options, certify
+from helmcheck.emulator.core import EmulatorCore
+from helmcheck.certify.vehicle import explore as explore_mod
+from helmcheck.certify.vehicle import replay as replay_mod
+from helmcheck.certify.vehicle.runner import Options, certify
 from helmcheck.grammar import sentences as s
 from helmcheck.reports.results import load_results
 from tests.faulty_vehicles import EMU_PROFILE, make_core, serve

@@ -2,7 +2,7 @@
 the backseat observer is fed as the events happen or through the wire log ``check-log`` reads.
 
 "Live" is what ``certify backseat`` does: every event goes through a
-:class:`~helmcheck.conformance.recorder.Recorder`, which writes the wire log and feeds the
+:class:`~helmcheck.line.recorder.Recorder`, which writes the wire log and feeds the
 observer. "Offline" is ``check_log(..., role="backseat")`` on that very file. The sessions are
 generated (commands good and bad, split anywhere; state reports, answers, lockout signs; the
 recorder's notes; times from a microsecond to several seconds apart), at two time scales and
@@ -17,8 +17,8 @@ from pathlib import Path
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from helmcheck.conformance.checklog.checker import check_log
-from helmcheck.conformance.recorder import Recorder
+from helmcheck.checklog.checker import check_log
+from helmcheck.line.recorder import Recorder
 from helmcheck.grammar import checksum_hex
 from helmcheck.judge import Ledger
 from helmcheck.judge.backseat import BS_CLAUSES, BackseatObserver

@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import pytest
 
-from helmcheck.conformance.checklog.checker import check_log
+from helmcheck.checklog.checker import check_log
 from helmcheck.profile import DEFAULT
 from tests.test_judge_vehicle_readings import LAT, LON, poll, write  # the hand-made wire logs
 

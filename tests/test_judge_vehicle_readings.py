@@ -13,7 +13,7 @@ from pathlib import Path
 
 import pytest
 
-from helmcheck.conformance.checklog.checker import check_log
+from helmcheck.checklog.checker import check_log
 from helmcheck.grammar import checksum_hex
 from helmcheck.grammar.wirelog import escape
 from helmcheck.profile import DEFAULT

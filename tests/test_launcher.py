@@ -1,4 +1,4 @@
-"""The process launcher of ``--exec`` (:mod:`helmcheck.conformance.launcher`), with real processes.
+"""The process launcher of ``--exec`` (:mod:`helmcheck.line.launcher`), with real processes.
 
 Argument building (placeholders, the port appended when ``{port}`` is absent, shlex, no shell),
 command checks, output capture and its tail, exit codes and signals, and stopping: SIGTERM to the
@@ -16,7 +16,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from helmcheck.conformance.launcher import TAIL_LINES, CommandError, Launcher, build_argv, check_command
+from helmcheck.line.launcher import TAIL_LINES, CommandError, Launcher, build_argv, check_command
 from tests.processes import descendants, survivors
 
 PY = shlex.quote(sys.executable)

@@ -9,7 +9,10 @@ import only its own layer and the layers below it:
   (``helmcheck/judge``);
 * ``reports`` (``helmcheck/reports``) sits beside the judge: it reads what the judge decided and
   may import it, never the other way round, and never a driver or a command;
-* ``drivers`` (``helmcheck/conformance``): the emulator, the live certifiers, the offline checker;
+* the drivers, lowest first: ``line`` (``helmcheck/line``: ports, the recorder, the implementation
+  under test as a process), ``emulator`` (``helmcheck/emulator``), ``checklog``
+  (``helmcheck/checklog``: the offline checker) and ``certify`` (``helmcheck/certify``: the live
+  certifiers, which may run the emulator in-process to plan a run);
 * ``commands`` (``helmcheck/commands``, ``helmcheck/cli.py`` and the other entry points).
 
 :func:`upward_imports` parses every module (no import is executed), resolves ``import
@@ -30,7 +33,8 @@ import pytest
 ROOT = Path(__file__).resolve().parents[1] / "helmcheck"
 
 #: The layers, lowest first: a module may import its own layer and those before it.
-LAYERS = ("foundation", "grammar", "model", "judge", "reports", "drivers", "commands")
+LAYERS = ("foundation", "grammar", "model", "judge", "reports", "line", "emulator", "checklog", "certify",
+          "commands")
 RANK = {name: i for i, name in enumerate(LAYERS)}
 
 #: Subpackages of ``helmcheck`` and their layer.
@@ -40,7 +44,10 @@ PACKAGES = {
     "model": "model",
     "judge": "judge",
     "reports": "reports",
-    "conformance": "drivers",
+    "line": "line",
+    "emulator": "emulator",
+    "checklog": "checklog",
+    "certify": "certify",
     "commands": "commands",
 }
 
@@ -56,7 +63,7 @@ TOP_LEVEL = {
     "profile_template": "foundation",  # the `profile init` template; imports profile, profile_toml
     "clauses": "foundation",  # the clause catalogue; standard library and the spec package data
     "outputs": "reports",  # report directories and output files; imports failures, reports.atomic
-    "demo": "drivers",  # `python -m helmcheck.demo`; imports the emulator and the vehicle certifier
+    "demo": "certify",  # `python -m helmcheck.demo`; imports the emulator and the vehicle certifier
     "pytest_plugin": "commands",  # the pytest11 entry point; runs the certifiers and the backseat command
     "cli": "commands",  # the `helmcheck` entry point; dispatches to helmcheck.commands
     "__main__": "commands",  # `python -m helmcheck`; imports cli
@@ -177,13 +184,19 @@ _DOWNWARD = {
     "judge/wire.py": "from helmcheck.grammar import codec\nfrom ..grammar.codec import math\n",
     "reports/__init__.py": "",
     "reports/verify.py": "from ..judge.wire import codec\nimport helmcheck.profile\n",
-    "conformance/__init__.py": "",
-    "conformance/checklog/__init__.py": "",
-    "conformance/checklog/checker.py": "from ...reports import verify\nfrom ...judge import wire\n",
+    "line/__init__.py": "",
+    "line/transport.py": "from ..grammar import codec\n",
+    "emulator/__init__.py": "",
+    "emulator/core.py": "from ..line import transport\nfrom ..judge import wire\n",
+    "checklog/__init__.py": "",
+    "checklog/checker.py": "from ..reports import verify\nfrom ..judge import wire\n",
+    "certify/__init__.py": "",
+    "certify/vehicle/__init__.py": "",
+    "certify/vehicle/runner.py": "from ...emulator import core\nfrom ...line.transport import codec\n",
     "commands/__init__.py": "",
-    "commands/verify_cmd.py": ("def run():\n    from ..conformance.checklog.checker import check_log\n"
+    "commands/verify_cmd.py": ("def run():\n    from ..checklog.checker import check_log\n"
                                "    from ..reports.verify import verify\n"
-                               "MODULES = ['helmcheck.conformance.checklog.checker']\n"),
+                               "MODULES = ['helmcheck.checklog.checker']\n"),
     "cli.py": "from .commands import verify_cmd\n",
 }
 
@@ -193,19 +206,24 @@ def test_the_check_passes_a_tree_whose_imports_run_down(tmp_path):
 
 
 @pytest.mark.parametrize("name, text, says", [
-    ("judge/wire.py", "from ..conformance.checklog import checker\n",
-     "helmcheck/judge/wire.py:1: helmcheck.judge.wire (judge) imports helmcheck.conformance.checklog.checker "
-     "(drivers) upward: `from ..conformance.checklog import checker`"),
-    ("reports/verify.py", "def f():\n    from helmcheck.conformance.checklog.checker import check_log\n",
+    ("judge/wire.py", "from ..checklog import checker\n",
+     "helmcheck/judge/wire.py:1: helmcheck.judge.wire (judge) imports helmcheck.checklog.checker "
+     "(checklog) upward: `from ..checklog import checker`"),
+    ("reports/verify.py", "def f():\n    from helmcheck.checklog.checker import check_log\n",
      "helmcheck/reports/verify.py:2: helmcheck.reports.verify (reports) imports "
-     "helmcheck.conformance.checklog.checker (drivers) upward"),
+     "helmcheck.checklog.checker (checklog) upward"),
+    ("emulator/core.py", "from ..certify.vehicle import runner\n",
+     "helmcheck/emulator/core.py:1: helmcheck.emulator.core (emulator) imports "
+     "helmcheck.certify.vehicle.runner (certify) upward"),
+    ("line/transport.py", "from ..emulator import core\n",
+     "helmcheck/line/transport.py:1: helmcheck.line.transport (line) imports helmcheck.emulator.core (emulator)"),
     ("reports/verify.py", "import helmcheck.commands.verify_cmd\n",
      "helmcheck/reports/verify.py:1: helmcheck.reports.verify (reports) imports helmcheck.commands.verify_cmd"),
-    ("conformance/checklog/checker.py", "from ... import cli\n",
-     "helmcheck/conformance/checklog/checker.py:1: helmcheck.conformance.checklog.checker (drivers) imports "
-     "helmcheck.cli (commands) upward: `from ... import cli`"),
-    ("conformance/checklog/checker.py", "ROLES = {'x': 'helmcheck.commands.verify_cmd'}\n",
-     "helmcheck/conformance/checklog/checker.py:1: helmcheck.conformance.checklog.checker (drivers) imports "
+    ("checklog/checker.py", "from .. import cli\n",
+     "helmcheck/checklog/checker.py:1: helmcheck.checklog.checker (checklog) imports "
+     "helmcheck.cli (commands) upward: `from .. import cli`"),
+    ("checklog/checker.py", "ROLES = {'x': 'helmcheck.commands.verify_cmd'}\n",
+     "helmcheck/checklog/checker.py:1: helmcheck.checklog.checker (checklog) imports "
      "helmcheck.commands.verify_cmd (commands) upward"),
     ("judge/wire.py", "from ..reports.verify import x\n",
      "helmcheck/judge/wire.py:1: helmcheck.judge.wire (judge) imports helmcheck.reports.verify (reports)"),

@@ -18,7 +18,7 @@ from html.parser import HTMLParser
 import pytest
 
 from helmcheck.clauses import catalogue
-from helmcheck.conformance.vehicle.runner import Options, certify
+from helmcheck.certify.vehicle.runner import Options, certify
 from helmcheck.reports.matrix import MatrixRun, column_label, columns, render_matrix_html, render_matrix_markdown
 from helmcheck.reports.results import add_clause, finish, new_results
 from helmcheck.reports.view import VERDICT_LABEL

@@ -70,7 +70,7 @@ def test_end_and_srp_missions_are_string_keys(tmp_path):
 def test_the_emulator_profile_names_what_the_emulator_ships():
     """``helmcheck/profiles/emulator.toml``: the ``$OXFLT`` extension and the missions the emulator
     ships, every one of them present in its built-in catalogue."""
-    from helmcheck.conformance.emulator.missionfile import builtin_dir
+    from helmcheck.emulator.missionfile import builtin_dir
     from helmcheck.profile import emulator_profile
 
     emu = emulator_profile()
@@ -83,7 +83,7 @@ def test_the_emulator_profile_names_what_the_emulator_ships():
 
 
 def test_empty_end_or_srp_mission_makes_its_case_not_tested():
-    from helmcheck.conformance.vehicle.catalogue import CASES, unmet_need
+    from helmcheck.certify.vehicle.catalogue import CASES, unmet_need
     from helmcheck.profile import emulator_profile
     end = next(c for c in CASES if c.subject == "RH-MSN-4")
     srp = next(c for c in CASES if c.subject == "RH-SAF-4" and "srp_mission" in c.needs)

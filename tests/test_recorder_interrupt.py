@@ -11,7 +11,7 @@ import threading
 
 import pytest
 
-from helmcheck.conformance.recorder import Recorder
+from helmcheck.line.recorder import Recorder
 from helmcheck.failures import Interrupted
 from helmcheck.signals import deferred, ending_signals
 

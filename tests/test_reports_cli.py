@@ -1,4 +1,5 @@
-"""``helmcheck report`` / ``python -m helmcheck.reports``: outputs, exit codes, error lines."""
+"""``helmcheck report``: outputs, exit codes, error lines (the one command line that renders a
+results directory; ``helmcheck.reports`` has no entry point of its own)."""
 
 from __future__ import annotations
 
@@ -10,10 +11,15 @@ from pathlib import Path
 
 import pytest
 
-from helmcheck.reports.render import main, render_all
+from helmcheck.cli import main as cli_main
+from helmcheck.reports.render import render_all
 
 ROOT = Path(__file__).resolve().parents[1]
 FIXTURES = Path(__file__).parent / "fixtures" / "reports"
+
+
+def main(argv: list[str]) -> int:
+    return cli_main(["report", *argv])
 
 
 @pytest.fixture
@@ -46,7 +52,7 @@ def test_render_all_returns_paths_and_rejects_unknown_formats(run_dir):
 def test_usage_errors_exit_64(argv, capsys):
     assert main(argv) == 64
     err = capsys.readouterr().err
-    assert "usage: helmcheck report" in err
+    assert err.startswith("helmcheck report: error: ") and err.count("\n") == 1
 
 
 def test_help_exits_0(capsys):
@@ -54,18 +60,18 @@ def test_help_exits_0(capsys):
     assert "--compare" in capsys.readouterr().out
 
 
-def test_unreadable_results_exit_2_with_one_line_naming_the_file(tmp_path, capsys):
+def test_unreadable_results_exit_64_with_one_line_naming_the_file(tmp_path, capsys):
     (tmp_path / "results.json").write_text("{garbage", encoding="utf-8")
-    assert main([str(tmp_path)]) == 2
+    assert main([str(tmp_path)]) == 64
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and str(tmp_path / "results.json") in err and "not valid JSON" in err
     assert not (tmp_path / "report.html").exists()
 
 
-def test_missing_directory_and_missing_compare_dir_exit_2(run_dir, tmp_path, capsys):
-    assert main([str(tmp_path / "nowhere")]) == 2
+def test_missing_directory_and_missing_compare_dir_exit_64(run_dir, tmp_path, capsys):
+    assert main([str(tmp_path / "nowhere")]) == 64
     assert "nowhere" in capsys.readouterr().err
-    assert main([str(run_dir), "--compare", str(tmp_path / "old")]) == 2
+    assert main([str(run_dir), "--compare", str(tmp_path / "old")]) == 64
     assert str(tmp_path / "old") in capsys.readouterr().err
 
 
@@ -91,12 +97,11 @@ def test_unwritable_directory_exits_2(run_dir, capsys):
     assert not [p for p in os.listdir(run_dir) if p.endswith(".tmp")]
 
 
-def test_python_dash_m_entry_point(run_dir):
-    env = dict(os.environ, PYTHONPATH=str(ROOT))
-    ok = subprocess.run([sys.executable, "-m", "helmcheck.reports", str(run_dir), "--format", "md"],
-                        capture_output=True, text=True, env=env, timeout=60)
-    assert ok.returncode == 0, ok.stderr
-    assert (run_dir / "report.md").exists()
-    bad = subprocess.run([sys.executable, "-m", "helmcheck.reports"], capture_output=True, text=True, env=env,
-                         timeout=60)
-    assert bad.returncode == 64 and "usage:" in bad.stderr
+def test_the_reports_package_has_no_command_line_of_its_own():
+    """``helmcheck report`` is the one way (the command line lives in ``helmcheck.commands``)."""
+    import importlib.util
+
+    assert importlib.util.find_spec("helmcheck.reports.__main__") is None
+    proc = subprocess.run([sys.executable, "-m", "helmcheck", "report"], capture_output=True, text=True,
+                          env=dict(os.environ, PYTHONPATH=str(ROOT)), timeout=60)
+    assert proc.returncode == 64 and proc.stderr.startswith("helmcheck report: error: ")

@@ -7,7 +7,7 @@ import time
 
 import pytest
 
-from helmcheck.conformance.transport import (LinePacer, LinkClosed, PtyLink, SerialLink, TcpClientLink,
+from helmcheck.line.transport import (LinePacer, LinkClosed, PtyLink, SerialLink, TcpClientLink,
                                              TcpServerLink, open_link, parse_port_spec)
 
 

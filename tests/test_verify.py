@@ -18,7 +18,7 @@ from pathlib import Path
 import pytest
 
 from helmcheck.cli import main as cli_main
-from helmcheck.conformance.emulator.process import EmulatorProcess
+from helmcheck.emulator.process import EmulatorProcess
 from helmcheck.profile import load_profile
 from helmcheck.profile_toml import emit_profile
 from helmcheck.reports.manifest import sha256_file

@@ -33,7 +33,7 @@ import pytest
 from junitparser import Error, Failure, JUnitXml
 
 from helmcheck.cli import main as cli_main
-from helmcheck.conformance.vehicle.runner import Options, certify
+from helmcheck.certify.vehicle.runner import Options, certify
 from helmcheck.reports.results import finish, load_results, write_results_atomic
 from tests.faulty_vehicles import EMU_PROFILE, MUTANTS, make_core, serve
 

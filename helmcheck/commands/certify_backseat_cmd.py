@@ -3,8 +3,8 @@
 The command opens the port (``--port pty`` prints ``port: /dev/pts/N`` as its first line on
 standard output, flushed, for the backseat to open; a device path is opened 8N1 at the
 profile's baud; ``socket://HOST:PORT`` serves one client), plays the reference vehicle, stages
-the scenarios of :mod:`helmcheck.conformance.backseat.scenarios` with the driver's
-:class:`~helmcheck.conformance.backseat.runner.Runner` and judges every byte the backseat sends
+the scenarios of :mod:`helmcheck.certify.backseat.scenarios` with the driver's
+:class:`~helmcheck.certify.backseat.runner.Runner` and judges every byte the backseat sends
 (:class:`helmcheck.judge.backseat.BackseatObserver`, the judge ``check-log`` uses too).
 At the end (also after Ctrl-C, SIGTERM or SIGHUP — :mod:`helmcheck.signals` raises them as
 ``KeyboardInterrupt`` —, a backseat that never connected or one that went away) it writes
@@ -15,7 +15,7 @@ line on standard output and exits 0 (pass; non-strict without ``--strict``), 1 (
 earlier run without ``--overwrite``). Progress goes to standard error.
 
 With ``--exec CMD`` helmcheck starts the backseat itself once the port is open and stops it at
-the end (:mod:`helmcheck.conformance.backseat.process`); a backseat that exits or dies before
+the end (:mod:`helmcheck.certify.backseat.process`); a backseat that exits or dies before
 the end fails the run.
 """
 
@@ -30,7 +30,7 @@ from datetime import datetime, timezone
 from pathlib import Path
 from typing import Any, Callable, Optional
 
-from ..conformance.backseat.scenarios import SCENARIOS
+from ..certify.backseat.scenarios import SCENARIOS
 from ..failures import UsageError, describe_interrupt
 
 __all__ = ["add_arguments", "run", "EPILOG"]
@@ -142,8 +142,8 @@ def run(args: argparse.Namespace, *, on_port: Optional[Callable[[str], None]] = 
     once the port is open (after the ``port:`` line), for callers that start the backseat."""
     from ..judge.timing import JITTER_S
     from ..profile import ProfileError, load_profile
-    from ..conformance.backseat.scenarios import make_plan
-    from ..conformance.transport import BAUD_RATES, parse_port_spec
+    from ..certify.backseat.scenarios import make_plan
+    from ..line.transport import BAUD_RATES, parse_port_spec
 
     try:
         profile = load_profile(args.profile)
@@ -158,7 +158,7 @@ def run(args: argparse.Namespace, *, on_port: Optional[Callable[[str], None]] = 
         raise UsageError(f"--connect-timeout must be a positive number of seconds (got {args.connect_timeout})")
     exec_cmd = getattr(args, "exec_cmd", None)
     if exec_cmd is not None:
-        from ..conformance.launcher import check_command
+        from ..line.launcher import check_command
         why = check_command(exec_cmd)
         if why:
             raise UsageError(f"--exec: {why}")
@@ -199,7 +199,7 @@ def run(args: argparse.Namespace, *, on_port: Optional[Callable[[str], None]] = 
 
 def _open_outputs_and_port(args, spec, profile, report_dir: Path):
     """(link, wire-log stream): paths checked, port opened, report directory prepared."""
-    from ..conformance.backseat.link import HangupPty
+    from ..certify.backseat.link import HangupPty
     from ..outputs import check_writable, open_output_stream, prepare_report_dir
     from .ports import open_port
 
@@ -231,8 +231,8 @@ def _certify(args, profile, spec, plan, report_dir: Path, log_file, settings, co
                 sys.stdout.flush()
             except OSError:
                 pass
-            from ..conformance.emulator.missionfile import DirectoryCatalog, builtin_dir  # after the port line
-            from ..conformance.backseat.runner import Runner
+            from ..emulator.missionfile import DirectoryCatalog, builtin_dir  # after the port line
+            from ..certify.backseat.runner import Runner
             meta = [f"started {started_dt.strftime('%Y-%m-%dT%H:%M:%S.%fZ')}  port {link.name}  "
                     f"baud {profile.baud}  time_scale {profile.time_scale:g}"]
             print(f"helmcheck certify backseat: {link.description}, profile {profile.name}, time scale "
@@ -248,7 +248,7 @@ def _certify(args, profile, spec, plan, report_dir: Path, log_file, settings, co
                             missions=DirectoryCatalog([builtin_dir()]), log=log_file, meta=meta,
                             connect_timeout=args.connect_timeout, progress=progress)
             if getattr(args, "exec_cmd", None):
-                from ..conformance.backseat.process import start_backseat
+                from ..certify.backseat.process import start_backseat
                 try:
                     runner.child = child = start_backseat(args.exec_cmd, link.name, report_dir,
                                                           time_scale=profile.time_scale, grace_s=args.exec_grace)
@@ -279,7 +279,7 @@ def _certify(args, profile, spec, plan, report_dir: Path, log_file, settings, co
     from ..reports.render import render_all
     from ..reports.results import ReportError, exit_code
     from ..reports.scope import headline
-    from ..conformance.backseat.report import build_results
+    from ..certify.backseat.report import build_results
 
     results = build_results(outcome, profile=profile, settings=settings, command=command,
                             port=link.name if link is not None else args.port, started=started,

@@ -2,8 +2,8 @@
 
 Each role's command line is its own module (:mod:`.certify_vehicle_cmd`,
 :mod:`.certify_backseat_cmd`) exposing ``add_arguments(parser)``, ``run(args) -> int`` and
-``EPILOG``; the certifiers they drive are ``helmcheck.conformance.vehicle`` and
-``helmcheck.conformance.backseat``.
+``EPILOG``; the certifiers they drive are ``helmcheck.certify.vehicle`` and
+``helmcheck.certify.backseat``.
 """
 
 from __future__ import annotations

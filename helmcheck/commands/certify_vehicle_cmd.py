@@ -3,9 +3,9 @@
 ``add_arguments(parser)`` and ``run(args) -> int`` are what
 :mod:`helmcheck.commands.certify_cmd` dispatches to; :data:`EPILOG` is the ``--help`` epilog.
 The certification itself is the driver's library entry point,
-:func:`helmcheck.conformance.vehicle.runner.certify`; this module is its command line.
+:func:`helmcheck.certify.vehicle.runner.certify`; this module is its command line.
 Exit status: 0 pass (or non-strict without ``--strict``), 1 fail, 2 inconclusive, 64 usage.
-``--plan`` (:mod:`helmcheck.conformance.vehicle.plan`) estimates the run instead, and opens no
+``--plan`` (:mod:`helmcheck.certify.vehicle.plan`) estimates the run instead, and opens no
 port and writes no file. The port is opened here, once, before anything is written
 (:mod:`helmcheck.commands.ports`: one that cannot be opened is exit 64); the report directory is
 checked first and cleared with ``--overwrite`` (:mod:`helmcheck.outputs`); the reports are
@@ -143,8 +143,8 @@ def run(args: argparse.Namespace) -> int:  # noqa: C901 - argument checks, then 
     from ..failures import OutputLost
     from ..outputs import OutputStream, check_writable, prepare_report_dir
     from ..profile import load_profile
-    from ..conformance.transport import BAUD_RATES
-    from ..conformance.vehicle.runner import Options, certify
+    from ..line.transport import BAUD_RATES
+    from ..certify.vehicle.runner import Options, certify
     from .ports import open_port, port_spec
 
     if args.resume is not None:
@@ -163,7 +163,7 @@ def run(args: argparse.Namespace) -> int:  # noqa: C901 - argument checks, then 
     if args.plan or args.json or args.missions is not None:
         return _plan(args, profile, k)
     if args.exec_cmd is not None:
-        from ..conformance.launcher import check_command
+        from ..line.launcher import check_command
         why = check_command(args.exec_cmd)
         if why:
             raise UsageError(f"--exec: {why}")
@@ -224,7 +224,7 @@ def run(args: argparse.Namespace) -> int:  # noqa: C901 - argument checks, then 
     sys.stdout.flush()
     restore = out.results.get("restore")
     if restore is not None and restore.get("attempted") and not restore.get("verified"):
-        from ..conformance.vehicle.restore import unverified_text
+        from ..certify.vehicle.restore import unverified_text
         print(f"helmcheck certify vehicle: {unverified_text(restore)}", file=sys.stderr)
     _finish_outputs(out.report_dir, wire, args.wire_log)
     return out.exit_code
@@ -298,7 +298,7 @@ def _hypothesis_profile(args: argparse.Namespace, k: float) -> str:
 
 
 def _plan(args: argparse.Namespace, profile, k: float) -> int:
-    """``--plan``: the estimate (:mod:`helmcheck.conformance.vehicle.plan`) on standard output; no port, no file touched."""
+    """``--plan``: the estimate (:mod:`helmcheck.certify.vehicle.plan`) on standard output; no port, no file touched."""
     import json
 
     if not args.plan:
@@ -309,7 +309,7 @@ def _plan(args: argparse.Namespace, profile, k: float) -> int:
         missions = Path(args.missions)
         if not missions.is_dir():
             raise UsageError(f"--missions: {args.missions} is not a directory")
-    from ..conformance.vehicle.plan import estimate, render_text, as_json
+    from ..certify.vehicle.plan import estimate, render_text, as_json
     plan = estimate(profile, k, select=select, examples=args.examples,
                     hypothesis_profile=_hypothesis_profile(args, k), missions_dir=missions)
     if args.json:

@@ -1,6 +1,6 @@
 """``helmcheck check-log``: check recorded serial logs against the reference model, offline.
 
-The command owns the command line only; the work is :mod:`helmcheck.conformance.checklog`.
+The command owns the command line only; the work is :mod:`helmcheck.checklog`.
 Exit status, like the certifiers: 0 conformant (every judged clause passes, or non-strict
 without ``--strict``), 1 a clause failed, 2 inconclusive (nothing failed, something could not be
 judged; or a report that could not be written), 64 usage (bad option, unreadable or
@@ -78,8 +78,8 @@ def run(args: argparse.Namespace) -> int:  # noqa: C901 - argument checks, then 
     from ..profile import load_profile
     from ..reports import results as R
     from ..reports.results import ReportError
-    from ..conformance.checklog.checker import LogFormatError, check_log
-    from ..conformance.checklog.report import write_report_dir
+    from ..checklog.checker import LogFormatError, check_log
+    from ..checklog.report import write_report_dir
 
     profile = load_profile(args.profile)  # a ProfileError is exit 64 (helmcheck.cli)
     if args.profile is None:
@@ -89,7 +89,7 @@ def run(args: argparse.Namespace) -> int:  # noqa: C901 - argument checks, then 
         raise UsageError(f"--time-scale must be positive (got {args.time_scale})")
     catalog = None
     if args.missions is not None:
-        from ..conformance.emulator.missionfile import DirectoryCatalog
+        from ..emulator.missionfile import DirectoryCatalog
         if not Path(args.missions).is_dir():
             raise PathError(f"--missions: {args.missions} is not a directory")
         catalog = DirectoryCatalog([Path(args.missions)])

@@ -2,7 +2,7 @@
 
 The emulator answers exactly as the reference model does (:mod:`helmcheck.model`); it adds
 plant dynamics, mission files, the settings store and the main log
-(:mod:`helmcheck.conformance.emulator`). The first line on standard output is
+(:mod:`helmcheck.emulator`). The first line on standard output is
 ``port: <what to open>`` (flushed), so scripts and backseats can connect; everything else goes
 to standard error (or the live view with ``--tui``). SIGINT, SIGTERM and SIGHUP stop it with
 exit 0; bad arguments, a malformed profile, a port or file that cannot be opened exit 64 with a
@@ -100,7 +100,7 @@ def _check_settings_file(path: str) -> None:
 
 
 def run(args: argparse.Namespace) -> int:  # noqa: C901 - argument checks, then one call
-    from ..conformance.transport import BAUD_RATES
+    from ..line.transport import BAUD_RATES
     from ..outputs import check_writable, is_regular_or_new, open_output_stream
     from ..profile import load_profile
     from .ports import port_spec
@@ -165,7 +165,7 @@ def run(args: argparse.Namespace) -> int:  # noqa: C901 - argument checks, then 
 
 def _emulator_settings(args: argparse.Namespace):
     """The ``[emulator]`` table of ``--profile``, then each ``--set`` (a ``ValueError`` names a bad one)."""
-    from ..conformance.emulator.freedoms import DEFAULT_SETTINGS, parse_assignment, settings_from_dict
+    from ..emulator.freedoms import DEFAULT_SETTINGS, parse_assignment, settings_from_dict
     from ..profile import load_emulator_table
 
     st = settings_from_dict(load_emulator_table(args.profile), where=f"{args.profile}: [emulator]",
@@ -185,9 +185,9 @@ def _serve(args, profile, link, baud, missions_dir, log_file, main_log_file, cho
 
     log = server = ui = core = None
     try:
-        from ..conformance.emulator.core import EmulatorCore, MainLog
-        from ..conformance.emulator.missionfile import DirectoryCatalog, builtin_dir
-        from ..conformance.emulator.server import Server
+        from ..emulator.core import EmulatorCore, MainLog
+        from ..emulator.missionfile import DirectoryCatalog, builtin_dir
+        from ..emulator.server import Server
         from ..grammar.wirelog import WireLogWriter
         dirs = ([missions_dir] if missions_dir is not None else []) + [builtin_dir()]
         catalog = DirectoryCatalog(dirs)
@@ -205,7 +205,7 @@ def _serve(args, profile, link, baud, missions_dir, log_file, main_log_file, cho
                             on_error=None if args.tui else lambda text: print(f"helmcheck emulate: {text}",
                                                                               file=sys.stderr))
         if args.tui:
-            from ..conformance.emulator.tui import LiveView
+            from ..emulator.tui import LiveView
             ui = LiveView(core, link.name)
         server = Server(link, core, ui=ui, install_signals=False)
         _operator_trips(server)  # before the port is announced: a trip is never fatal
@@ -215,7 +215,7 @@ def _serve(args, profile, link, baud, missions_dir, log_file, main_log_file, cho
               f"{profile.time_scale:g}, baud {baud or 'unpaced'}, fault injection "
               f"{profile.fault_injection}, missions {', '.join(str(d) for d in dirs)}", file=sys.stderr)
         if choices is not None and not choices.is_default:
-            from ..conformance.emulator.freedoms import nonconforming
+            from ..emulator.freedoms import nonconforming
             print(f"helmcheck emulate: settings {' '.join(choices.assignments())}", file=sys.stderr)
             for why in nonconforming(choices, profile):
                 print(f"helmcheck emulate: warning: not a conforming vehicle: {why}", file=sys.stderr)

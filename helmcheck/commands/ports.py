@@ -15,7 +15,7 @@ from __future__ import annotations
 import os
 from typing import Callable, Optional
 
-from ..conformance.transport import Link, PortSpec, open_link, parse_port_spec
+from ..line.transport import Link, PortSpec, open_link, parse_port_spec
 from ..failures import PathError, UsageError
 
 __all__ = ["port_spec", "open_port"]

@@ -1,7 +1,7 @@
 """``helmcheck replay FILE --port URL``: re-drive a saved failing sequence against a vehicle.
 
 The replay file (written by ``helmcheck certify vehicle`` when exploration finds a failure, see
-:mod:`helmcheck.conformance.vehicle.replay`) lists the exact bytes sent and the protocol waits.
+:mod:`helmcheck.certify.vehicle.replay`) lists the exact bytes sent and the protocol waits.
 Every reply is judged again by the present reference model. Exit status: 1 it still fails,
 0 it passes now, 2 inconclusive (link fault, a step not sent; a wire log that could not be
 written), 64 usage (bad option, unreadable replay file or profile, a port that cannot be opened).
@@ -40,11 +40,11 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
 
 def run(args: argparse.Namespace) -> int:
     from ..clauses import vehicle_clauses
-    from ..conformance.recorder import Recorder
-    from ..conformance.vehicle.flow import LinkLost
-    from ..conformance.vehicle.link import TesterLink
-    from ..conformance.vehicle.replay import ReplayError, load_replay
-    from ..conformance.vehicle.session import Session
+    from ..line.recorder import Recorder
+    from ..certify.vehicle.flow import LinkLost
+    from ..certify.vehicle.link import TesterLink
+    from ..certify.vehicle.replay import ReplayError, load_replay
+    from ..certify.vehicle.session import Session
     from ..judge import Ledger
     from ..judge.vehicle import VehicleObserver
     from ..failures import PathError, UsageError
@@ -86,7 +86,7 @@ def run(args: argparse.Namespace) -> int:
     try:
         if args.wire_log:
             log = open_output_stream(args.wire_log, "--wire-log", stop=False, what="wire log")
-        from ..conformance.vehicle.replay import redrive
+        from ..certify.vehicle.replay import redrive
         ledger = Ledger([c.id for c in vehicle_clauses()])
         observer = VehicleObserver(profile, ledger, time_scale=k, baud=profile.baud)
         recorder = Recorder(log, [f"replay {args.file} port {args.port} time_scale {k:g}"], [observer])

@@ -9,18 +9,37 @@ written is exit 2 naming the file. Each report is written atomically.
 from __future__ import annotations
 
 import argparse
+from pathlib import Path
 
 from ..reports import render
 
 
+def _formats(value: str) -> list[str]:
+    names = [v.strip() for v in value.split(",") if v.strip()]
+    bad = [n for n in names if n not in render.OUTPUT_NAMES]
+    if bad or not names:
+        raise argparse.ArgumentTypeError(
+            f"unknown format {', '.join(bad) or repr(value)}; choose from {','.join(render.FORMATS)}")
+    return names
+
+
 def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p = sub.add_parser("report", help="render results.json to HTML, JUnit XML and Markdown",
-                       description=render.__doc__.strip().splitlines()[0] if render.__doc__ else None,
+                       description="Rebuild the compliance reports of a results directory (nothing is "
+                                   "re-run): DIR/report.html, DIR/junit.xml and DIR/report.md, each "
+                                   "written atomically.",
                        formatter_class=argparse.RawDescriptionHelpFormatter,
                        epilog="exit status: 0 written; 1 with --fail-on-regression, when a clause "
                               "regressed or lost coverage; 2 a report could not be written; 64 usage "
                               "(bad option, an unreadable or invalid results directory).")
-    render.add_arguments(p)
+    p.add_argument("directory", metavar="DIR", type=Path, help="results directory holding results.json and wire.log")
+    p.add_argument("--format", dest="formats", type=_formats, default=list(render.FORMATS),
+                   metavar="LIST", help="comma-separated formats to write: html,junit,md (default: all)")
+    p.add_argument("--compare", dest="compare_dir", type=Path, metavar="OLD_DIR",
+                   help="an earlier results directory to compare with")
+    p.add_argument("--fail-on-regression", action="store_true",
+                   help="with --compare: exit 1 when a clause regressed or lost coverage (judged before, "
+                        "not judged now)")
     p.set_defaults(func=run)
     return p
 

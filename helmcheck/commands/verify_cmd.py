@@ -2,7 +2,7 @@
 
 :func:`verify_run` is the verification: it runs the checks of :mod:`helmcheck.reports.verify` in
 their order and re-judges the wire log under the recorded profile with the offline checker
-(:func:`helmcheck.conformance.checklog.check_log`, a driver, which is why this runs here and not
+(:func:`helmcheck.checklog.check_log`, a driver, which is why this runs here and not
 in the reports package), then compares every clause verdict, the run verdict and the certificate
 flag with ``results.json``, checks the recorded digests, and checks the signature when the run
 is signed (against ``--public-key`` when given).
@@ -57,7 +57,7 @@ def verify_run(directory: Path | str, public_key=None, *, public_key_name: str =
 
     *public_key*: a trusted Ed25519 public key, or ``None``. A directory that is not a results
     directory raises :class:`~helmcheck.reports.verify.VerifyUsageError`."""
-    from ..conformance.checklog.checker import LogFormatError, check_log
+    from ..checklog.checker import LogFormatError, check_log
     from ..reports.verify import check_digests, check_profile, check_signature, compare_rejudged, open_run, rejudging
 
     directory = Path(directory)

@@ -30,7 +30,7 @@ This module owns all of it; nothing else in helmcheck writes or parses a record:
   (``certify vehicle --resume``); :func:`parse_record` reads one line (``helmcheck parse``);
 * **the writer** — :class:`WireLogWriter`: the header, then one record a line, flushed record by
   record (the emulator; the certifiers and ``replay`` through
-  :class:`~helmcheck.conformance.recorder.Recorder`).
+  :class:`~helmcheck.line.recorder.Recorder`).
 
 Pure text processing: no clock, and no I/O beyond the lines and the stream it is handed.
 """

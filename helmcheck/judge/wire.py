@@ -10,7 +10,7 @@ offline log check — hands it the same :class:`WireEvent` s, in order:
 A :class:`WireEvent` is a wire-log record: it and the directions are defined with the format
 in :mod:`helmcheck.grammar.wirelog`, and re-exported here for the judges. A live run writes every
 event to its wire log *and* feeds it to the judge with the time and line number it was written
-with (:class:`helmcheck.conformance.recorder.Recorder`); an offline check reads the same records
+with (:class:`helmcheck.line.recorder.Recorder`); an offline check reads the same records
 back with the same module's reader. So one log gives one verdict, whoever reads it.
 
 Notes a judge acts on (anything else is kept as evidence only); the words are part of the

@@ -16,7 +16,7 @@ Modules, one concern each:
 * :mod:`~helmcheck.reports.timeline` — the mode timeline SVG.
 * :mod:`~helmcheck.reports.html`, :mod:`~helmcheck.reports.junit`,
   :mod:`~helmcheck.reports.markdown`, :mod:`~helmcheck.reports.compare` — the renderings.
-* :mod:`~helmcheck.reports.render` — :func:`render_all` and the ``helmcheck report`` command.
+* :mod:`~helmcheck.reports.render` — :func:`render_all` (the command line is ``helmcheck report``).
 * :mod:`~helmcheck.reports.matrix` — several runs side by side (``helmcheck matrix``).
 
 Certificates (issue: certificates anyone can verify):
@@ -32,7 +32,7 @@ Certificates (issue: certificates anyone can verify):
 """
 
 from .digest import Digest, digest_bytes, digest_dir
-from .render import main, render_all
+from .render import render_all
 from .results import (
     CLAUSE_VERDICTS,
     VERDICTS,
@@ -70,7 +70,6 @@ __all__ = [
     "finish",
     "load_results",
     "load_run",
-    "main",
     "new_results",
     "overall_verdict",
     "render_all",

@@ -1,9 +1,9 @@
 """The one way from judge to certificate: ledger + run facts → clause entries, run verdict, scope.
 
 :func:`assemble` is called by every producer of a results document — ``certify vehicle``
-(:mod:`helmcheck.conformance.vehicle.runner`), ``certify backseat``
-(:mod:`helmcheck.conformance.backseat.report`), ``check-log``
-(:mod:`helmcheck.conformance.checklog.report`) — and by ``helmcheck verify``
+(:mod:`helmcheck.certify.vehicle.runner`), ``certify backseat``
+(:mod:`helmcheck.certify.backseat.report`), ``check-log``
+(:mod:`helmcheck.checklog.report`) — and by ``helmcheck verify``
 (:mod:`.verify`), which runs it again on the evidence and compares. Its inputs:
 
 * the verdict ledger of the role's observer (:class:`helmcheck.judge.ledger.Ledger`), or the
@@ -59,7 +59,7 @@ def assemble(role: str, judged: Any, facts: Optional[RunFacts] = None, *, strict
     """Assemble one run (module docstring).
 
     *judged*: a :class:`~helmcheck.judge.ledger.Ledger` (the facts are booked into it here) or
-    its entries (already booked, as :func:`helmcheck.conformance.checklog.check_log` returns
+    its entries (already booked, as :func:`helmcheck.checklog.check_log` returns
     them). *partial*: ``None`` takes it from the facts (a ``run partial`` note); ``True`` for a
     run still in progress. *lead*: a sentence put before the verdict reason (why the run
     stopped; not when the implementation ended early, whose end the reason quotes); it changes

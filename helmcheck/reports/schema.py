@@ -259,7 +259,7 @@ def _check_process(ck: _Checker, process: Any) -> None:
 
 
 def _check_restore(ck: _Checker, restore: Any) -> None:
-    """The vehicle left as found (``helmcheck.conformance.vehicle.restore``)."""
+    """The vehicle left as found (``helmcheck.certify.vehicle.restore``)."""
     if not ck.obj("restore", restore):
         return
     for key in ("attempted", "verified"):

@@ -13,7 +13,7 @@
    says which wire log to re-judge, as which role (``vehicle`` or ``backseat`` as recorded) and
    at which time scale (the profile's);
 5. the wire log is **re-judged** under that profile by the offline observer (the command calls
-   :func:`helmcheck.conformance.checklog.check_log`: a driver, which this package does not
+   :func:`helmcheck.checklog.check_log`: a driver, which this package does not
    import), which also reads the run facts of its notes (:mod:`helmcheck.judge.runfacts`: the
    selection, the clauses not judged, the ``process`` note of an implementation helmcheck
    started, ``run partial``); then :func:`compare_rejudged` runs the one function that
@@ -219,7 +219,7 @@ def rejudging(out: Verification, directory: Path, results: Mapping[str, Any], pr
 def compare_rejudged(out: Verification, results: Mapping[str, Any], clauses: list, facts: RunFacts,
                      role: str) -> None:
     """Step 5, after the wire log was re-judged as *role* (its clause verdicts *clauses* and run
-    *facts*, as :func:`helmcheck.conformance.checklog.check_log` returns them): the assembly
+    *facts*, as :func:`helmcheck.checklog.check_log` returns them): the assembly
     again, on that evidence, compared with *results*."""
     for text in facts.unreadable:
         out.add(evidence_files(results)[0], f"a run-fact note cannot be read: {text}")

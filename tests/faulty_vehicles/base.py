@@ -1,6 +1,6 @@
 """The faulty-vehicle toolkit: a profile, the :class:`Mutant` record, a core factory and a server.
 
-A mutant is the emulator's core (:class:`~helmcheck.conformance.emulator.core.EmulatorCore`) or
+A mutant is the emulator's core (:class:`~helmcheck.emulator.core.EmulatorCore`) or
 its model (:class:`~helmcheck.model.vehicle.VehicleModel`) with one behaviour changed, served
 behind a real pseudo-terminal by the emulator's own I/O loop in a thread (:func:`serve`). The
 mutants themselves live in one module per family of clauses (:mod:`.wire`, :mod:`.control`);
@@ -15,10 +15,10 @@ from contextlib import contextmanager
 from dataclasses import dataclass
 from typing import Callable
 
-from helmcheck.conformance.emulator.core import EmulatorCore
-from helmcheck.conformance.emulator.missionfile import DirectoryCatalog, builtin_dir
-from helmcheck.conformance.emulator.server import Server
-from helmcheck.conformance.transport import PtyLink
+from helmcheck.emulator.core import EmulatorCore
+from helmcheck.emulator.missionfile import DirectoryCatalog, builtin_dir
+from helmcheck.emulator.server import Server
+from helmcheck.line.transport import PtyLink
 from helmcheck.grammar import checksum_hex
 from helmcheck.model.vehicle import VehicleModel
 from helmcheck.profile import Profile, emulator_profile

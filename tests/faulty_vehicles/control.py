@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from dataclasses import replace
 
-from helmcheck.conformance.emulator.core import EmulatorCore
+from helmcheck.emulator.core import EmulatorCore
 from helmcheck.grammar import sentences as s
 from helmcheck.model.handlers import ack
 

@@ -18,8 +18,8 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
 
-from helmcheck.conformance.emulator.server import Server  # noqa: E402
-from helmcheck.conformance.transport import open_link  # noqa: E402
+from helmcheck.emulator.server import Server  # noqa: E402
+from helmcheck.line.transport import open_link  # noqa: E402
 from tests.faulty_vehicles import make_core  # noqa: E402
 
 

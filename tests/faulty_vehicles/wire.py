@@ -6,7 +6,7 @@ from __future__ import annotations
 from dataclasses import replace
 from decimal import Decimal
 
-from helmcheck.conformance.emulator.core import EmulatorCore
+from helmcheck.emulator.core import EmulatorCore
 from helmcheck.grammar import Discard, Line, decode, format as format_sentence
 from helmcheck.grammar import sentences as s
 from helmcheck.model.vehicle import VehicleModel

@@ -2,7 +2,7 @@
 
 :class:`BackseatObserver` is sans-IO. A driver hands it every record of a run as a
 :class:`~helmcheck.judge.wire.WireEvent`, in order — ``certify backseat`` through its
-:class:`~helmcheck.conformance.recorder.Recorder` as the bytes cross the line, ``check-log``
+:class:`~helmcheck.line.recorder.Recorder` as the bytes cross the line, ``check-log``
 from the wire log (or a socat capture) — and calls :meth:`~BackseatObserver.close` at the end
 of the run or of the log. Every finding goes to the :class:`~helmcheck.judge.ledger.Ledger` it
 was given; the same events give the same ledger, whoever feeds them.

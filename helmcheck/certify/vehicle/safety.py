@@ -3,7 +3,7 @@
 With ``[bench_safety] in_water = false`` (the default) the tester never sends an ``$OMP`` whose
 motor byte is above ``max_motor_byte``, nor an ``$OMS``/``$OPK``/``$OMW`` whose speed is above
 ``max_speed_kn`` — whatever a case or a hypothesis strategy asks for. The check runs on the raw
-bytes at the link's one send function (:meth:`helmcheck.conformance.vehicle.link.TesterLink.send`),
+bytes at the link's one send function (:meth:`helmcheck.certify.vehicle.link.TesterLink.send`),
 and it reads malformed lines too (a bad checksum or an unknown case of the ID): a faulty vehicle
 might act on a line it should have discarded, so such a line must be safe as well. For the same
 reason a motion command's speed is checked in **every alignment a vehicle could execute**: as

@@ -2,7 +2,7 @@
 
 :class:`EmulatorProcess` runs ``python -m helmcheck emulate …``, reads the ``port: …`` line the
 command prints first, and stops it with SIGTERM. :class:`HelmClient` is a minimal synchronous
-backseat over any :class:`~helmcheck.conformance.transport.Link`: it frames commands
+backseat over any :class:`~helmcheck.line.transport.Link`: it frames commands
 (``$body*hh`` CR LF, RH-FRM-1/2) and collects the replies up to the command's ``$ACK``
 (RH-ACK-1, RH-ACK-5).
 """
@@ -18,9 +18,9 @@ import tempfile
 import time
 from typing import Optional, Sequence
 
-from ...grammar import Framer, Line, checksum_hex, decode
-from ...grammar import sentences as s
-from ..transport import Link, open_link
+from ..grammar import Framer, Line, checksum_hex, decode
+from ..grammar import sentences as s
+from ..line.transport import Link, open_link
 
 __all__ = ["EmulatorProcess", "HelmClient", "frame", "AckTimeout"]
 

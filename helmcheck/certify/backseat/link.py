@@ -1,11 +1,11 @@
-"""The certifier's pty: a :class:`~helmcheck.conformance.transport.PtyLink` that notices the
+"""The certifier's pty: a :class:`~helmcheck.line.transport.PtyLink` that notices the
 backseat going away.
 
 A plain ``PtyLink`` keeps its own slave descriptor open so that the master never sees a
 hang-up. The certifier wants the hang-up: once the backseat's first byte has arrived,
 :meth:`HangupPty.peer_seen` closes that descriptor, and from then on the backseat closing the
 port (or dying) makes the master read fail, which ``PtyLink.poll`` reports as
-:class:`~helmcheck.conformance.transport.LinkClosed`. Bytes the backseat wrote before it went
+:class:`~helmcheck.line.transport.LinkClosed`. Bytes the backseat wrote before it went
 are still read first. This module imports no grammar, so the ``port:`` line goes out at once.
 """
 
@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import os
 
-from ..transport import PtyLink
+from ...line.transport import PtyLink
 
 __all__ = ["HangupPty"]
 

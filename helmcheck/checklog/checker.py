@@ -35,14 +35,14 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import BinaryIO, Callable, Optional
 
-from ...clauses import vehicle_clauses
-from ...grammar.wirelog import FROM_VEHICLE, HEADER_LINES, TO_VEHICLE
-from ...judge.backseat import BS_CLAUSES, BackseatObserver
-from ...judge.ledger import Evidence as LedgerEvidence, Ledger
-from ...judge.runfacts import RunFacts
-from ...judge.vehicle import VehicleObserver
-from ...model.missions import MissionCatalog
-from ...profile import DEFAULT, Profile
+from ..clauses import vehicle_clauses
+from ..grammar.wirelog import FROM_VEHICLE, HEADER_LINES, TO_VEHICLE
+from ..judge.backseat import BS_CLAUSES, BackseatObserver
+from ..judge.ledger import Evidence as LedgerEvidence, Ledger
+from ..judge.runfacts import RunFacts
+from ..judge.vehicle import VehicleObserver
+from ..model.missions import MissionCatalog
+from ..profile import DEFAULT, Profile
 from .readers import (HEAD_BYTES, NOTE, UNREADABLE, Chunk, LogMeta, Unreadable, detect_format, header_comment, read_chunks,
                       timestamp_resolution)
 from .sidejob import SideJob, SideJobLost, cores

@@ -6,7 +6,7 @@ observer ``check-log`` feeds from a wire log. Modules, one concern each:
 * :mod:`.scenarios` — the scenarios the tester stages while the backseat runs (``nominal``,
   ``reject``, ``lockout``, ``mission-end``, ``silence``) and how a run's duration is split.
 * :mod:`.runner` — the I/O loop: one link, one reference vehicle
-  (:class:`~helmcheck.conformance.emulator.core.EmulatorCore`), the recorder (wire log and
+  (:class:`~helmcheck.emulator.core.EmulatorCore`), the recorder (wire log and
   observer) and the scenario plan; it owns the clock and the descriptors.
 * :mod:`.link` — the certifier's pty, which notices the backseat going away.
 * :mod:`.process` — the backseat under test when helmcheck starts it (``--exec CMD``).

@@ -25,7 +25,7 @@ import threading
 import time
 from typing import Any, Callable, Optional
 
-from ..transport import Link, LinkClosed
+from ..line.transport import Link, LinkClosed
 from .core import EmulatorCore
 
 __all__ = ["Server", "MAX_PENDING"]

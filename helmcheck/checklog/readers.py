@@ -25,7 +25,7 @@ from __future__ import annotations
 
 from typing import BinaryIO, Iterator, Optional
 
-from ...grammar.wirelog import RECORD_HEAD, TAG, read_wire_log
+from ..grammar.wirelog import RECORD_HEAD, TAG, read_wire_log
 from .records import (HEAD_BYTES, NOTE, UNREADABLE, Chunk, LogMeta, Progress, Unreadable, decimals_resolution,
                       header_comment)
 from .socat import HEX_LINE, SOCAT_HEADER, TimeUnit, read_socat, socat_resolution, socat_time_unit

@@ -56,16 +56,16 @@ from dataclasses import dataclass, fields as dc_fields
 from pathlib import Path
 from typing import IO, Any, Callable, Optional
 
-from ...grammar import Decoded, Discard, Framer, decode, prepare
-from ...grammar import format as format_sentence
-from ...grammar import sentences as s
-from ...grammar.wirelog import FROM_VEHICLE, NOTE, TO_VEHICLE, WireLogWriter, escape
-from ...grammar.errors import SentenceError
-from ...model.missions import MissionCatalog
-from ...model.plant import SafetyViolation
-from ...model.vehicle import VehicleModel
-from ...profile import SAFETY_CODES, Profile
-from ..transport import LinePacer
+from ..grammar import Decoded, Discard, Framer, decode, prepare
+from ..grammar import format as format_sentence
+from ..grammar import sentences as s
+from ..grammar.wirelog import FROM_VEHICLE, NOTE, TO_VEHICLE, WireLogWriter, escape
+from ..grammar.errors import SentenceError
+from ..model.missions import MissionCatalog
+from ..model.plant import SafetyViolation
+from ..model.vehicle import VehicleModel
+from ..profile import SAFETY_CODES, Profile
+from ..line.transport import LinePacer
 from .freedoms import DEFAULT_SETTINGS, EmulatorSettings, ReplyDelay, ReplyShaper, SkewedTimers
 from .plant import Plant, PlantParams
 from .rules import OperationTimeRule
@@ -566,7 +566,7 @@ class EmulatorCore:
         m = self.model
         if self._last_target is None or m.running or m.mode not in ("S", "M"):
             return None
-        from ...model.geo import distance_m
+        from ..model.geo import distance_m
         p = self.plant
         return distance_m(p.lat, p.lon, *self._last_target)
 
@@ -598,8 +598,8 @@ class EmulatorCore:
         leaves the old file or the new one). A file that cannot be written stops the emulator
         with :class:`~helmcheck.failures.OutputLost` naming it: a vehicle that acknowledged a
         write it cannot keep must not go on serving as if it had."""
-        from ...failures import OutputLost
-        from ...reports.atomic import write_text_atomic
+        from ..failures import OutputLost
+        from ..reports.atomic import write_text_atomic
 
         data = {k: [st, list(vals)] for k, (st, vals) in self.model.settings.as_dict().items()}
         try:

@@ -55,10 +55,10 @@ from dataclasses import dataclass, field
 from decimal import Decimal
 from typing import Any, Optional
 
-from ...grammar import sentences as s
-from ...grammar.wirelog import transmit_time
-from ...model.timers import Timers, tolerance
-from ...profile import SAFETY_CODES, Profile
+from ..grammar import sentences as s
+from ..grammar.wirelog import transmit_time
+from ..model.timers import Timers, tolerance
+from ..profile import SAFETY_CODES, Profile
 
 __all__ = ["EmulatorSettings", "SettingsError", "settings_from_dict", "parse_assignment", "nonconforming",
            "SkewedTimers", "ReplyShaper", "ReplyDelay", "DEFAULT_SETTINGS", "DECIMAL_FIELDS", "skew_allowance"]
@@ -147,7 +147,7 @@ class EmulatorSettings:
 
     def assignments(self) -> list[str]:
         """``--set KEY=VALUE`` arguments giving these settings (only those not at their default)."""
-        from ...profile_toml import toml_value
+        from ..profile_toml import toml_value
 
         out = []
         for name, v in self.as_dict().items():

@@ -1,6 +1,6 @@
 """The tester's side of the serial line (RH-FRM-9): send, receive, record — and nothing else.
 
-:class:`TesterLink` wraps a client :class:`~helmcheck.conformance.transport.Link`. It owns:
+:class:`TesterLink` wraps a client :class:`~helmcheck.line.transport.Link`. It owns:
 
 * the one send function, :meth:`TesterLink.send`, where the bench-safety interlock
   (:mod:`.safety`) sees every byte before it leaves;
@@ -8,7 +8,7 @@
   record is one line, and an overlong vehicle line still arrives whole for the judge) and each
   arrives as an :class:`Rx` with its wall time;
 * recording: every byte each way, and every note, goes through the run's
-  :class:`~helmcheck.conformance.recorder.Recorder` — which writes the wire log and feeds the
+  :class:`~helmcheck.line.recorder.Recorder` — which writes the wire log and feeds the
   judges — stamped *before* a write and *after* a read, so the times bracket what the vehicle
   did;
 * link-fault detection: :class:`~.flow.LinkLost` when the device vanishes (EIO, closed socket).
@@ -26,8 +26,8 @@ from typing import Optional
 from ...grammar import Discard, Framer
 from ...grammar.wirelog import FROM_VEHICLE, TO_VEHICLE, escape, transmit_time
 from ...profile import Profile
-from ..recorder import Recorder
-from ..transport import Link, LinkClosed
+from ...line.recorder import Recorder
+from ...line.transport import Link, LinkClosed
 from .flow import LinkLost
 from .safety import BenchGuard, BenchSafetyRefused
 

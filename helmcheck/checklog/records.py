@@ -15,7 +15,7 @@ import re
 from dataclasses import dataclass
 from typing import Callable, Optional
 
-from ...grammar.wirelog import NOTE, UNREADABLE, Record, Unreadable
+from ..grammar.wirelog import NOTE, UNREADABLE, Record, Unreadable
 
 __all__ = ["Chunk", "Unreadable", "LogMeta", "Progress", "header_comment", "decimals_resolution", "UNREADABLE",
            "NOTE", "HEAD_BYTES"]

@@ -47,10 +47,10 @@ import math
 from dataclasses import dataclass, field
 from typing import Any, Optional
 
-from ...model.geo import EARTH_RADIUS_M, distance_m
-from ...model.plant import (AtSurface, OnStation, PlantEvent, PlantSnapshot, QueueWaypointReached,
+from ..model.geo import EARTH_RADIUS_M, distance_m
+from ..model.plant import (AtSurface, OnStation, PlantEvent, PlantSnapshot, QueueWaypointReached,
                             Submerged, WaypointReached)
-from ...profile import Profile
+from ..profile import Profile
 
 __all__ = ["PlantParams", "Plant", "Target", "KN"]
 

@@ -1,7 +1,7 @@
 """A serial line in virtual time, with the reference vehicle in-process at its far end.
 
-:class:`VirtualLine` is a :class:`~helmcheck.conformance.transport.Link` whose other end is an
-:class:`~helmcheck.conformance.emulator.core.EmulatorCore` (sans-IO: bytes in with a time, bytes
+:class:`VirtualLine` is a :class:`~helmcheck.line.transport.Link` whose other end is an
+:class:`~helmcheck.emulator.core.EmulatorCore` (sans-IO: bytes in with a time, bytes
 out) and whose time is its own :class:`VirtualClock`. A :class:`~.link.TesterLink` built on it
 with ``clock=line.clock`` runs the real session and case interpreter unchanged: where the tester
 would wait for bytes, the line advances the clock to the next thing that happens instead of
@@ -13,7 +13,7 @@ The line model (both directions 8N1 at ``baud``, 10 bits a byte):
 * tester → vehicle: a write leaves when the line is free; each line of it (up to its LF)
   reaches the vehicle when its last byte has crossed, and the vehicle acts on it
   :data:`VEHICLE_DELAY_S` later (its reading and processing time);
-* vehicle → tester: the vehicle's own pacing (:class:`~helmcheck.conformance.transport.LinePacer`)
+* vehicle → tester: the vehicle's own pacing (:class:`~helmcheck.line.transport.LinePacer`)
   decides when a sentence starts; it reaches the tester once its last byte has crossed.
 
 ``baud = 0`` carries bytes in no time. What happens on the vehicle off the wire (a sensor an
@@ -27,7 +27,7 @@ import math
 from typing import Callable, Optional
 
 from ...grammar.wirelog import transmit_time
-from ..transport import Link, LinkEvent
+from ...line.transport import Link, LinkEvent
 
 __all__ = ["VirtualClock", "VirtualLine", "VEHICLE_DELAY_S"]
 

@@ -1,10 +1,10 @@
 """The I/O loop of ``certify backseat``: one link, the reference vehicle, the recorder, the plan.
 
 This module owns the clock, the descriptors and the recording; the vehicle's behaviour is the
-emulator core's (:class:`~helmcheck.conformance.emulator.core.EmulatorCore`, exactly the
+emulator core's (:class:`~helmcheck.emulator.core.EmulatorCore`, exactly the
 model's), the judging is the backseat observer's
 (:class:`~helmcheck.judge.backseat.BackseatObserver`, fed by the
-:class:`~helmcheck.conformance.recorder.Recorder`, which writes ``wire.log`` too) and the
+:class:`~helmcheck.line.recorder.Recorder`, which writes ``wire.log`` too) and the
 staging is :mod:`.scenarios`'. The loop judges nothing itself: it records every byte from the
 backseat as it is read (``>``), every byte to the backseat as it is written (``<``) and every
 staged fact as a note (``scenario X starts``, ``reject: …``, ``silence starts``/``ends``,
@@ -25,7 +25,7 @@ a hang-up; on a TCP serial server it is the client's disconnect; on a device, a 
 disappears. Any of these before the run's end is "disconnected" (the report says when). The
 loop waits in ``select`` at most 50 ms at a time; SIGINT/SIGTERM (or :meth:`Runner.stop`)
 end it early as "interrupted". When helmcheck started the backseat (``child``, a
-:class:`~helmcheck.conformance.launcher.Launcher`), the loop also ends, as "exited", as soon as
+:class:`~helmcheck.line.launcher.Launcher`), the loop also ends, as "exited", as soon as
 that process has ended (checked every tick).
 
 Run facts (:mod:`helmcheck.judge.runfacts`): before the record closes, the loop stops the
@@ -52,9 +52,9 @@ from ...judge.ledger import Ledger
 from ...judge.runfacts import RunFacts, not_judged_note, partial_note
 from ...model.missions import MissionCatalog
 from ...profile import Profile
-from ..emulator.core import EmulatorCore
-from ..recorder import Recorder
-from ..transport import Link, LinkClosed
+from ...emulator.core import EmulatorCore
+from ...line.recorder import Recorder
+from ...line.transport import Link, LinkClosed
 from .link import HangupPty
 from .scenarios import LOCKOUT_CODE, Plan
 

@@ -61,7 +61,7 @@ from dataclasses import dataclass
 from datetime import datetime
 from typing import BinaryIO, Iterable, Iterator, Optional
 
-from ...grammar.wirelog import FROM_VEHICLE, SWAPPED, TO_VEHICLE, WireEvent
+from ..grammar.wirelog import FROM_VEHICLE, SWAPPED, TO_VEHICLE, WireEvent
 from .records import HEAD_BYTES, NOTE, UNREADABLE, Chunk, LogMeta, Progress, Unreadable, decimals_resolution, \
     header_comment
 

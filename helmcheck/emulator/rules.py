@@ -17,7 +17,7 @@ from __future__ import annotations
 
 from typing import Any, Optional
 
-from ...model.plant import SafetyViolation
+from ..model.plant import SafetyViolation
 
 __all__ = ["OperationTimeRule", "TIME_LIMIT_CODE"]
 

@@ -2,7 +2,7 @@
 
 helmcheck plays the backseat, so the vehicle under test is the side that opens or serves the
 port. :func:`open_for_child` opens helmcheck's end, starts the child on the other end through a
-:class:`~helmcheck.conformance.launcher.Launcher`, and returns once the child is there:
+:class:`~helmcheck.line.launcher.Launcher`, and returns once the child is there:
 
 * ``pty`` — :class:`ChildPty`, a new pseudo-terminal whose own slave descriptor is let go at
   once. Its master then reads EIO until the child has opened the slave path (``{port}``), which

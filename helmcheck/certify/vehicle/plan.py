@@ -37,7 +37,7 @@ from ...judge import Ledger
 from ...judge.vehicle import VehicleObserver
 from ...model.missions import Mission, MissingMission, normalise_name
 from ...profile import Profile
-from ..recorder import Recorder
+from ...line.recorder import Recorder
 from .catalogue import select_cases
 from .explore import PROFILES as EXPLORE_PROFILES
 from .flow import LinkLost
@@ -115,7 +115,7 @@ class _PlanCatalog:
     mission the profile names and neither holds is stood in for (:data:`STAND_INS`)."""
 
     def __init__(self, profile: Profile, missions_dir: Optional[Path]):
-        from ..emulator.missionfile import DirectoryCatalog, builtin_dir
+        from ...emulator.missionfile import DirectoryCatalog, builtin_dir
         self.dirs = ([missions_dir] if missions_dir is not None else []) + [builtin_dir()]
         self.inner = DirectoryCatalog(self.dirs)
         builtin = DirectoryCatalog([builtin_dir()])
@@ -145,7 +145,7 @@ def estimate(profile: Profile, time_scale: float, *, select: Optional[list] = No
              missions_dir: Optional[Path] = None) -> Plan:
     """Time the run's phases at ``time_scale`` (module docstring): the link check, the selected
     cases, the exploration's budget and the restore, in the runner's order."""
-    from ..emulator.core import EmulatorCore
+    from ...emulator.core import EmulatorCore
 
     k = float(time_scale)
     profile = profile.replace(time_scale=k)

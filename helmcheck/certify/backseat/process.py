@@ -3,7 +3,7 @@
 Three steps around the run, each a small function so the command and the loop only call them:
 
 * :func:`start_backseat` — once the port is open (after the ``port:`` line), start the command
-  on it (:class:`~helmcheck.conformance.launcher.Launcher`: ``{port}`` is the pty path or
+  on it (:class:`~helmcheck.line.launcher.Launcher`: ``{port}`` is the pty path or
   ``socket://HOST:PORT``; output into ``backseat.stdout.log`` / ``backseat.stderr.log``).
 * :func:`end_backseat` — when the run is over, before its record closes
   (:class:`~.runner.Runner`): let an exit that closed the port become visible (up to 1 s), stop
@@ -31,8 +31,8 @@ from pathlib import Path
 from typing import Any, Iterable, Optional
 
 from ...judge.runfacts import not_judged_note, process_note
-from ..launcher import Launcher
-from ..transport import parse_port_spec
+from ...line.launcher import Launcher
+from ...line.transport import parse_port_spec
 from .scenarios import Plan
 
 __all__ = ["EXERCISED_BY", "start_backseat", "end_backseat", "process_notes", "unfinished_clauses"]

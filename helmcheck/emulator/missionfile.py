@@ -49,7 +49,7 @@ from importlib import resources
 from pathlib import Path
 from typing import Iterable, Optional, Union
 
-from ...model.missions import (BadMission, LookupResult, MissingMission, Mission, Waypoint,
+from ..model.missions import (BadMission, LookupResult, MissingMission, Mission, Waypoint,
                                mission_name_problem, normalise_name)
 
 __all__ = ["HEADER", "MissionFileError", "parse_mission", "format_mission", "DirectoryCatalog",
@@ -131,7 +131,7 @@ def format_mission(mission: Mission) -> str:
 
 def builtin_dir() -> Path:
     """The directory of the built-in missions (``conformance.mis``, ``short.mis``, ``srp.mis``)."""
-    return Path(str(resources.files("helmcheck.conformance.emulator").joinpath("missions")))
+    return Path(str(resources.files("helmcheck.emulator").joinpath("missions")))
 
 
 class DirectoryCatalog:

@@ -45,7 +45,7 @@ from rich.panel import Panel
 from rich.table import Table
 from rich.text import Text
 
-from ...profile import SAFETY_CODES
+from ..profile import SAFETY_CODES
 from .core import EmulatorCore
 
 __all__ = ["LiveView", "FAULT_KEYS", "FAULT_WORDS", "MODE_NAMES", "legend", "legend_lines", "Snapshot"]

@@ -8,7 +8,7 @@ in order (:mod:`.interpreter`), then the hypothesis exploration (:mod:`.explore`
 ``DIR/results.json`` after every case — atomically, so a crash or Ctrl-C leaves a valid partial
 report marked ``partial`` — plus ``DIR/wire.log`` and, at the end, every report format.
 
-Every byte and note goes through one :class:`~helmcheck.conformance.recorder.Recorder`: to the
+Every byte and note goes through one :class:`~helmcheck.line.recorder.Recorder`: to the
 wire log, to the one vehicle observer (:class:`~helmcheck.judge.vehicle.VehicleObserver`),
 which writes the one ledger, and to the run facts (:class:`~helmcheck.judge.runfacts.RunFacts`:
 the ``selection:`` note of a ``--select`` run, the ``process:`` note of ``--exec``, ``run
@@ -20,7 +20,7 @@ A vanished device stops the run: a ``run aborted`` note makes the clauses not ye
 INCONCLUSIVE with that reason, and the report is still written.
 
 With ``Options.exec_cmd`` (``--exec``) helmcheck starts the vehicle under test itself on the
-port (:mod:`helmcheck.conformance.exec_port`, :mod:`helmcheck.conformance.launcher`), checks it
+port (:mod:`helmcheck.line.exec_port`, :mod:`helmcheck.line.launcher`), checks it
 is still running before every case, and stops it at the end. If it ends before the run's end,
 that is a finding about the vehicle, not a link fault: the clauses judged before keep their
 verdicts, those not judged yet are NOT-TESTED with the exit as the reason (a ``not tested``
@@ -48,9 +48,9 @@ from ...judge.wire import tester_note
 from ...profile import Profile
 from ...reports import results as R
 from ...reports.assemble import apply, assemble
-from ..recorder import Recorder
+from ...line.recorder import Recorder
 from ...reports.certificate import RunDeclaration, finish_run
-from ..transport import open_link
+from ...line.transport import open_link
 from .catalogue import select_cases
 from .clockprobe import ClockMismatch, check_clock
 from .flow import LinkLost, LinkSilent
@@ -364,8 +364,8 @@ class Run:
     # ------------------------------------------------------------------ the vehicle under test (--exec)
     def _start_child(self):
         """Start the vehicle under test on the port; the link once it has opened it."""
-        from ..exec_port import ChildNotReady, open_for_child
-        from ..launcher import Launcher
+        from ...line.exec_port import ChildNotReady, open_for_child
+        from ...line.launcher import Launcher
 
         self.child = Launcher(self.o.exec_cmd, subject="vehicle", directory=self.dir, grace_s=self.o.exec_grace_s)
         try:

@@ -14,11 +14,11 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any, Optional
 
-from ...profile import Profile
-from ...reports import results as R
-from ...reports.assemble import apply, assemble
-from ...reports.atomic import copy_file_atomic
-from ...reports.render import render_all
+from ..profile import Profile
+from ..reports import results as R
+from ..reports.assemble import apply, assemble
+from ..reports.atomic import copy_file_atomic
+from ..reports.render import render_all
 from .checker import CheckOutcome
 
 __all__ = ["build_results", "write_report_dir", "COPY_LIMIT"]

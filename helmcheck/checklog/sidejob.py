@@ -83,7 +83,7 @@ class SideJob:
         env = dict(os.environ)
         env["PYTHONPATH"] = os.pathsep.join(p for p in (_PACKAGE_ROOT, env.get("PYTHONPATH", "")) if p)
         self._proc = subprocess.Popen(
-            [sys.executable, "-P", "-c", "from helmcheck.conformance.checklog.sidejob import child; child()"],
+            [sys.executable, "-P", "-c", "from helmcheck.checklog.sidejob import child; child()"],
             stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.PIPE, env=env,
             start_new_session=True)
         stdin, self._proc.stdin = self._proc.stdin, None  # written once here; communicate() only reads

@@ -1,0 +1,12 @@
+"""The tester's side of a serial line, shared by the emulator and the live certifiers.
+
+* :mod:`.transport` — opening a byte link (pty, serial device, TCP serial server, any pyserial
+  URL) and moving bytes over it;
+* :mod:`.recorder` — every event of a live run to the wire log (by the one wire-log writer,
+  :mod:`helmcheck.grammar.wirelog`) and to the judges, identically;
+* :mod:`.launcher` — start, watch and stop the implementation under test (``--exec CMD``);
+* :mod:`.exec_port` — the tester's end of a port that a started implementation opens.
+
+Nothing here judges: a driver above (:mod:`helmcheck.emulator`, :mod:`helmcheck.certify`)
+decides what to send, the judges (:mod:`helmcheck.judge`) what it means.
+"""
