@@ -10,8 +10,8 @@ protocol code, adds no item and changes no outcome. With one of
 it adds one item per clause of that role, named by clause ID (``helmcheck.vehicle::RH-SRV-4``,
 ``helmcheck.backseat::RH-BS-1``), then the item ``run-verdict``. The certification runs once per
 session, in the setup of the first helmcheck item that runs (its time is charged to that item),
-through :func:`helmcheck.certify.vehicle.runner.certify` for a vehicle and the ``certify
-backseat`` command (:mod:`helmcheck.commands.certify_backseat_cmd`) for a backseat; the report
+through the library entries :func:`helmcheck.certify.vehicle.runner.certify` for a vehicle and
+:func:`helmcheck.certify.backseat.certifier.certify` for a backseat (no command line is parsed); the report
 directory (``--helm-report-dir``) gets ``results.json``, the wire log and every report format,
 as the commands write them. The directory belongs to the plugin: each session replaces the
 previous session's run in it.
@@ -133,7 +133,7 @@ class _Certification:
         self.error: Optional[str] = None
         self.exit_code: Optional[int] = None
         if self.role == "backseat":
-            self.backseat_argv = self._backseat_argv()
+            self.backseat_options = self._backseat_options()
 
     # ------------------------------------------------------------------ collection
     @pytest.hookimpl(tryfirst=True)
@@ -150,30 +150,20 @@ class _Certification:
             self.selected = ids
 
     # ------------------------------------------------------------------ the run
-    def _backseat_argv(self) -> list[str]:
-        import argparse
-
-        from .commands import certify_backseat_cmd as cli
+    def _backseat_options(self):
+        """The backseat run's options, checked now (usage errors before the first item)."""
+        from .certify.backseat.certifier import Options, problems
 
         opt = self.config.getoption
-        argv = ["--port", opt("helm_exec_port"), "--duration", str(opt("helm_duration")),
-                "--time-scale", repr(self.time_scale), "--report-dir", str(self.report_dir),
-                "--exec", self.exec_cmd or "", "--overwrite"]  # the plugin's own directory: each session replaces it
-        if opt("helm_profile"):
-            argv += ["--profile", opt("helm_profile")]
-        if self.strict:
-            argv.append("--strict")
-        for name in opt("helm_scenario") or ():
-            argv += ["--scenario", name]
-
-        class Parser(argparse.ArgumentParser):
-            def error(self, message: str):  # noqa: D401 - argparse's hook
-                raise _usage(message)
-
-        p = Parser(prog="helmcheck certify backseat")
-        cli.add_arguments(p)
-        p.parse_args(argv)  # usage errors now, not at the first item
-        return argv
+        opts = Options(profile=self.profile, report_dir=self.report_dir, port=opt("helm_exec_port"),
+                       time_scale=self.time_scale, duration=opt("helm_duration"),
+                       scenarios=list(opt("helm_scenario") or ()) or None, strict=self.strict,
+                       exec_cmd=self.exec_cmd, progress=False, command=self._command())
+        wrong = problems(opts, spell=lambda name: {"exec": "--helm-backseat-exec",
+                                                   "port": "--helm-exec-port"}.get(name, f"--helm-{name}"))
+        if wrong:
+            raise _usage(wrong[0])
+        return opts
 
     def ensure_run(self) -> None:
         if self.results is not None or self.error is not None:
@@ -205,15 +195,12 @@ class _Certification:
         self.results, self.exit_code = out.results, out.exit_code
 
     def _run_backseat(self) -> None:
-        import argparse
+        from .certify.backseat.certifier import certify
+        from .outputs import prepare_report_dir
 
-        from .commands import certify_backseat_cmd as cli
-        from .reports.results import load_results
-
-        p = argparse.ArgumentParser()
-        cli.add_arguments(p)
-        self.exit_code = cli.run(p.parse_args(self.backseat_argv))
-        self.results = load_results(self.report_dir)
+        prepare_report_dir(self.report_dir, overwrite=True)  # the plugin's own directory: each session replaces it
+        out = certify(self.backseat_options)
+        self.results, self.exit_code = out.results, out.exit_code
 
     # ------------------------------------------------------------------ reporting
     def entry(self, cid: str) -> Optional[dict]:

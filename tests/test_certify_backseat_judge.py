@@ -441,13 +441,13 @@ def test_results_document_strict_and_partial():
     """SHOULD missed: non-strict (exit 0), fail with --strict (exit 1); a cut-short run is
     inconclusive with its reason first; every document validates (schema 1, role backseat)."""
     from helmcheck.certify.backseat.report import build_results
-    from helmcheck.certify.backseat.runner import Outcome
+    from helmcheck.certify.backseat.runner import RunRecord
     from helmcheck.judge.runfacts import RunFacts
     from helmcheck.reports.results import exit_code, validate
 
     r = Run().bs(0.0, frame("OSD,G,C,S,P,,,,", lower=True)).close(1.0)
     for strict, verdict, code in ((False, "non-strict", 0), (True, "fail", 1)):
-        doc = build_results(Outcome("complete", "the run completed", r.o, 0.0, 1.0, 1.0), profile=DEFAULT,
+        doc = build_results(RunRecord("complete", "the run completed", r.o, 0.0, 1.0, 1.0), profile=DEFAULT,
                             settings={"strict": strict, "time_scale": 1.0}, command="x", port="pty",
                             started="2026-01-01T00:00:00Z")
         assert not validate(doc) and doc["role"] == "backseat"
@@ -456,7 +456,7 @@ def test_results_document_strict_and_partial():
         assert bs7["offending_count"] == 1 and bs7["evidence"][0]["line"] == "line 1: $OSD,G,C,S,P,,,,*5f"
     # a cut-short run records why in its wire log (``run partial:``), and the results follow the record
     why = "the backseat closed the port or crashed after 0.5 s"
-    cut = build_results(Outcome("disconnected", why, r.o, 0.0, 1.0, 10.0, facts=RunFacts(partial=why)),
+    cut = build_results(RunRecord("disconnected", why, r.o, 0.0, 1.0, 10.0, facts=RunFacts(partial=why)),
                         profile=DEFAULT, settings={}, command="x", port="pty", started="2026-01-01T00:00:00Z")
     assert not validate(cut) and cut["verdict"] == "inconclusive" and cut["partial"]
     assert cut["verdict_reason"].startswith("The backseat closed the port")

@@ -64,7 +64,7 @@ TOP_LEVEL = {
     "clauses": "foundation",  # the clause catalogue; standard library and the spec package data
     "outputs": "reports",  # report directories and output files; imports failures, reports.atomic
     "demo": "certify",  # `python -m helmcheck.demo`; imports the emulator and the vehicle certifier
-    "pytest_plugin": "commands",  # the pytest11 entry point; runs the certifiers and the backseat command
+    "pytest_plugin": "commands",  # the pytest11 entry point; runs the certifiers through their library entries
     "cli": "commands",  # the `helmcheck` entry point; dispatches to helmcheck.commands
     "__main__": "commands",  # `python -m helmcheck`; imports cli
 }

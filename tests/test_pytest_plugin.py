@@ -95,7 +95,7 @@ def test_collect_only_lists_one_item_per_clause_and_runs_nothing(pytester):
     (("--helm-vehicle", "/dev/pts/1", "--helm-backseat-exec", "true"), "give one of --helm-vehicle"),
     (("--helm-vehicle", "/dev/pts/1", "--helm-profile", "missing.toml"), "--helm-profile"),
     (("--helm-backseat-exec", "no-such-backseat-xyz"), "--helm-backseat-exec: no-such-backseat-xyz: command not found"),
-    (("--helm-backseat-exec", "true", "--helm-scenario", "party"), "argument --scenario: invalid choice"),
+    (("--helm-backseat-exec", "true", "--helm-scenario", "party"), "--helm-scenario: unknown party"),
 ])
 def test_bad_options_are_usage_errors(pytester, args, message):
     result = pytester.runpytest_subprocess("-p", "no:cacheprovider", *args)

@@ -1,5 +1,12 @@
 """Command-line subcommands, one module each; :mod:`helmcheck.cli` dispatches to them.
 
+* :mod:`.certify_cmd` — ``certify vehicle|backseat``; :mod:`.certify_vehicle_cmd`,
+  :mod:`.certify_backseat_cmd` — the two roles;
+* :mod:`.emulate_cmd` — ``emulate``; :mod:`.checklog_cmd` — ``check-log``; :mod:`.verify_cmd` —
+  ``verify``; :mod:`.report_cmd` — ``report``; :mod:`.matrix_cmd` — ``matrix``;
+* :mod:`.replay_cmd` — ``replay``; :mod:`.parse_cmd` — ``parse``; :mod:`.keygen_cmd` — ``keygen``;
+  :mod:`.profile_cmd` — ``profile init``; :mod:`.docs_cmd` — ``docs``.
+
 ``certify`` dispatches again, by role, to :mod:`.certify_vehicle_cmd` and
 :mod:`.certify_backseat_cmd`; :mod:`.ports` (opening the port a command names) and
 :mod:`.certificate_opts` (``--sign-key``, ``--operator``, ``--site``, ``--implementation``) are

@@ -17,21 +17,23 @@ earlier run without ``--overwrite``). Progress goes to standard error.
 With ``--exec CMD`` helmcheck starts the backseat itself once the port is open and stops it at
 the end (:mod:`helmcheck.certify.backseat.process`); a backseat that exits or dies before
 the end fails the run.
+
+This module turns the arguments into :class:`helmcheck.certify.backseat.certifier.Options`,
+checks every path and opens the port before anything runs, and calls
+:func:`~helmcheck.certify.backseat.certifier.certify` (the pytest plugin calls it too).
 """
 
 from __future__ import annotations
 
 import argparse
-import math
 import shlex
 import sys
-import time
 from datetime import datetime, timezone
 from pathlib import Path
-from typing import Any, Callable, Optional
+from typing import Callable, Optional
 
 from ..certify.backseat.scenarios import SCENARIOS
-from ..failures import UsageError, describe_interrupt
+from ..failures import UsageError
 
 __all__ = ["add_arguments", "run", "EPILOG"]
 
@@ -99,105 +101,62 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                         "removed first); without it such a directory is refused")
 
 
-def _positive(x: Optional[float]) -> bool:
-    return x is not None and math.isfinite(x) and x > 0
-
-
-class _Progress:
-    """Rich progress on standard error: scenario, elapsed time and offences so far."""
-
-    def __init__(self) -> None:
-        from rich.console import Console
-        from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
-
-        self.console = Console(stderr=True)
-        self.bar = Progress(TextColumn("{task.description}"), BarColumn(), TextColumn("{task.fields[extra]}"),
-                            TimeRemainingColumn(), console=self.console, transient=False,
-                            disable=not self.console.is_terminal)
-        self.task = None
-        self._last = 0.0
-
-    def start(self, total: float) -> None:
-        self.bar.start()
-        self.task = self.bar.add_task("connected", total=total, extra="")
-
-    def update(self, elapsed: float, scenario: str, counts: dict) -> None:
-        if self.task is None:
-            return
-        now = time.monotonic()
-        if now - self._last < 0.2:
-            return
-        self._last = now
-        bad = ", ".join(f"{c} ×{n}" for c, n in counts.items() if n)
-        self.bar.update(self.task, completed=elapsed, description=f"{scenario:<11}",
-                        extra=bad or "no offence so far")
-
-    def stop(self) -> None:
-        if self.task is not None:
-            self.bar.stop()
-
-
-def run(args: argparse.Namespace, *, on_port: Optional[Callable[[str], None]] = None) -> int:  # noqa: C901
+def run(args: argparse.Namespace, *, on_port: Optional[Callable[[str], None]] = None) -> int:
     """Carry out ``certify backseat``; returns the exit status. ``on_port(name)`` is called
     once the port is open (after the ``port:`` line), for callers that start the backseat."""
-    from ..judge.timing import JITTER_S
+    from ..certify.backseat.certifier import Options, certify, problems
     from ..profile import ProfileError, load_profile
-    from ..certify.backseat.scenarios import make_plan
-    from ..line.transport import BAUD_RATES, parse_port_spec
+    from ..reports.scope import headline
+    from .certificate_opts import DeclarationError, declaration
+    from .ports import port_spec
 
     try:
         profile = load_profile(args.profile)
     except ProfileError as e:
         raise UsageError(str(e)) from None
-    scale = args.time_scale if args.time_scale is not None else profile.time_scale
-    if not _positive(scale):
-        raise UsageError(f"--time-scale must be a positive number (got {args.time_scale})")
-    if not _positive(args.duration):
-        raise UsageError(f"--duration must be a positive number of seconds (got {args.duration})")
-    if not _positive(args.connect_timeout):
-        raise UsageError(f"--connect-timeout must be a positive number of seconds (got {args.connect_timeout})")
-    exec_cmd = getattr(args, "exec_cmd", None)
-    if exec_cmd is not None:
-        from ..line.launcher import check_command
-        why = check_command(exec_cmd)
-        if why:
-            raise UsageError(f"--exec: {why}")
-        if not _positive(args.exec_grace):
-            raise UsageError(f"--exec-grace must be a positive number of seconds (got {args.exec_grace})")
-    baud = args.baud if args.baud is not None else profile.baud
-    if baud not in BAUD_RATES:
-        raise UsageError(f"--baud must be one of {', '.join(map(str, BAUD_RATES))} (got {baud})")
+    opts = Options(profile=profile, report_dir=Path("."), port=args.port, time_scale=args.time_scale,
+                   baud=args.baud, duration=args.duration, scenarios=args.scenario, strict=bool(args.strict),
+                   connect_timeout=args.connect_timeout, exec_cmd=getattr(args, "exec_cmd", None),
+                   exec_grace_s=args.exec_grace)
+    wrong = problems(opts)
+    if wrong:
+        raise UsageError(wrong[0])
     try:
-        spec = parse_port_spec(args.port)
-    except ValueError as e:
-        raise UsageError(f"--port: {e}") from None
-    profile = profile.replace(time_scale=float(scale), baud=baud)
-    from .certificate_opts import DeclarationError, declaration
-    try:
-        cert = declaration(args, "backseat")
+        opts.certificate = declaration(args, "backseat")
     except DeclarationError as e:
         raise UsageError(str(e)) from None
-    names = args.scenario or list(SCENARIOS)
-    plan = make_plan(names, args.duration, time_scale=scale, lockout_s=profile.lockout_s)
-    started_dt = datetime.now(timezone.utc)
-    stamp = started_dt.strftime("%Y%m%dT%H%M%SZ")
-    report_dir = Path(args.report_dir) if args.report_dir else Path("reports") / f"backseat-{stamp}"
-    # Command-line hooks (helmcheck.outputs, helmcheck.commands.ports): every path and the port
-    # checked before anything is written; the port opened once, here (exit 64 if it cannot be).
-    link, log_file = _open_outputs_and_port(args, spec, profile, report_dir)
-    settings: dict[str, Any] = {"time_scale": float(scale), "strict": bool(args.strict),
-                                "duration_s": float(args.duration), "planned_s": round(plan.total, 3),
-                                "scenarios": list(dict.fromkeys(names)), "baud": baud,
-                                "connect_timeout_s": float(args.connect_timeout),
-                                "reaction_s": float(profile.reaction_s), "jitter_s": JITTER_S}
-    command = "helmcheck certify backseat " + shlex.join(sys.argv[3:] if sys.argv[1:3] == ["certify", "backseat"]
-                                                         else ["--port", args.port])
-    started = started_dt.isoformat(timespec="seconds").replace("+00:00", "Z")
-    return _certify(args, profile, spec, plan, report_dir, log_file, settings, command, started, started_dt,
-                    on_port, cert, link)
+    stamp = datetime.now(timezone.utc).strftime("%Y%m%dT%H%M%SZ")
+    opts.report_dir = Path(args.report_dir) if args.report_dir else Path("reports") / f"backseat-{stamp}"
+    opts.command = "helmcheck certify backseat " + shlex.join(
+        sys.argv[3:] if sys.argv[1:3] == ["certify", "backseat"] else ["--port", args.port])
+    # Every path and the port checked before anything is written; the port opened once, here
+    # (exit 64 if it cannot be: helmcheck.outputs, helmcheck.commands.ports).
+    opts.link, opts.log = _open_outputs_and_port(args, port_spec(args.port), opts.baud or profile.baud,
+                                                 opts.report_dir)
+
+    def announce(name: str) -> None:
+        try:
+            sys.stdout.write(f"port: {name}\n")
+            sys.stdout.flush()
+        except OSError:
+            pass
+        if on_port is not None:
+            on_port(name)
+
+    opts.on_port = announce
+    out = certify(opts)
+    print(f"{headline(out.results)}. {out.reason}")  # the headline says when the run was cut short
+    print(f"helmcheck certify backseat: report in {out.report_dir}", file=sys.stderr)
+    sys.stdout.flush()
+    if hasattr(opts.log, "check"):
+        opts.log.check()  # the wire log lost on the way is exit 2, after the verdict line
+    if args.wire_log:
+        from ..outputs import copy_output
+        copy_output(out.report_dir / "wire.log", args.wire_log, what="wire log copy")
+    return out.exit_code
 
 
-def _open_outputs_and_port(args, spec, profile, report_dir: Path):
+def _open_outputs_and_port(args, spec, baud: int, report_dir: Path):
     """(link, wire-log stream): paths checked, port opened, report directory prepared."""
     from ..certify.backseat.link import HangupPty
     from ..outputs import check_writable, open_output_stream, prepare_report_dir
@@ -206,8 +165,8 @@ def _open_outputs_and_port(args, spec, profile, report_dir: Path):
     if args.wire_log:
         check_writable(args.wire_log, "--wire-log")
     prepare_report_dir(report_dir, args.overwrite, clear=False)
-    link = open_port(spec, role="server", baud=profile.baud,
-                     opener=(lambda: HangupPty(profile.baud)) if spec.kind == "pty" else None)
+    link = open_port(spec, role="server", baud=baud,
+                     opener=(lambda: HangupPty(baud)) if spec.kind == "pty" else None)
     try:
         prepare_report_dir(report_dir, args.overwrite)
         args.report_dir = str(report_dir)  # where a tester error's traceback goes
@@ -215,87 +174,3 @@ def _open_outputs_and_port(args, spec, profile, report_dir: Path):
     except BaseException:
         link.close()
         raise
-
-
-def _certify(args, profile, spec, plan, report_dir: Path, log_file, settings, command: str,
-             started: str, started_dt: datetime, on_port=None, cert=None, link=None) -> int:
-    strict = bool(args.strict)
-    outcome = None
-    reason = ""
-    progress = None
-    child = process = None  # --exec: the backseat under test (.process)
-    try:
-        if link is not None:
-            try:
-                sys.stdout.write(f"port: {link.name}\n")
-                sys.stdout.flush()
-            except OSError:
-                pass
-            from ..emulator.missionfile import DirectoryCatalog, builtin_dir  # after the port line
-            from ..certify.backseat.runner import Runner
-            meta = [f"started {started_dt.strftime('%Y-%m-%dT%H:%M:%S.%fZ')}  port {link.name}  "
-                    f"baud {profile.baud}  time_scale {profile.time_scale:g}"]
-            print(f"helmcheck certify backseat: {link.description}, profile {profile.name}, time scale "
-                  f"{profile.time_scale:g}, baud {profile.baud}, scenarios {', '.join(s.name for s in plan.slots)} "
-                  f"over {plan.total:.1f} s; waiting up to {args.connect_timeout:g} s for the backseat",
-                  file=sys.stderr)
-            if plan.note:
-                print(f"helmcheck certify backseat: {plan.note}", file=sys.stderr)
-            progress = _Progress()
-            if on_port is not None:
-                on_port(link.name)
-            runner = Runner(link, profile, plan, time_scale=profile.time_scale,
-                            missions=DirectoryCatalog([builtin_dir()]), log=log_file, meta=meta,
-                            connect_timeout=args.connect_timeout, progress=progress)
-            if getattr(args, "exec_cmd", None):
-                from ..certify.backseat.process import start_backseat
-                try:
-                    runner.child = child = start_backseat(args.exec_cmd, link.name, report_dir,
-                                                          time_scale=profile.time_scale, grace_s=args.exec_grace)
-                except OSError as e:
-                    runner.stop(f"stopped: the backseat under test could not be started ({e.strerror or e})")
-            try:
-                outcome = runner.run()
-            except KeyboardInterrupt as e:  # Ctrl-C, SIGTERM, SIGHUP (helmcheck.signals)
-                outcome = runner.outcome
-                outcome.status = "interrupted"
-                outcome.reason = (f"the run was {describe_interrupt(e)} after "
-                                  f"{outcome.ended_at - (outcome.connected_at or 0.0):.1f} s")
-            finally:
-                progress.stop()
-                process = runner.outcome.process  # stopped and recorded before the record closed
-    finally:
-        if child is not None and process is None:
-            child.stop()  # the run never started (or broke): leave nothing behind
-        if link is not None:
-            link.close()
-        try:
-            log_file.close()
-        except OSError:
-            pass
-    from ..failures import OutputLost
-    from ..outputs import copy_output
-    from ..reports.certificate import finish_run
-    from ..reports.render import render_all
-    from ..reports.results import ReportError, exit_code
-    from ..reports.scope import headline
-    from ..certify.backseat.report import build_results
-
-    results = build_results(outcome, profile=profile, settings=settings, command=command,
-                            port=link.name if link is not None else args.port, started=started,
-                            reason=reason)
-    try:
-        # results.json with the certificate (profile.toml, digests, identity, scope, signature), then the reports
-        finish_run(results, report_dir, profile, cert)
-        render_all(report_dir)
-    except (ReportError, OSError) as e:
-        raise OutputLost(f"report not written: {e}") from None
-    verdict = results["verdict"]
-    print(f"{headline(results)}. {results['verdict_reason']}")  # the headline says when the run was cut short
-    print(f"helmcheck certify backseat: report in {report_dir}", file=sys.stderr)
-    sys.stdout.flush()
-    if hasattr(log_file, "check"):
-        log_file.check()  # the wire log lost on the way is exit 2, after the verdict line
-    if args.wire_log:
-        copy_output(report_dir / "wire.log", args.wire_log, what="wire log copy")
-    return exit_code(verdict, strict)

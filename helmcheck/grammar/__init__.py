@@ -13,8 +13,12 @@ Public API::
     prepare()                                          # build lazily-built parsers now (live use)
     read_records(lines) -> [WireEvent];  WireLogWriter(stream)   # the wire log (wirelog.py)
 
-:mod:`.wirelog` is the wire-log (capture) format: its directions, records, one reader and one
-writer, and the line's 8N1 transmit time.
+Modules: :mod:`.compile` loads the grammar and derives the parsers; :mod:`.sentences` — the
+typed sentence classes; :mod:`.codec` — parse and format; :mod:`.checksum` (RH-FRM-2);
+:mod:`.framer` — bytes to lines (RH-FRM-6/7); :mod:`.ranges` — value ranges from the profile;
+:mod:`.errors` — errors and findings tagged with their clause; :mod:`.docs` — the generated
+grammar reference; :mod:`.wirelog` — the wire-log (capture) format: its directions, records, one
+reader and one writer, and the line's 8N1 transmit time.
 """
 
 from .checksum import checksum, checksum_hex

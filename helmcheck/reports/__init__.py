@@ -2,7 +2,8 @@
 
 Modules, one concern each:
 
-* :mod:`~helmcheck.reports.results` — ``results.json`` schema 1: builder, validator, loader,
+* :mod:`~helmcheck.reports.results` — ``results.json`` schema 1: builder, loader;
+  :mod:`~helmcheck.reports.schema` — its validator; :mod:`~helmcheck.reports.verdicts` — the
   verdict rules (:func:`overall_verdict`, :func:`run_verdict`, :func:`exit_code`).
 * :mod:`~helmcheck.reports.assemble` — the one way from a verdict ledger and the run facts to
   clause entries, run verdict and certificate flag (every certifier, ``check-log`` and

@@ -5,6 +5,9 @@ observer ``check-log`` feeds from a wire log. Modules, one concern each:
 
 * :mod:`.scenarios` — the scenarios the tester stages while the backseat runs (``nominal``,
   ``reject``, ``lockout``, ``mission-end``, ``silence``) and how a run's duration is split.
+* :mod:`.certifier` — the library entry: :func:`~.certifier.certify` (:class:`~.certifier.Options`) →
+  :class:`~.certifier.Outcome`, used by the command line and the pytest plugin.
+* :mod:`.progress` — the progress bar on standard error.
 * :mod:`.runner` — the I/O loop: one link, one reference vehicle
   (:class:`~helmcheck.emulator.core.EmulatorCore`), the recorder (wire log and
   observer) and the scenario plan; it owns the clock and the descriptors.

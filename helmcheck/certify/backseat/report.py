@@ -27,12 +27,12 @@ from ...profile import Profile
 from ...reports import render_all
 from ...reports.assemble import apply, assemble
 from ...reports.results import add_event, add_mode, new_results, write_results_atomic
-from .runner import Outcome
+from .runner import RunRecord
 
 __all__ = ["build_results", "write_reports"]
 
 
-def build_results(outcome: Optional[Outcome], *, profile: Profile, settings: dict[str, Any],
+def build_results(outcome: Optional[RunRecord], *, profile: Profile, settings: dict[str, Any],
                   command: str, port: str, started: str, reason: str = "") -> dict[str, Any]:
     """The results document of a run (``outcome`` None: the run could not start at all)."""
     strict = bool(settings.get("strict", False))

@@ -58,7 +58,7 @@ from ...line.transport import Link, LinkClosed
 from .link import HangupPty
 from .scenarios import LOCKOUT_CODE, Plan
 
-__all__ = ["Runner", "Outcome", "HangupPty", "MAX_OUT"]
+__all__ = ["Runner", "RunRecord", "HangupPty", "MAX_OUT"]
 
 MAX_OUT = 256 * 1024  #: bytes waiting for a link nobody reads; beyond this they are dropped
 _TICK = 0.05
@@ -82,7 +82,7 @@ class _CoreNotes:
 
 
 @dataclass
-class Outcome:
+class RunRecord:
     """How a run ended and what it saw; times are seconds since the certifier started."""
 
     status: str  #: complete | never-connected | disconnected | interrupted | exited
@@ -133,7 +133,7 @@ class Runner:
         self._scenario = ""
         self._dropped_out = 0
         self.connected_at: Optional[float] = None
-        self.outcome = Outcome("interrupted", "", self.observer, planned=plan.total, facts=self.facts)
+        self.outcome = RunRecord("interrupted", "", self.observer, planned=plan.total, facts=self.facts)
 
     # ------------------------------------------------------------------ control
     def stop(self, why: str = "interrupted") -> None:
@@ -144,7 +144,7 @@ class Runner:
         return now - self.launch
 
     # ------------------------------------------------------------------ the loop
-    def run(self) -> Outcome:
+    def run(self) -> RunRecord:
         o = self.outcome
         status, reason = "interrupted", "the run was interrupted"
         try:

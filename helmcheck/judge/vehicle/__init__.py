@@ -2,6 +2,8 @@
 
 * :mod:`.observer` — :class:`VehicleObserver`, the facade: wire events in, ledger findings out;
 * :mod:`.lines` — what a backseat line is to a vehicle; per-line judgement of vehicle output;
+* :mod:`.sent` — one backseat line as classified, and how reasons quote it;
+* :mod:`.answers` — what the vehicle answered: ACK pairing, the command's effect, each ``$OSI``;
 * :mod:`.belief` — the mirror: the candidate states a conforming vehicle may be in;
 * :mod:`.candidate` — one candidate state and its bookkeeping;
 * :mod:`.closure` — unseen plant events, adopted with explicit time windows;
