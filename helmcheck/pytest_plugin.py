@@ -295,14 +295,16 @@ class _ClauseItem(pytest.Item):
         self._judge(entry["verdict"], entry["reason"], entry["evidence"], entry["level"], report)
 
     def _judge(self, verdict: str, reason: str, evidence: list, level: str, report: Path) -> None:
+        from .judge.verdict import Verdict
+
         word = verdict.upper()
-        if verdict == "pass":
+        if verdict == Verdict.PASS:
             return
-        if verdict == "not-tested":
+        if verdict == Verdict.NOT_TESTED:
             pytest.skip(f"NOT-TESTED: {reason}")
-        if verdict == "inconclusive" and self.plan.skip_inconclusive:
+        if verdict == Verdict.INCONCLUSIVE and self.plan.skip_inconclusive:
             pytest.skip(f"INCONCLUSIVE: {reason}")
-        if verdict == "non-strict" and not self.plan.strict:
+        if verdict == Verdict.NON_STRICT and not self.plan.strict:
             warnings.warn(HelmcheckNonStrict(f"{self.name} NON-STRICT ({level}): {reason}"), stacklevel=1)
             return
         message = f"{word}: {reason}"

@@ -4,6 +4,7 @@ Live certification and offline log checking feed the same observer the same
 :class:`~helmcheck.judge.wire.WireEvent` s, so the same bytes get the same verdict, whoever
 reads them. Modules:
 
+* :mod:`~helmcheck.judge.verdict` — :class:`Verdict`, the one type of a clause or run verdict;
 * :mod:`~helmcheck.judge.ledger` — the one verdict ledger and its one combining rule;
 * :mod:`~helmcheck.judge.timing` — RH-TIM-1 tolerances, observer slack, the ACK window;
 * :mod:`~helmcheck.judge.facts` — protocol facts derived from the transition table;
@@ -17,6 +18,7 @@ Nothing here imports ``serial``, ``time``, ``threading`` or ``asyncio``.
 """
 
 from .ledger import ClauseVerdict, Evidence, Ledger
+from .verdict import Verdict
 from .wire import FROM_VEHICLE, NOTE, TO_VEHICLE, WireEvent
 
-__all__ = ["Ledger", "Evidence", "ClauseVerdict", "WireEvent", "TO_VEHICLE", "FROM_VEHICLE", "NOTE"]
+__all__ = ["Verdict", "Ledger", "Evidence", "ClauseVerdict", "WireEvent", "TO_VEHICLE", "FROM_VEHICLE", "NOTE"]

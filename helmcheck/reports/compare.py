@@ -18,14 +18,13 @@ from typing import Any, Mapping
 
 from .markdown import md_escape
 from .rundir import Run
+from ..judge.verdict import Verdict
 from .scope import scope_of
 from .text import printable
+from .verdicts import SEVERITY as _RANK
 from .view import VERDICT_LABEL
 
 __all__ = ["compare", "compare_runs", "compare_text", "compare_markdown", "compare_html", "worsened"]
-
-_RANK = {"pass": 0, "non-strict": 1, "inconclusive": 2, "fail": 3}
-
 
 def compare(old: Mapping[str, Any], new: Mapping[str, Any]) -> dict[str, Any]:
     """Differences from results *old* to results *new*.
@@ -47,12 +46,12 @@ def compare(old: Mapping[str, Any], new: Mapping[str, Any]) -> dict[str, Any]:
     for cid, c in new_by.items():
         before = old_by.get(cid)
         item = {"id": cid, "old": before["verdict"] if before else None, "new": c["verdict"], "reason": c["reason"]}
-        was_judged = before is not None and item["old"] != "not-tested"
+        was_judged = before is not None and item["old"] != Verdict.NOT_TESTED
         if item["old"] == item["new"]:
             out["unchanged"] += 1
-        elif was_judged and item["new"] == "not-tested":
+        elif was_judged and item["new"] == Verdict.NOT_TESTED:
             out["lost"].append(item)
-        elif not was_judged and item["new"] != "not-tested":
+        elif not was_judged and item["new"] != Verdict.NOT_TESTED:
             out["gained" if before is not None else "added"].append(item)
         elif before is None:
             out["added"].append(item)
@@ -63,7 +62,7 @@ def compare(old: Mapping[str, Any], new: Mapping[str, Any]) -> dict[str, Any]:
     for cid, c in old_by.items():
         if cid not in new_by:
             item = {"id": cid, "old": c["verdict"], "new": None, "reason": c["reason"]}
-            out["lost" if c["verdict"] != "not-tested" else "removed"].append(item)
+            out["lost" if c["verdict"] != Verdict.NOT_TESTED else "removed"].append(item)
     return out
 
 

@@ -27,6 +27,7 @@ import re
 from html import escape
 from typing import Any, Iterable, Mapping
 
+from ..judge.verdict import Verdict
 from .identity import identity_rows
 from .rundir import Run
 from .scope import headline, scope_of
@@ -196,7 +197,7 @@ def _banner(run: Run) -> str:
     strict = ' <span class="muted">(strict: SHOULD clauses count as MUST)</span>' if run.strict else ""
     scope = scope_of(r)
     word = VERDICT_LABEL.get(r["verdict"], r["verdict"])
-    partial_scope = not scope.certificate and r["verdict"] in ("pass", "non-strict")
+    partial_scope = not scope.certificate and r["verdict"] in (Verdict.PASS, Verdict.NON_STRICT)
     cls = (f'banner v-{_e(r["verdict"])}' + ("" if scope.certificate else " not-certificate")
            + (" scope-partial" if partial_scope else ""))
     gaps = "".join(f"<li>{_e(line)}</li>" for line in scope.why())
@@ -379,7 +380,7 @@ def _matrix(run: Run) -> str:
             cid = _e(row["id"])
             if _has_finding(run, row):
                 link = f'<a href="#finding-{cid}">{cid}</a>'
-            elif v == "pass":
+            elif v == Verdict.PASS:
                 link = f'<a href="#evidence-{cid}">{cid}</a>'
             else:
                 link = cid
@@ -395,9 +396,9 @@ def _matrix(run: Run) -> str:
 
 
 def _has_finding(run: Run, row: Mapping[str, Any]) -> bool:
-    if row["verdict"] == "pass":
+    if row["verdict"] == Verdict.PASS:
         return False
-    return row["verdict"] != "not-tested" or bool(row["evidence"]) or replay_for(run.results, row) is not None
+    return row["verdict"] != Verdict.NOT_TESTED or bool(row["evidence"]) or replay_for(run.results, row) is not None
 
 
 def _replay_steps(replay: Mapping[str, Any]) -> str:

@@ -35,6 +35,7 @@ from __future__ import annotations
 import xml.etree.ElementTree as ET
 from typing import Any, Mapping
 
+from ..judge.verdict import Verdict
 from .identity import identity_rows
 from .rundir import Run
 from .scope import headline, scope_of
@@ -83,12 +84,12 @@ def _run_verdict_case(suite: ET.Element, r: Mapping[str, Any], strict: bool, not
     message = f"{VERDICT_LABEL.get(v, str(v).upper())}: {r['verdict_reason']}"
     text = "\n".join(x for x in (message, headline(r), not_a_certificate and f"Not a certificate: {not_a_certificate}")
                      if x)
-    if v == "fail" or (v == "non-strict" and strict):
+    if v == Verdict.FAIL or (v == Verdict.NON_STRICT and strict):
         el = ET.SubElement(case, "failure", message=_t(message), type="run-verdict")
         el.text = _t(text)
         tallies["failures"] += 1
-    elif v == "inconclusive":
-        el = ET.SubElement(case, "error", message=_t(message), type="inconclusive")
+    elif v == Verdict.INCONCLUSIVE:
+        el = ET.SubElement(case, "error", message=_t(message), type=Verdict.INCONCLUSIVE)
         el.text = _t(text)
         tallies["errors"] += 1
     else:
@@ -140,22 +141,22 @@ def render_junit(run: Run, strict: bool | None = None) -> str:
                              classname=_t(section_name(row["section"], row["section_title"])),
                              name=_t(f"{row['id']} {title}"), time="0")
         v = row["verdict"]
-        if v == "fail" or (v == "non-strict" and strict):
-            kind = "non-strict" if v == "non-strict" else row["level"]
+        if v == Verdict.FAIL or (v == Verdict.NON_STRICT and strict):
+            kind = Verdict.NON_STRICT if v == Verdict.NON_STRICT else row["level"]
             el = ET.SubElement(case, "failure", message=_t(row["reason"]), type=_t(kind))
             el.text = _evidence_text(row)
             tallies["failures"] += 1
-        elif v == "inconclusive":
-            el = ET.SubElement(case, "error", message=_t(row["reason"]), type="inconclusive")
+        elif v == Verdict.INCONCLUSIVE:
+            el = ET.SubElement(case, "error", message=_t(row["reason"]), type=Verdict.INCONCLUSIVE)
             el.text = _evidence_text(row)
             tallies["errors"] += 1
-        elif v == "not-tested":
+        elif v == Verdict.NOT_TESTED:
             ET.SubElement(case, "skipped", message=_t(row["reason"]))
             tallies["skipped"] += 1
-        elif v == "non-strict":
+        elif v == Verdict.NON_STRICT:
             out = ET.SubElement(case, "system-out")
             out.text = _t(f"{VERDICT_LABEL[v]} (SHOULD not met): {row['reason']}")
-        elif v == "pass":
+        elif v == Verdict.PASS:
             out = ET.SubElement(case, "system-out")
             out.text = _evidence_text(row) if row["evidence"] else _t(f"{row['reason']}\n(no wire evidence recorded)")
     proc = r.get("process")

@@ -20,6 +20,7 @@ from typing import Any, Iterable, Mapping
 from helmcheck import __version__
 from helmcheck.clauses import SPEC_NAME, catalogue
 
+from ..judge.verdict import Verdict
 from .atomic import write_bytes_atomic
 from .schema import DIRECTIONS, EVENT_KINDS, LEVELS, ROLES, SCHEMA, validate
 from .verdicts import (CLAUSE_VERDICTS, VERDICTS, describe_verdict, ended_early, exit_code, overall_verdict,
@@ -108,7 +109,7 @@ def new_results(
         "started": started or _utc_now(),
         "finished": None,
         "duration_s": None,
-        "verdict": "inconclusive",
+        "verdict": Verdict.INCONCLUSIVE,
         "verdict_reason": "The run has not finished.",
         "command": command,
         "implementation": dict(implementation or {}),
@@ -216,7 +217,7 @@ def add_process(results: dict[str, Any], process: Mapping[str, Any], *,
         todo = set(not_run)
         for c in results["clauses"]:
             if c["id"] in todo:
-                c.update(verdict="not-tested", reason=reason, offending_count=0, evidence=[], replay=None)
+                c.update(verdict=Verdict.NOT_TESTED, reason=reason, offending_count=0, evidence=[], replay=None)
 
 
 def finish(results: dict[str, Any], *, finished: str | None = None, partial: bool = False,

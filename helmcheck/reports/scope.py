@@ -31,11 +31,12 @@ from typing import Any, Iterable, Mapping
 
 from helmcheck.clauses import backseat_clauses, catalogue, vehicle_clauses
 
+from ..judge.verdict import Verdict
 from .view import VERDICT_LABEL
 
 __all__ = ["JUDGED", "Gap", "Scope", "claimed_clauses", "scope_of", "headline", "id_ranges"]
 
-JUDGED = ("pass", "non-strict", "fail")
+JUDGED = (Verdict.PASS, Verdict.NON_STRICT, Verdict.FAIL)
 _GAPS_SHOWN = 4
 
 
@@ -48,7 +49,7 @@ class Gap:
     reason: str
 
     def text(self) -> str:
-        what = {"not-tested": "not tested", "inconclusive": "inconclusive",
+        what = {Verdict.NOT_TESTED: "not tested", Verdict.INCONCLUSIVE: Verdict.INCONCLUSIVE,
                 "missing": "missing from the results"}.get(self.verdict, self.verdict)
         return f"{id_ranges(self.clauses)} {what}" + (f": {self.reason}" if self.reason else "")
 
@@ -110,7 +111,7 @@ def scope_of(results: Mapping[str, Any], verdicts: Mapping[str, str] | None = No
         v = verdicts.get(cid)
         if v in JUDGED:
             continue
-        verdict = v if v in ("not-tested", "inconclusive") else "missing"
+        verdict = v if v in (Verdict.NOT_TESTED, Verdict.INCONCLUSIVE) else "missing"
         reason = str(entries.get(cid, {}).get("reason") or "") if verdict != "missing" else ""
         groups.setdefault((verdict, _plain_reason(reason)), []).append(cid)
     gaps = tuple(Gap(tuple(ids), v, r) for (v, r), ids in groups.items())

@@ -1,6 +1,8 @@
 """The verdict rules: one clause verdict per clause, one verdict per run, one exit status.
 
-Reference profile, preamble: a MUST not met gives FAIL, a SHOULD not met gives NON-STRICT.
+Reference profile, preamble: a MUST not met gives FAIL, a SHOULD not met gives NON-STRICT. The
+words are :class:`helmcheck.judge.verdict.Verdict`'s; :data:`VERDICTS` and :data:`CLAUSE_VERDICTS`
+are the same words as plain strings (for messages and the schema).
 
 * :func:`overall_verdict` — any ``fail`` → ``fail``; else any ``inconclusive`` →
   ``inconclusive``; else any ``non-strict`` → ``non-strict`` (``fail`` when *strict*: a SHOULD
@@ -20,13 +22,17 @@ from __future__ import annotations
 
 from typing import Any, Iterable, Mapping
 
-__all__ = ["VERDICTS", "CLAUSE_VERDICTS", "overall_verdict", "run_verdict", "exit_code", "describe_verdict",
+from ..judge.verdict import CLAUSE_VERDICTS as ALL_CLAUSE_VERDICTS, RUN_VERDICTS, Verdict
+
+__all__ = ["VERDICTS", "CLAUSE_VERDICTS", "SEVERITY", "overall_verdict", "run_verdict", "exit_code", "describe_verdict",
            "describe_process", "ended_early"]
 
-VERDICTS = ("pass", "non-strict", "fail", "inconclusive")
-CLAUSE_VERDICTS = VERDICTS + ("not-tested",)
+#: the words of :data:`helmcheck.judge.verdict.RUN_VERDICTS` and ``CLAUSE_VERDICTS``, as plain strings
+VERDICTS = tuple(v.value for v in RUN_VERDICTS)
+CLAUSE_VERDICTS = tuple(v.value for v in ALL_CLAUSE_VERDICTS)
 
-_RANK = {"pass": 0, "non-strict": 1, "inconclusive": 2, "fail": 3}
+#: how bad a run verdict is (higher is worse): the precedence of :func:`overall_verdict`
+SEVERITY = {Verdict.PASS: 0, Verdict.NON_STRICT: 1, Verdict.INCONCLUSIVE: 2, Verdict.FAIL: 3}
 
 
 def overall_verdict(clause_verdicts: Iterable[str], strict: bool = False) -> str:
@@ -35,15 +41,15 @@ def overall_verdict(clause_verdicts: Iterable[str], strict: bool = False) -> str
     ``not-tested`` does not lower the verdict. With *strict*, a ``non-strict`` clause (a SHOULD
     not met) counts as ``fail``. An unknown verdict word raises ``ValueError``.
     """
-    worst = "pass"
+    worst = Verdict.PASS
     for v in clause_verdicts:
-        if v == "not-tested":
+        if v == Verdict.NOT_TESTED:
             continue
-        if v not in _RANK:
+        if v not in SEVERITY:
             raise ValueError(f"unknown clause verdict {v!r}; expected one of {CLAUSE_VERDICTS}")
-        if strict and v == "non-strict":
-            v = "fail"
-        if _RANK[v] > _RANK[worst]:
+        if strict and v == Verdict.NON_STRICT:
+            v = Verdict.FAIL
+        if SEVERITY[v] > SEVERITY[worst]:
             worst = v
     return worst
 
@@ -58,24 +64,24 @@ def run_verdict(clause_verdicts: Iterable[str], *, strict: bool = False, partial
         for v in verdicts:  # still refuse unknown words
             if v not in CLAUSE_VERDICTS:
                 raise ValueError(f"unknown clause verdict {v!r}; expected one of {CLAUSE_VERDICTS}")
-        return "fail"
+        return Verdict.FAIL
     verdict = overall_verdict(verdicts, strict)
-    judged = any(v != "not-tested" for v in verdicts)
-    if verdict in ("pass", "non-strict") and (partial or not judged):
-        return "inconclusive"
+    judged = any(v != Verdict.NOT_TESTED for v in verdicts)
+    if verdict in (Verdict.PASS, Verdict.NON_STRICT) and (partial or not judged):
+        return Verdict.INCONCLUSIVE
     return verdict
 
 
 def exit_code(verdict: str, strict: bool = False) -> int:
     """Process exit status for a run verdict: pass 0, non-strict 0 (1 if strict), fail 1,
     inconclusive 2."""
-    if verdict == "pass":
+    if verdict == Verdict.PASS:
         return 0
-    if verdict == "non-strict":
+    if verdict == Verdict.NON_STRICT:
         return 1 if strict else 0
-    if verdict == "fail":
+    if verdict == Verdict.FAIL:
         return 1
-    if verdict == "inconclusive":
+    if verdict == Verdict.INCONCLUSIVE:
         return 2
     raise ValueError(f"unknown verdict {verdict!r}; expected one of {VERDICTS}")
 
@@ -126,8 +132,8 @@ def describe_verdict(clauses: list[Mapping[str, Any]], *, strict: bool = False, 
     """One sentence explaining :func:`run_verdict` for these clause entries (and *process*, the
     implementation under test when helmcheck started it)."""
     if process is not None and process.get("ended_early") is True:
-        judged = [c for c in clauses if c["verdict"] != "not-tested"]
-        failed = [c["id"] for c in clauses if c["verdict"] == "fail"]
+        judged = [c for c in clauses if c["verdict"] != Verdict.NOT_TESTED]
+        failed = [c["id"] for c in clauses if c["verdict"] == Verdict.FAIL]
         text = (f"{describe_process(process, subject)} An implementation that dies during certification "
                 f"cannot be certified ({len(judged)} clause(s) judged before it ended")
         text += f", {len(failed)} of them failed: {_id_list(failed)})." if failed else ")."
@@ -143,20 +149,20 @@ def _describe(clauses: list[Mapping[str, Any]], *, strict: bool, partial: bool) 
     for c in clauses:
         by.setdefault(c["verdict"], []).append(c["id"])
     verdict = run_verdict([c["verdict"] for c in clauses], strict=strict, partial=partial)
-    judged = len(clauses) - len(by["not-tested"])
-    if verdict == "fail":
-        if by["fail"]:
+    judged = len(clauses) - len(by[Verdict.NOT_TESTED])
+    if verdict == Verdict.FAIL:
+        if by[Verdict.FAIL]:
             return f"{len(by['fail'])} clause(s) failed: {_id_list(by['fail'])}."
         return f"Strict run: {len(by['non-strict'])} SHOULD clause(s) not met: {_id_list(by['non-strict'])}."
-    if verdict == "inconclusive":
-        if by["inconclusive"]:
+    if verdict == Verdict.INCONCLUSIVE:
+        if by[Verdict.INCONCLUSIVE]:
             return (f"No clause failed, but {len(by['inconclusive'])} could not be judged: "
                     f"{_id_list(by['inconclusive'])}.")
         if partial:
             return f"The run was interrupted after judging {judged} clause(s); nothing failed before it stopped."
         return "No clause was judged."
-    if verdict == "non-strict":
+    if verdict == Verdict.NON_STRICT:
         return (f"Every MUST judged is met; {len(by['non-strict'])} SHOULD clause(s) not met: "
                 f"{_id_list(by['non-strict'])}.")
-    untested = f" ({len(by['not-tested'])} not tested)" if by["not-tested"] else ""
+    untested = f" ({len(by['not-tested'])} not tested)" if by[Verdict.NOT_TESTED] else ""
     return f"All {judged} judged clause(s) pass{untested}."

@@ -11,20 +11,21 @@ from typing import Any, Mapping
 
 from helmcheck.clauses import catalogue
 
+from ..judge.verdict import Verdict
 from .verdicts import CLAUSE_VERDICTS
 
 __all__ = ["VERDICT_LABEL", "NON_PASS", "counts", "clause_rows", "sections", "replay_for", "non_pass_rows",
            "pass_rows"]
 
 VERDICT_LABEL = {
-    "pass": "PASS",
-    "non-strict": "NON-STRICT",
-    "fail": "FAIL",
-    "inconclusive": "INCONCLUSIVE",
-    "not-tested": "NOT-TESTED",
+    Verdict.PASS: "PASS",
+    Verdict.NON_STRICT: "NON-STRICT",
+    Verdict.FAIL: "FAIL",
+    Verdict.INCONCLUSIVE: "INCONCLUSIVE",
+    Verdict.NOT_TESTED: "NOT-TESTED",
 }
 #: Verdicts that get a finding of their own (replay, wire excerpt) in the reports.
-NON_PASS = ("fail", "non-strict", "inconclusive", "not-tested")
+NON_PASS = (Verdict.FAIL, Verdict.NON_STRICT, Verdict.INCONCLUSIVE, Verdict.NOT_TESTED)
 
 _OTHER_SECTION = ("?", "Clauses not in the reference profile")
 
@@ -68,13 +69,13 @@ def sections(results: Mapping[str, Any]) -> list[tuple[str, str, list[dict[str, 
 def non_pass_rows(results: Mapping[str, Any]) -> list[dict[str, Any]]:
     """Rows whose verdict is not ``pass``, worst first (fail, non-strict, inconclusive, not-tested)."""
     rank = {v: i for i, v in enumerate(NON_PASS)}
-    rows = [r for r in clause_rows(results) if r["verdict"] != "pass"]
+    rows = [r for r in clause_rows(results) if r["verdict"] != Verdict.PASS]
     return sorted(rows, key=lambda r: rank[r["verdict"]])  # stable: profile order within a verdict
 
 
 def pass_rows(results: Mapping[str, Any]) -> list[dict[str, Any]]:
     """Rows whose verdict is ``pass``, in profile order: each carries its deciding evidence."""
-    return [r for r in clause_rows(results) if r["verdict"] == "pass"]
+    return [r for r in clause_rows(results) if r["verdict"] == Verdict.PASS]
 
 
 def replay_for(results: Mapping[str, Any], entry: Mapping[str, Any]) -> dict[str, Any] | None:
