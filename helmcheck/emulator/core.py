@@ -18,6 +18,9 @@ seconds, any monotonic origin) into every call and writes what comes back.
 
 The model is built by ``model_factory(profile, missions)`` (default
 :class:`~helmcheck.model.vehicle.VehicleModel`; a test may pass a deliberately faulty one).
+This module keeps input, the hand-over to the model, the off-wire events and the live view; the
+clocks and catching up are :mod:`.timeline`'s, the output queue :mod:`.outbox`'s, the log
+records :mod:`.logs`' and the settings file :mod:`.settingsfile`'s.
 
 Freedoms (``settings``, :class:`~.freedoms.EmulatorSettings`; defaults: the behaviour described
 here): where the profile lets a conforming vehicle choose, the core can choose otherwise — a
@@ -32,34 +35,32 @@ A valid command goes to the model; a well-framed known command with bad fields g
 model as its :class:`~helmcheck.grammar.errors.SentenceError` so it is answered with the
 error ACK (RH-ACK-3); framing errors and unknown IDs are discarded silently (RH-FRM-4/5).
 
-Time (RH-TIM-2): vehicle time is ``time_scale × (now - start)``; the model and the plant run on
-vehicle time, so every protocol duration shrinks by the time scale in wall time. Output pacing
-(10 bits per byte at ``baud``, RH-ACK-2's transmit time) is wall time. ``baud = 0`` sends
-everything at once.
+Time (RH-TIM-2, :mod:`.timeline`): vehicle time is ``time_scale × (now - start)``; the model and
+the plant run on vehicle time, so every protocol duration shrinks by the time scale in wall
+time. Output pacing (10 bits per byte at ``baud``, RH-ACK-2's transmit time) is wall time.
+``baud = 0`` sends everything at once.
 
 Logs: the wire log (``helmcheck.grammar.wirelog`` format) records every input line or
 discarded run (``>``/``>~``), every sentence sent (``<``) and notes (``!``) for plant and model
 events, injected faults and link changes; times are wall seconds since ``start``. Accepted
-``$OLOGD`` rows (RH-LOG-2) go to the main log, a CSV file. Memory stays bounded: the model
-keeps only its last rows and ``$OPOS`` records (:attr:`VehicleModel.HISTORY`), the core asks it
-for the rows written since it last looked (``log_rows_since``), and the output queue is capped
-(:data:`MAX_OUTBOX_BYTES`).
+``$OLOGD`` rows (RH-LOG-2) go to the main log, a CSV file (:class:`~.logs.MainLog`). Memory
+stays bounded: the model keeps only its last rows and ``$OPOS`` records
+(:attr:`VehicleModel.HISTORY`), the core asks it for the rows written since it last looked
+(``log_rows_since``), and the output queue (:mod:`.outbox`) is capped
+(:data:`~.outbox.MAX_OUTBOX_BYTES`).
 """
 
 from __future__ import annotations
 
-import csv
-import json
 import math
 from collections import deque
-from dataclasses import dataclass, fields as dc_fields
 from pathlib import Path
-from typing import IO, Any, Callable, Optional
+from typing import Any, Callable, Optional
 
 from ..grammar import Decoded, Discard, Framer, decode, prepare
 from ..grammar import format as format_sentence
 from ..grammar import sentences as s
-from ..grammar.wirelog import FROM_VEHICLE, NOTE, TO_VEHICLE, WireLogWriter, escape
+from ..grammar.wirelog import NOTE, TO_VEHICLE, WireLogWriter, escape
 from ..grammar.errors import SentenceError
 from ..model.missions import MissionCatalog
 from ..model.plant import SafetyViolation
@@ -67,66 +68,16 @@ from ..model.vehicle import VehicleModel
 from ..profile import SAFETY_CODES, Profile
 from ..line.transport import LinePacer
 from .freedoms import DEFAULT_SETTINGS, EmulatorSettings, ReplyDelay, ReplyShaper, SkewedTimers
+from .logs import HistoryEntry, MainLog, event_text
+from .outbox import MAX_OUTBOX_BYTES, Outbox
 from .plant import Plant, PlantParams
 from .rules import OperationTimeRule
+from .settingsfile import load_settings, save_settings
+from .timeline import Timeline
 
 __all__ = ["EmulatorCore", "HistoryEntry", "MainLog", "MAX_OUTBOX_BYTES", "DEFAULT_UTC0", "plant_params"]
 
-#: Replies waiting for the line are capped; beyond this a flood's replies are dropped (noted).
-MAX_OUTBOX_BYTES = 64 * 1024
 DEFAULT_UTC0 = 1_767_225_600.0  # 2026-01-01T00:00:00Z
-
-
-@dataclass(frozen=True, slots=True)
-class HistoryEntry:
-    """One line for a live view: wall seconds since start, direction, text, verdict."""
-
-    t: float
-    direction: str  #: ">" in, "<" out, "!" note
-    text: str
-    verdict: str = ""
-
-
-class MainLog:
-    """The vehicle's main log as CSV: a header row whenever the ``$OLOGL`` labels change,
-    then one row per accepted ``$OLOGD`` (RH-LOG-1, RH-LOG-2)."""
-
-    def __init__(self, stream: IO[str]):
-        self._f = stream
-        self._w = csv.writer(stream, lineterminator="\n")
-        self._labels: Optional[tuple[str, ...]] = None
-
-    def write(self, vehicle_t: float, utc: float, lat: float, lon: float, depth: float,
-              labels: tuple[str, ...], values: tuple[str, ...]) -> None:
-        if labels != self._labels:
-            self._w.writerow(["vehicle_time_s", "utc", "lat", "lon", "depth_m", *labels])
-            self._labels = labels
-        self._w.writerow([f"{vehicle_t:.3f}", f"{utc:.3f}", f"{lat:.8f}", f"{lon:.8f}",
-                          f"{depth:.2f}", *values])
-        self._f.flush()
-
-    def close(self) -> None:
-        self._f.close()
-
-
-def _reply_label(raw: bytes) -> str:
-    """What a live view says about a sentence the vehicle sent: an ``$ACK`` is ``accepted``
-    (status 0) or ``refused (err N)`` (status 1, RH-ACK-1); other sentences say nothing."""
-    if not raw.startswith(b"$ACK,"):
-        return ""
-    fields = raw[5:].split(b"*", 1)[0].split(b",")
-    if len(fields) < 3:
-        return ""
-    if fields[1] == b"0":
-        return "accepted"
-    return f"refused (err {fields[2].decode('ascii', 'replace')})"
-
-
-def _event_text(e: Any) -> str:
-    parts = [f"{f.name}={getattr(e, f.name)!r}" for f in dc_fields(e) if f.name != "at"]
-    clause = getattr(e, "clause", "")
-    inner = ", ".join(parts)
-    return f"{type(e).__name__}({inner})" + (f" [{clause}]" if clause else "")
 
 
 def plant_params(st: EmulatorSettings) -> PlantParams:
@@ -138,7 +89,7 @@ def plant_params(st: EmulatorSettings) -> PlantParams:
                        start_heading=st.start_heading, speed_factor=st.speed_factor)
 
 
-class EmulatorCore:
+class EmulatorCore(Timeline, Outbox):
     """One emulated vehicle behind a byte stream. See the module docstring."""
 
     def __init__(self, profile: Profile, missions: Optional[MissionCatalog] = None, *,
@@ -188,16 +139,8 @@ class EmulatorCore:
         self.last_command_v: float = 0.0
         self._log_written = 0  #: the model's ``log_row_count`` already in the main log
         if settings_path is not None:
-            self._load_settings(settings_path)
+            load_settings(self.model.settings, settings_path)
         self._push_snapshot()
-
-    # ================================================================ clocks
-    def vehicle_time(self, now: float) -> float:
-        """Vehicle seconds at wall time ``now`` (RH-TIM-2)."""
-        return (now - self.start) * self.time_scale
-
-    def wall_time(self, vehicle_t: float) -> float:
-        return self.start + vehicle_t / self.time_scale
 
     # ================================================================ public API
     def feed(self, data: bytes, now: float) -> bytes:
@@ -247,42 +190,6 @@ class EmulatorCore:
         control ticks (RH-RD-15), never before what the model has reached."""
         return max(v, self.vehicle_time(now)) if self.tick_v else v
 
-    def next_wakeup(self) -> Optional[float]:
-        """Wall time of the next thing :meth:`tick` must do, or ``None`` (wait for input)."""
-        best: Optional[float] = None
-        up = self._tick_up
-        md = self.model.next_deadline()
-        if md is not None:
-            best = self.wall_time(up(max(md, self.v)))
-        rd = self.rules.due_v
-        if rd is not None:
-            w = self.wall_time(up(max(rd, self.v)))
-            best = w if best is None else min(best, w)
-        pb = self.plant.next_event_in(self.model)
-        if pb is not None:
-            w = self.wall_time(up(self.v + max(pb, self.plant.params.dt / 4)))
-            best = w if best is None else min(best, w)
-        if self._out:
-            w = self.pacer.free_at
-            best = w if best is None else min(best, w)
-        if self._inbox:
-            w = self._inbox[0][0]
-            best = w if best is None else min(best, w)
-        return best
-
-    def _tick_up(self, v: float) -> float:
-        """The first control tick at or after vehicle time ``v`` (``v`` itself with no tick)."""
-        k = self.tick_v
-        if not k:
-            return v
-        return max(v, math.ceil(v / k - 1e-9) * k)
-
-    def _tick_down(self, v: float) -> float:
-        k = self.tick_v
-        if not k:
-            return v
-        return math.floor(v / k + 1e-9) * k
-
     def inject_fault(self, code: str, now: float, source: str = "key") -> bytes:
         """Raise safety violation ``code`` on the vehicle at once (RH-SAF-1, RH-SAF-5)."""
         if code not in SAFETY_CODES:
@@ -291,7 +198,7 @@ class EmulatorCore:
         self.stats["faults"] += 1
         self._note(now, f"fault injected ({source}): {code}")
         for e in self._model_call(lambda: self.model.plant(SafetyViolation(code), v), now) or ():
-            self._note(now, f"model: {_event_text(e)}")
+            self._note(now, f"model: {event_text(e)}")
         self._after_model(now)
         return self._release(now)
 
@@ -344,10 +251,6 @@ class EmulatorCore:
     def note(self, now: float, text: str) -> None:
         """Write a ``!`` note in the wire log (and the live history)."""
         self._note(now, text)
-
-    @property
-    def pending_output(self) -> int:
-        return self._out_bytes
 
     # ================================================================ input
     def _discard(self, ev: Discard, now: float) -> None:
@@ -448,7 +351,7 @@ class EmulatorCore:
         """Flush the model's pending events to the log and let the plant see the new goal."""
         evs = self._model_call(self.model.drain_events, now) or ()
         for e in evs:
-            self._note(now, f"model: {_event_text(e)}")
+            self._note(now, f"model: {event_text(e)}")
         self.plant.sync(self.model)
 
     def _write_main_log(self) -> None:
@@ -461,104 +364,7 @@ class EmulatorCore:
                                     row.labels, row.values)
         self._log_written = m.log_row_count
 
-    # ================================================================ time
-    def _catch_up(self, now: float) -> float:
-        """Bring plant and model to vehicle time ``vehicle_time(now)``, events in time order."""
-        target = self._tick_down(self.vehicle_time(now))
-        if target < self.v:
-            target = self.v
-        m, p = self.model, self.plant
-        up = self._tick_up
-        for _ in range(100_000):  # a hard bound; each pass consumes time, an event or a timer
-            md = m.next_deadline()
-            if md is not None and self.tick_v:
-                md = up(md)  # a timer takes effect on the control tick after it ran out
-            if md is not None and md <= self.v:
-                self._push_snapshot()
-                wall = self.wall_time(self.v)
-                for me in self._model_call(lambda: m.advance(self.v), wall) or ():
-                    self._note(wall, f"model: {_event_text(me)}")
-                p.sync(m)
-                continue
-            rd = self.rules.due_v
-            if rd is not None and self.tick_v:
-                rd = up(rd)
-            if rd is not None and rd <= self.v:  # the mission's Maximum Operation Time tripped
-                self._push_snapshot()
-                wall = self.wall_time(self.v)
-                ev = self.rules.fire()
-                self.stats["faults"] += 1
-                self._note(wall, f"plant: {_event_text(ev)} at v={self.v:.3f}")
-                for me in self._model_call(lambda: m.plant(ev, self.v), wall) or ():
-                    self._note(wall, f"model: {_event_text(me)}")
-                p.sync(m)
-                continue
-            seg_end = min(x for x in (target, md, rd) if x is not None)
-            if self.v >= seg_end:
-                break
-            evs = p.step(m, seg_end - self.v)
-            if not evs:
-                self.v = seg_end
-                continue
-            self.v = min(seg_end, self.v + p.consumed)
-            if self.tick_v:  # the control loop learns of it on its next tick
-                tick_end = min(seg_end, up(self.v))
-                while self.v < tick_end - 1e-12:
-                    more = p.step(m, tick_end - self.v)
-                    self.v = min(tick_end, self.v + p.consumed) if more else tick_end
-                    evs += more
-                self.v = tick_end
-            self._push_snapshot()
-            wall = self.wall_time(self.v)
-            for e in evs:
-                self._note(wall, f"plant: {_event_text(e)} at v={self.v:.3f}")
-                for me in self._model_call(lambda e=e: m.plant(e, self.v), wall) or ():
-                    self._note(wall, f"model: {_event_text(me)}")
-            p.sync(m)
-        self._push_snapshot()
-        return self.v
-
-    def _push_snapshot(self) -> None:
-        m = self.model
-        if self._shaper.st.idle_distance == "last":
-            target = m.navigation_target()
-            if target is not None:
-                self._last_target = target
-        snap = self.plant.snapshot(m, self.v, self.utc0, m.snapshot)
-        out = self._model_call(lambda: m.update_plant(snap), self.wall_time(self.v)) or ()
-        for me in out:
-            self._note(self.wall_time(self.v), f"model: {_event_text(me)}")
-
     # ================================================================ output
-    def _send(self, raw: bytes, now: float) -> None:
-        if self._out_bytes + len(raw) > MAX_OUTBOX_BYTES:
-            self.stats["dropped_out"] += len(raw)
-            if self.stats["dropped_out"] == len(raw):
-                self._note(now, "output overflow: replies dropped (the line is slower than the requests)")
-            return
-        self._out.append(raw)
-        self._out_bytes += len(raw)
-
-    def _release(self, now: float) -> bytes:
-        if not self._out:
-            return b""
-        out = bytearray()
-        pacer = self.pacer
-        while self._out:
-            if pacer.baud and pacer.free_at > now + 1e-9:
-                break
-            raw = self._out.popleft()
-            self._out_bytes -= len(raw)
-            pacer.reserve(len(raw), now)
-            out += raw
-            self.stats["sentences_out"] += 1
-            if self.log is not None:
-                self.log.bytes(now - self.start, FROM_VEHICLE, raw)
-            self.history.append(HistoryEntry(now - self.start, "<", escape(raw.rstrip(b"\r\n")[:160]),
-                                             _reply_label(raw)))
-        self.stats["bytes_out"] += len(out)
-        return bytes(out)
-
     def _idle_distance(self) -> Optional[float]:
         """``$OSI`` field 7 where the profile leaves it to the vehicle (RH-RD-5: no navigation
         target, in ``S`` or an ``M`` entered from ``S``): the distance to the last target, for
@@ -576,34 +382,15 @@ class EmulatorCore:
         self.history.append(HistoryEntry(now - self.start, NOTE, text))
 
     # ================================================================ settings store
-    def _load_settings(self, path: Path) -> None:
-        """Restore ``$ORWSET`` settings saved by an earlier run (RH-SET-2); a bad file is ignored."""
-        try:
-            data = json.loads(Path(path).read_text(encoding="utf-8"))
-        except (OSError, ValueError):
-            return
-        if not isinstance(data, dict):
-            return
-        store = self.model.settings
-        known = store.as_dict()
-        for name, value in data.items():
-            if name not in known or not isinstance(value, list) or len(value) != 2:
-                continue
-            state, values = value
-            if state in (0, 1) and isinstance(values, list) and all(isinstance(x, str) for x in values):
-                store.write(name, state, tuple(values[:3]))
-
     def _save_settings(self, path: Path) -> None:
-        """Keep the ``$ORWSET`` settings across runs (RH-SET-2), written atomically (a crash
-        leaves the old file or the new one). A file that cannot be written stops the emulator
-        with :class:`~helmcheck.failures.OutputLost` naming it: a vehicle that acknowledged a
-        write it cannot keep must not go on serving as if it had."""
+        """Keep the ``$ORWSET`` settings across runs (RH-SET-2, :func:`.settingsfile.save_settings`).
+        A file that cannot be written stops the emulator with
+        :class:`~helmcheck.failures.OutputLost` naming it: a vehicle that acknowledged a write it
+        cannot keep must not go on serving as if it had."""
         from ..failures import OutputLost
-        from ..reports.atomic import write_text_atomic
 
-        data = {k: [st, list(vals)] for k, (st, vals) in self.model.settings.as_dict().items()}
         try:
-            write_text_atomic(path, json.dumps(data, indent=1) + "\n")
+            save_settings(self.model.settings, path)
         except OSError as e:
             self._note(self.wall_time(self.v), f"settings not saved: {e}")
             raise OutputLost(f"cannot write settings {path}: {e.strerror or e}") from None

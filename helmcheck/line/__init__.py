@@ -1,7 +1,13 @@
 """The tester's side of a serial line, shared by the emulator and the live certifiers.
 
 * :mod:`.transport` — opening a byte link (pty, serial device, TCP serial server, any pyserial
-  URL) and moving bytes over it;
+  URL) from a port spec; it re-exports the names of the modules below:
+* :mod:`.port_spec` — parsing a ``--port`` value, the baud rates;
+* :mod:`.link` — the :class:`~helmcheck.line.link.Link` interface: polling, writing, blocking
+  helpers;
+* :mod:`.pty_link`, :mod:`.serial_link`, :mod:`.tcp_link` — the pseudo-terminal, the serial
+  device (pyserial) and the TCP client and server links;
+* :mod:`.pacer` — :class:`~helmcheck.line.pacer.LinePacer`, a UART's capacity at a baud rate;
 * :mod:`.recorder` — every event of a live run to the wire log (by the one wire-log writer,
   :mod:`helmcheck.grammar.wirelog`) and to the judges, identically;
 * :mod:`.launcher` — start, watch and stop the implementation under test (``--exec CMD``);

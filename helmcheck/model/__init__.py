@@ -6,6 +6,8 @@ Modules, one concern each:
   fast dispatch index; :mod:`~helmcheck.model.chart` — the python-statemachine statechart built
   from it; :mod:`~helmcheck.model.docs` — generated Graphviz/Markdown docs.
 * :mod:`~helmcheck.model.vehicle` — :class:`VehicleModel` (``receive``/``advance``/``plant``);
+  :mod:`~helmcheck.model.status` — what its state reads as (``$OSI``, data sentences, field 7);
+  :mod:`~helmcheck.model.effects` — the state changes its handlers share;
   :mod:`~helmcheck.model.handlers` — what each accepted event does to the data;
   :mod:`~helmcheck.model.records` — logged rows and ``$OPOS`` outcomes.
 * :mod:`~helmcheck.model.validate` — field ranges; :mod:`~helmcheck.model.settings` — the

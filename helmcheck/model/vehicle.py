@@ -15,6 +15,11 @@ Inputs, all with the model-clock time ``now`` in seconds (never read from a cloc
 Every mode and phase change goes through :data:`~helmcheck.model.transitions.TABLE` via
 :func:`~helmcheck.model.transitions.select`; the handlers here only do the data part.
 
+This module keeps the inputs, the timer and table dispatch, clones and the checkpoint; the class
+takes what its state reads as (``$OSI``, data sentences, field 7, park time, invariants) from
+:mod:`~helmcheck.model.status` and the state changes the handlers share from
+:mod:`~helmcheck.model.effects`.
+
 Order of checks for a command (RH-RD-2): unknown ID → no reply (RH-FRM-5; a command the
 profile's ``commands`` lacks counts as unknown); lockout rows (err 26, also for a malformed
 command); field syntax and ranges (the ``SentenceError``'s error, or
@@ -62,16 +67,17 @@ from ..grammar import sentences as s
 from ..grammar.errors import SentenceError
 from ..profile import DEFAULT, SAFETY_CODES, Profile
 from . import events as ev
-from .data import CLASS_OF_LETTER, DataCache, park_seconds
-from .geo import distance_m
+from .data import DataCache
+from .effects import StateEffects
 from .missions import BadMission, InMemoryCatalog, Mission, MissingMission, MissionCatalog, normalise_name
-from .plant import (NEUTRAL, AtSurface, OnStation, PlantEvent, PlantSnapshot, QueueWaypointReached,
-                    SafetyViolation, Submerged, WaypointReached)
+from .plant import (AtSurface, OnStation, PlantEvent, PlantSnapshot, QueueWaypointReached, SafetyViolation,
+                    Submerged, WaypointReached)
 from .records import LogRow, OposRecord
 from .handlers import APPLY as _APPLY, CHECKS as _CHECKS, EXPIRE as _EXPIRE, ack as _ack
 from .settings import SettingsStore
+from .status import VehicleStatus
 from .timers import Timers
-from .transitions import ERRORS, EVENT_OF_ACK_TYPE, REMOTE_MODES, STAY, Row, rows_for, select
+from .transitions import ERRORS, EVENT_OF_ACK_TYPE, Row, rows_for, select
 from .validate import field_error
 
 __all__ = ["VehicleModel", "LogRow", "OposRecord", "Item", "Step"]
@@ -96,7 +102,7 @@ class Step(NamedTuple):
     duration: float = 0.0
 
 
-class VehicleModel:
+class VehicleModel(VehicleStatus, StateEffects):
     """The reference vehicle state machine. See the module docstring."""
 
     #: How many ``log_rows`` and ``opos_records`` the model keeps (the oldest are dropped).
@@ -192,29 +198,6 @@ class VehicleModel:
         return self.settings.safety_action == "srp" and self.srp_mission is not None
 
     # ======================================================================== public API
-
-    @property
-    def snapshot(self) -> PlantSnapshot:
-        return self._snap
-
-    @property
-    def gps_fix(self) -> bool:
-        """RH-RD-10: a fix needs the surface and a mission not started with ignore-GPS."""
-        return self._snap.depth_m <= self.profile.gps_fix_depth_m and not (
-            self.mission is not None and self.ignore_gps)
-
-    @property
-    def at_surface(self) -> bool:
-        return self._snap.depth_m <= self.profile.gps_fix_depth_m
-
-    @property
-    def dvl_in_use(self) -> bool:
-        """RH-DVL-1, RH-RD-10: ``$ODVL`` velocities are used while active and submerged."""
-        return self.dvl is not None and not self.at_surface
-
-    @property
-    def remote_active(self) -> bool:
-        return self.mode in REMOTE_MODES
 
     def next_deadline(self) -> Optional[float]:
         """The model time of the next timer expiry, or ``None`` when no timer runs."""
@@ -343,39 +326,7 @@ class VehicleModel:
         out, self._pending = self._pending, []
         return out
 
-    # ------------------------------------------------------------------ observable state
-
-    @property
-    def opk_counting(self) -> bool:
-        """RH-PK-2: the ``$OPK`` park countdown runs (the vehicle is on station)."""
-        return self.timers.armed("opk")
-
-    @property
-    def lockout_active(self) -> bool:
-        """RH-SAF-1: the lockout after a safety violation runs (commands but ``$OSD`` get 26)."""
-        return self.phase == "lockout"
-
-    def navigation_target(self) -> Optional[tuple[float, float]]:
-        """RH-RD-5: the position ``$OSI`` field 7 measures the distance to, or ``None`` (field 7
-        is 0): the ``$OPK`` position in ``mP``, the first queued ``$OMW`` waypoint in ``W``, the
-        mission's next waypoint in ``N`` and in ``P`` (not while a frozen park has no time set)."""
-        if self.mode == "mP" and self.opk is not None:
-            return float(self.opk.lat), float(self.opk.lon)
-        if self.mode == "W" and self.queue:
-            return float(self.queue[0].lat), float(self.queue[0].lon)
-        if self.mode in ("N", "P") and self.mission is not None and not (
-                self.mode == "P" and self.park_left is None and not self.timers.armed("park")):
-            w = self.mission.waypoints[self.mission_wp]
-            return w.lat, w.lon
-        return None
-
-    def log_rows_since(self, count: int) -> list[LogRow]:
-        """The main-log rows written after the first ``count`` (RH-LOG-2), oldest first; rows
-        already dropped from the bounded history (:attr:`HISTORY`) are not returned."""
-        new = min(self.log_row_count - count, len(self.log_rows))
-        if new <= 0:
-            return []
-        return list(self.log_rows)[-new:]
+    # ------------------------------------------------------------------ observers' checkpoint
 
     @property
     def checkpoint(self) -> Optional["VehicleModel"]:
@@ -393,56 +344,6 @@ class VehicleModel:
         :class:`~helmcheck.model.plant.OnStation` (an observer that cannot see the position
         adopts the countdown only when the vehicle shows it)."""
         self.timers.disarm("opk")
-
-    def park_remaining(self, now: Optional[float] = None) -> Optional[float]:
-        """Seconds of park left as ``$OSI`` field 10 would show them (before rounding up)."""
-        now = self.now if now is None else now
-        t = self.timers
-        if self.mode == "P":
-            if t.armed("park"):
-                return t.remaining("park", now)
-            return self.park_left
-        if self.mode == "mP":
-            if t.armed("opk"):
-                return t.remaining("opk", now)
-            return float(self.opk_seconds)
-        if self.mode == "W" and self.queue_parking:
-            return t.remaining("qpark", now)
-        return None
-
-    @property
-    def osi_waypoint(self) -> int:
-        """``$OSI`` field 3: the (frozen) mission waypoint, 0 in ``S`` (RH-RD-5)."""
-        return self.mission_wp if self.mission is not None else 0
-
-    def state(self, now: Optional[float] = None) -> tuple[str, int, str, int, bool]:
-        """(mode, field 3, error state, field 10 seconds, SRP active): the judged ``$OSI`` fields."""
-        return (self.mode, self.osi_waypoint, self.error_state,
-                park_seconds(self.park_remaining(now)), self.srp_active)
-
-    def osi(self, now: Optional[float] = None) -> s.OSI:
-        """The ``$OSI`` a conforming vehicle reports now (RH-OUT-1, RH-OUT-4)."""
-        m = self.mission or self.loaded
-        if self.mode == "M":
-            act = self.primitive.actuators.upper()  # type: ignore[union-attr]
-        elif self.mode == "S":
-            act = NEUTRAL
-        else:
-            act = self._snap.actuators
-        return self._data.osi(
-            actuators=act, mode=self.mode, next_waypoint=self.osi_waypoint,
-            distance=self._distance(), error_state=self.error_state,
-            park_time=park_seconds(self.park_remaining(now)),
-            mission_name=m.name if m is not None else "", srp_active=self.srp_active)
-
-    def data(self, letter: str, now: Optional[float] = None) -> s.Reply:
-        """The data sentence for one ``$OSD`` letter (RH-OSD-1); its class name only when
-        :attr:`data_names` is set."""
-        if self.data_names:
-            return CLASS_OF_LETTER[letter].__name__  # type: ignore[return-value]
-        if letter == "S":
-            return self.osi(now)
-        return self._data.sentence(letter, self.gps_fix)
 
     def clone(self) -> "VehicleModel":
         """An independent copy (for shadows and what-if questions)."""
@@ -462,67 +363,7 @@ class VehicleModel:
         from .observe import expectation
         return expectation(self, now, slack)
 
-    def check_invariants(self) -> list[str]:
-        """Internal consistency of the model's state; an empty list when all hold."""
-        bad = []
-        m = self.mode
-        if (m == "A") != (self.servo is not None):
-            bad.append("A iff servo set-points")
-        if (m == "M") != (self.primitive is not None):
-            bad.append("M iff primitive")
-        if (m == "mP") != (self.opk is not None):
-            bad.append("mP iff $OPK")
-        if (m == "W") != bool(self.queue):
-            bad.append("W iff queue non-empty")
-        if m in ("N", "P", "mP", "A", "W") and self.mission is None:
-            bad.append(f"{m} without a running mission")
-        if m == "S" and self.mission is not None:
-            bad.append("S with a running mission")
-        if m in ("N", "P") and self.mission_mode != m:
-            bad.append(f"mode {m} but mission behaviour {self.mission_mode}")
-        if self.phase == "lockout" and (m not in ("S", "N", "P") or not self.timers.armed("lockout")):
-            bad.append("lockout outside S/N/P or without its timer")
-        if self.phase == "ascent" and m not in ("S", "N", "P", "M"):
-            bad.append(f"ascent in {m}")
-        if self.phase != "none" and self.error_state == "N":
-            bad.append("safety phase without a code")
-        if self.timers.armed("park") and not (m == "P" and self.phase == "none"):
-            bad.append("mission park counting outside P")
-        if self.mission is not None and not 0 <= self.mission_wp <= self.mission.last:
-            bad.append("mission waypoint out of range")
-        return bad
-
     # ========================================================================= internals
-
-    def _set_snapshot(self, snap: PlantSnapshot) -> None:
-        if snap is not self._snap:
-            self._snap = snap
-            self._data = DataCache(self.profile, snap)
-
-    def _distance(self) -> float:
-        """``$OSI`` field 7 (RH-RD-5): metres to :meth:`navigation_target`, else 0."""
-        target = self.navigation_target()
-        if target is None:
-            return 0.0
-        p = self._snap
-        return distance_m(p.lat, p.lon, target[0], target[1])
-
-    def _own_history(self) -> None:
-        """Take a private copy of the bounded histories before changing them (a clone shares them)."""
-        if self._history_shared:
-            self.log_rows = deque(self.log_rows, maxlen=self.HISTORY)
-            self.opos_records = deque(self.opos_records, maxlen=self.HISTORY)
-            self._history_shared = False
-
-    def _write_log_row(self, row: LogRow) -> None:
-        """RH-LOG-2: keep ``row`` in the bounded history and count it."""
-        self._own_history()
-        self.log_rows.append(row)
-        self.log_row_count += 1
-
-    def _control_changed(self) -> None:
-        """The remote-control goal (set-points, ``$OPK`` position, queue head) may have changed."""
-        self.control_generation += 1
 
     def _receive_error(self, err: SentenceError) -> list[s.Reply]:
         t = err.ack_type
@@ -565,40 +406,6 @@ class VehicleModel:
         _APPLY[event](self, row, None, now)
         return row
 
-    def _transition(self, row: Row, now: float) -> None:
-        """Set mode and phase from ``row``; keep the mission park counting only in P (RH-RD-5)."""
-        if row.target != STAY:
-            self.mode = row.target
-        if row.phase_to is not None:
-            self.phase = row.phase_to
-        counting = self.mode == "P" and self.phase == "none" and self.mission is not None
-        armed = self.timers.armed("park")
-        if counting and not armed and self.park_left is not None:
-            self.timers.arm("park", now, self.park_left)
-            self.park_left = None
-        elif armed and not counting:
-            self.park_left = self.timers.remaining("park", now)
-            self.timers.disarm("park")
-
-    def _end_remote(self) -> None:
-        """RH-INT-1: end whatever remote control is active (there is no stack)."""
-        self._control_changed()
-        self.servo = None
-        self.primitive = None
-        self.opk = None
-        self.queue = []
-        self.queue_parking = False
-        t = self.timers
-        t.disarm("remote")
-        t.disarm("opk")
-        t.disarm("qpark")
-
-    def _release(self, row: Row, now: float) -> None:
-        """RH-INT-2: remote control ended; resume the frozen mission behaviour."""
-        self._end_remote()
-        self._transition(row, now)
-        self._pending.append(ev.ControlReleased(now, self.mode))
-
     def _violation(self, code: str, now: float) -> None:
         """RH-SAF-1, RH-RD-11: show the code, end remote control for good, lock out."""
         if code not in _SAFETY:
@@ -614,32 +421,6 @@ class VehicleModel:
         self.timers.arm("lockout", now, self.profile.lockout_s)
         self._transition(row, now)
         self._pending.append(ev.SafetyRaised(now, code))
-
-    def _maybe_surface(self, now: float) -> None:
-        if self.phase == "ascent" and self.at_surface:
-            self._fire("surfaced", now)
-
-    def _start(self, mission: Mission, row: Row, now: float, *, ignore_gps: bool,
-               srp: Optional[Mission], as_srp: bool) -> None:
-        self.loaded = mission
-        self._reset_mission(mission, ignore_gps=ignore_gps, srp=srp, as_srp=as_srp)
-        self._transition(row, now)
-
-    def _reset_mission(self, mission: Optional[Mission], *, ignore_gps: bool = False,
-                       srp: Optional[Mission] = None, as_srp: bool = False) -> None:
-        """Mission state as ``$OMSTART`` leaves it (``mission`` given) or ``$OMSTOP`` (None):
-        remote control and the queue ended, the safety episode over (RH-MSN-2/3, RH-RD-13)."""
-        self._end_remote()
-        self.mission = mission
-        self.mission_mode = "N"
-        self.mission_wp = 0
-        self.park_left = None
-        self.ignore_gps = ignore_gps
-        self.srp_mission = srp
-        self.srp_active = as_srp
-        self.error_state = "N"
-        self.timers.disarm("lockout")
-        self.timers.disarm("park")
 
     def _lookup(self, name: str) -> Union[Mission, MissingMission, BadMission]:
         return self.missions.lookup(normalise_name(name))

@@ -17,6 +17,12 @@ Modules, one concern each:
 * :mod:`~helmcheck.reports.timeline` — the mode timeline SVG.
 * :mod:`~helmcheck.reports.html`, :mod:`~helmcheck.reports.junit`,
   :mod:`~helmcheck.reports.markdown`, :mod:`~helmcheck.reports.compare` — the renderings.
+* The HTML report's parts: :mod:`~helmcheck.reports.html_style` — its CSS and
+  Content-Security-Policy; :mod:`~helmcheck.reports.html_markup` — escaping, profile Markdown,
+  tables; :mod:`~helmcheck.reports.html_certificate` — the first page;
+  :mod:`~helmcheck.reports.html_clauses` — clause matrix, findings, passing evidence;
+  :mod:`~helmcheck.reports.html_run` — implementation, run, process, restore;
+  :mod:`~helmcheck.reports.html_coverage` — model coverage and the event table.
 * :mod:`~helmcheck.reports.render` — :func:`render_all` (the command line is ``helmcheck report``).
 * :mod:`~helmcheck.reports.matrix` — several runs side by side (``helmcheck matrix``).
 

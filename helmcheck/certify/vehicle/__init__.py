@@ -21,6 +21,9 @@ entry point is :func:`.runner.certify`. Modules, one concern each:
 * :mod:`.resume` — ``--resume DIR``: an interrupted run goes on from its last completed case.
 * :mod:`.plan` — ``--plan``: the run's estimated time, from the cases run in virtual time
   (:mod:`.virtual`: a serial line in virtual time with the reference vehicle at its far end).
-* :mod:`.runner` — one certification run: cases, exploration, results and reports.
+* :mod:`.runner` — one certification run: cases, exploration, results and reports;
+  :mod:`.resultsfile` — its ``results.json``: what it starts as, each save, a tester error's
+  traceback beside it; :mod:`.exec_child` — the vehicle under test when helmcheck starts it
+  (``--exec``).
 * :mod:`.progress` — the progress display (rich on a terminal, plain lines otherwise).
 """

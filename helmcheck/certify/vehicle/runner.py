@@ -5,8 +5,9 @@ that something answers (a link that carries nothing, or only garbage, is INCONCL
 reason), checks that the vehicle's clock runs at the declared time scale (:mod:`.clockprobe`: a
 clear mismatch stops the run INCONCLUSIVE, naming both rates), runs the selected clause cases
 in order (:mod:`.interpreter`), then the hypothesis exploration (:mod:`.explore`), and writes
-``DIR/results.json`` after every case — atomically, so a crash or Ctrl-C leaves a valid partial
-report marked ``partial`` — plus ``DIR/wire.log`` and, at the end, every report format.
+``DIR/results.json`` after every case (:mod:`.resultsfile`) — atomically, so a crash or Ctrl-C
+leaves a valid partial report marked ``partial`` — plus ``DIR/wire.log`` and, at the end, every
+report format.
 
 Every byte and note goes through one :class:`~helmcheck.line.recorder.Recorder`: to the
 wire log, to the one vehicle observer (:class:`~helmcheck.judge.vehicle.VehicleObserver`),
@@ -20,8 +21,8 @@ A vanished device stops the run: a ``run aborted`` note makes the clauses not ye
 INCONCLUSIVE with that reason, and the report is still written.
 
 With ``Options.exec_cmd`` (``--exec``) helmcheck starts the vehicle under test itself on the
-port (:mod:`helmcheck.line.exec_port`, :mod:`helmcheck.line.launcher`), checks it
-is still running before every case, and stops it at the end. If it ends before the run's end,
+port (:mod:`.exec_child`; :mod:`helmcheck.line.exec_port`, :mod:`helmcheck.line.launcher`),
+checks it is still running before every case, and stops it at the end. If it ends before the run's end,
 that is a finding about the vehicle, not a link fault: the clauses judged before keep their
 verdicts, those not judged yet are NOT-TESTED with the exit as the reason (a ``not tested``
 note), the exit is recorded as a ``process:`` note (``results.json`` ``process``), and the run
@@ -42,17 +43,18 @@ from ...clauses import vehicle_clauses
 from ...failures import describe_interrupt
 from ...grammar import prepare
 from ...judge import Ledger
-from ...judge.runfacts import RunFacts, partial_note, process_note, selection_note
+from ...judge.runfacts import RunFacts, partial_note, selection_note
 from ...judge.vehicle import VehicleObserver
 from ...judge.wire import tester_note
 from ...profile import Profile
 from ...reports import results as R
-from ...reports.assemble import apply, assemble
 from ...line.recorder import Recorder
 from ...reports.certificate import RunDeclaration, finish_run
 from ...line.transport import open_link
+from . import resultsfile
 from .catalogue import select_cases
 from .clockprobe import ClockMismatch, check_clock
+from .exec_child import ExecChild
 from .flow import LinkLost, LinkSilent
 from .interpreter import run_case
 from .link import TesterLink
@@ -116,7 +118,7 @@ def selected_ids(select: Optional[list]) -> list[str]:
     return [cid for cid in ids if any(fnmatchcase(cid, p) for p in select)]
 
 
-class Run:
+class Run(ExecChild):
     """State of one certification run (see :func:`certify`)."""
 
     def __init__(self, opts: Options):
@@ -136,21 +138,7 @@ class Run:
         self.stopped: Optional[str] = None  #: a start-up check stopped the run: leads the verdict reason
         self.partial = False
         self.t_start = time.monotonic()
-        settings = {"time_scale": self.k, "strict": opts.strict, "hypothesis_profile": opts.hypothesis_profile,
-                    "select": list(opts.select or []), "ack_window_s": self.p.ack_window_s,
-                    "bench_safety": {"enforced": not self.p.bench_safety.in_water,
-                                     "max_motor_byte": self.p.bench_safety.max_motor_byte,
-                                     "max_speed_kn": self.p.bench_safety.max_speed_kn}}
-        if opts.seed is not None:
-            settings["seed"] = opts.seed
-        if opts.examples is not None:
-            settings["examples"] = opts.examples
-        self.results = R.new_results("vehicle", command=opts.command, tool_version=__version__,
-                                     implementation={"port": opts.port, "protocol": self.p.protocol,
-                                                     "osi_fields": self.p.osi_fields,
-                                                     "fault_injection": self.p.fault_injection},
-                                     profile=self.p.as_dict(), settings=settings, seed=opts.seed)
-        self.results["cases"] = []
+        self.results = resultsfile.new_results(opts)
         self.recorder: Optional[Recorder] = None
         self.link: Optional[TesterLink] = None
         self.session: Optional[Session] = None
@@ -164,42 +152,8 @@ class Run:
 
     # ------------------------------------------------------------------ results
     def save(self, final: bool = False) -> None:
-        r = self.results
-        obs = self.observer
-        if self.recorder is None:  # no record at all: the facts the notes would have given
-            self.facts.select = tuple(self.o.select or ())
-        partial = None  # from the record's own ``run partial`` note
-        if not final or (self.partial and self.facts.partial is None):
-            partial = True
-        lead = (self.aborted if self.partial else self.stopped) or ""
-        assembly = assemble("vehicle", self.ledger, self.facts, strict=self.o.strict, partial=partial,
-                            lead=lead if final else "")
-        r["timeline"] = [{"t": t, "mode": m} for t, m in obs.timeline]
-        r["events"] = list(obs.events)
-        modes = sorted({m for _, m in obs.timeline})
-        pairs = [list(p) for p in sorted(obs.interrupt_pairs)]
-        steps = [[a, "observed", b] for (_, a), (_, b) in zip(obs.timeline, obs.timeline[1:]) if a != b]
-        r["coverage"] = {"modes": modes, "transitions": [list(x) for x in sorted({tuple(s) for s in steps})],
-                         "interrupt_pairs": pairs}
-        if obs.last_osi is not None and obs.last_osi.vehicle_name:
-            r["implementation"]["vehicle_name"] = obs.last_osi.vehicle_name
-        if self.link is not None:
-            r["settings"]["bench_safety"]["refused_lines"] = self.link.guard.refused
-        if self.custodian.attempted or any(x.before is not None for x in self.custodian.records.values()):
-            r["restore"] = self.custodian.record()
-        if self.session is not None:
-            self.stats["forced_wait_s"] = round(self.session.forced_wait, 3)
-        self.stats["wall_s"] = round(time.monotonic() - self.t_start
-                                     + (self.resumed.wall_s if self.resumed is not None else 0.0), 3)
-        r["stats"] = self.stats
-        apply(r, assembly, final=final, duration_s=self.stats["wall_s"])
-        for rep in r["replays"]:  # where a clause's replay script is (not a verdict)
-            for c in r["clauses"]:
-                if c["id"] == rep["clause"]:
-                    c["replay"] = rep["file"]
-        if not final:
-            r["verdict_reason"] = "The run is in progress."
-        R.write_results_atomic(self.dir, r)
+        """Write ``results.json`` (:func:`.resultsfile.save`)."""
+        resultsfile.save(self, final)
 
     # ------------------------------------------------------------------ main
     def open(self) -> None:
@@ -361,55 +315,6 @@ class Run:
                                if case.subject in self.ledger else outcome)
             self.save()
 
-    # ------------------------------------------------------------------ the vehicle under test (--exec)
-    def _start_child(self):
-        """Start the vehicle under test on the port; the link once it has opened it."""
-        from ...line.exec_port import ChildNotReady, open_for_child
-        from ...line.launcher import Launcher
-
-        self.child = Launcher(self.o.exec_cmd, subject="vehicle", directory=self.dir, grace_s=self.o.exec_grace_s)
-        try:
-            return open_for_child(self.o.port, self.child, baud=self.p.baud, time_scale=self.k,
-                                  ready_s=self.o.exec_ready_s)
-        except ChildNotReady as e:
-            raise LinkLost(str(e)) from None
-
-    def child_gone(self, settle_s: float = 0.0) -> Optional[str]:
-        """Why the run cannot go on when the vehicle under test has ended by itself, else None.
-
-        *settle_s*: after a link fault, how long to give its exit to become visible (the port
-        closes before the process is reaped)."""
-        c = self.child
-        if c is None or c.proc is None:
-            return None
-        if settle_s and c.stopping_at is None and not c.ended:
-            c.wait(settle_s)
-        if not c.ended_by_itself:
-            return None
-        return f"the vehicle under test {c.exit_text()} at {c.ended_at - self.t_start:.1f} s"
-
-    def check_child(self) -> None:
-        """Between cases: :class:`LinkLost` if the vehicle under test has ended."""
-        gone = self.child_gone()
-        if gone:
-            raise LinkLost(gone)
-
-    def stop_child(self) -> None:
-        """End of the run: stop the vehicle under test and record its end as a ``process:`` note
-        (a run fact: ``results.json`` ``process``), before the record closes."""
-        c = self.child
-        if c is None or c.proc is None:
-            return
-        if self.aborted and not c.ended:
-            c.wait(1.0)  # a link fault may be its exit, not yet reaped
-        c.stop()
-        rec = c.record(epoch=self.t_start)
-        if self.recorder is not None:
-            t = self.link.now() if self.link is not None else self.recorder.last_t
-            self.recorder.note(t, process_note(rec))
-        else:
-            self.facts.process = rec
-
     def end(self, reason: Optional[str]) -> None:
         """Close the record: a ``run aborted`` note when it ended early (a ``not tested`` note for
         what a dead vehicle under test never reached), then the observer."""
@@ -426,22 +331,6 @@ class Run:
             if self.partial:  # a run fact: it cannot certify a pass
                 self.recorder.note(t, partial_note(reason or "the run was interrupted"))
         self.observer.close()
-
-
-def _keep_traceback(run: Run, exc: BaseException) -> str:
-    """A tester error's traceback beside ``results.json`` (``tester-error.txt``, where the command
-    line writes it too): ``"; traceback in tester-error.txt"`` for the verdict reason, or ``""``."""
-    import traceback
-
-    from ...failures import TRACEBACK_NAME
-    text = (f"helmcheck {__version__} tester error\ncommand: {run.o.command or 'certify()'}\n"
-            f"time: {time.strftime('%Y-%m-%dT%H:%M:%SZ', time.gmtime())}\n\n"
-            + "".join(traceback.format_exception(exc)))
-    try:
-        (run.dir / TRACEBACK_NAME).write_text(text, encoding="utf-8")
-    except OSError:
-        return ""
-    return f"; traceback in {TRACEBACK_NAME}"
 
 
 def certify(opts: Options) -> Outcome:
@@ -475,7 +364,7 @@ def certify(opts: Options) -> Outcome:
         run.aborted = describe_interrupt(e)
     except Exception as e:  # a tester error: the results say partial, the command line says why
         run.partial = True
-        run.aborted = f"tester error ({type(e).__name__}){_keep_traceback(run, e)}"
+        run.aborted = f"tester error ({type(e).__name__}){resultsfile.keep_traceback(run, e)}"
         raise
     finally:
         try:

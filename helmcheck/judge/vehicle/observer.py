@@ -11,7 +11,7 @@
   :func:`~helmcheck.judge.timing.ack_give_up_after` its send is missing (RH-ACK-1) — if the vehicle
   still says anything; an ACK that comes after that belongs to it (RH-ACK-2), not to the next
   command. A line the vehicle must discard passes its clause (RH-FRM-2/4/5/6/7) when the window
-  passes unanswered, and fails it when answered;
+  passes unanswered, and fails it when answered (the windows that run out: :mod:`.deadlines`);
 * **the mirror** (:mod:`.belief`): the answered command goes in at its ACK's time; every ``$OSI``
   is judged against it (RH-OUT-4 and the clauses of what led there); unseen plant events are
   adopted with explicit time windows (:mod:`.closure`);
@@ -39,13 +39,14 @@ from ...grammar.wirelog import escape
 from ...model import plant as P
 from ...profile import Profile
 from ..ledger import Evidence, Ledger, Reason
-from ..timing import JITTER_S, ack_allowance, ack_give_up_after
+from ..timing import JITTER_S
 from ..wire import FROM_VEHICLE, NOTE, TO_VEHICLE, WireEvent, parse_note
 from . import osichecks
 from .belief import Beliefs
 from .answers import Answers
 from .blame import targets
 from .catalog import GivenMissions, KnownMissions
+from .deadlines import Deadlines
 from .lines import Kind, OutputJudge, classify
 from .sent import Sent, class_of_id, text_of
 
@@ -54,13 +55,11 @@ __all__ = ["VehicleObserver", "Sent"]
 _PLANT = {"WaypointReached": P.WaypointReached, "OnStation": P.OnStation,
           "QueueWaypointReached": P.QueueWaypointReached, "AtSurface": P.AtSurface,
           "Submerged": P.Submerged, "SafetyViolation": P.SafetyViolation}
-#: Wall seconds after which an unanswered command's ACK is taken never to come (RH-ACK-1).
-GIVE_UP_S = 15.0
 _DATA_OF = {"G": "GPRMC", "C": "Compass", "S": "OSI", "P": "OPI", "D": "DVL", "Y": "OYSI", "T": "OCTD",
             "I": "OINS"}
 
 
-class VehicleObserver(Answers):
+class VehicleObserver(Answers, Deadlines):
     """See the module docstring."""
 
     def __init__(self, profile: Profile, ledger: Ledger, *, time_scale: float = 1.0,
@@ -358,86 +357,7 @@ class VehicleObserver(Answers):
             p.osi = sentence
             self._osi(sentence, p, t, evd)
 
-    # ------------------------------------------------------------------ time
-    def _advance(self, t: float) -> None:
-        """Time passed (the next event's time): windows and waits that have run out."""
-        if t < self.t:
-            t = self.t
-        self.t = t
-        while self.silent and self._silent_over(self.silent[0], t):
-            q = self.silent.popleft()
-            self._silence_kept(q)
-        window = self.profile.ack_window_s
-        over = []
-        for p in self.pending:
-            if t - p.t <= window:
-                continue  # inside the bare window: inside every allowance (ack_allowance ≥ the window)
-            allowance = ack_allowance(window, len(p.raw), self.vbytes - p.vbytes0, self.baud, self.res)
-            if t - p.t > ack_give_up_after(allowance):
-                over.append((p, allowance))
-        for p, allowance in over:  # in order (each one's allowance does not depend on the others)
-            self.pending.remove(p)
-            self._missing(p, allowance)
-        if self.gave_up:
-            self._give_up(t)
-
-    def _silent_over(self, q: Sent, t: float) -> bool:
-        allowance = ack_allowance(self.profile.ack_window_s, len(q.raw), 0, self.baud, self.res)
-        return t - q.t > allowance
-
-    def _silence_kept(self, q: Sent) -> None:
-        """RH-FRM-2/4/5/6/7: no answer within the window — passed once the vehicle is seen to be
-        listening (it answers something after the line)."""
-        if q.kind.kind == "oxflt" or q.state == "answered-discard":
-            return
-        if self.alive_t is not None and self.alive_t >= q.t:
-            self.ledger.passed(q.kind.clause, f"{text_of(q)} was discarded silently ({q.kind.clause})",
-                               [q.ev], q.case)
-        else:
-            self.quiet.append(q)
-
-    def _missing(self, p: Sent, allowance: float) -> None:
-        """Past the give-up deadline unanswered. RH-ACK-2 is certain now (whatever comes later is
-        too late); RH-ACK-1 only once its ACK can no longer come: :data:`GIVE_UP_S` after it was
-        sent, or at the record's end — an ACK that comes before that belongs to it (RH-ACK-2),
-        never to a later command."""
-        p.state = "missing"
-        p.waited = ack_give_up_after(allowance)
-        self.gave_up.append(p)
-        if self.alive_t is not None and self.alive_t > p.t:
-            self._book_late(p)
-        else:
-            self.dead.append(p)
-
-    def _book_late(self, p: Sent) -> None:
-        cands = ((p.kind.variant,) if p.kind.variant else ()) + ("RH-ACK-2",)
-        self.book("fail", cands, f"{text_of(p)}: no $ACK,{p.kind.ack_type} within {p.waited:.1f} s, though "
-                                 f"the vehicle still answers (the window is {self.profile.ack_window_s:g} s)",
-                  [p.ev], at=p)
-        p.late_booked = True
-
-    def _book_missing(self, p: Sent) -> None:
-        if not p.late_booked:
-            self._book_late(p)
-        cands = ((p.kind.variant,) if p.kind.variant else ()) + ("RH-ACK-1",)
-        self.book("fail", cands, f"{text_of(p)}: no $ACK,{p.kind.ack_type} at all, though the vehicle still "
-                                 f"answers", [p.ev], at=p)
-
-    def _give_up(self, t: float) -> None:
-        """RH-ACK-1 for what is unanswered :data:`GIVE_UP_S` after it was sent."""
-        for p in list(self.gave_up):
-            if p.ack is None and not p.missing_booked and t - p.t > GIVE_UP_S and p.late_booked:
-                p.missing_booked = True
-                self._book_missing(p)
-
-    def _revive(self, t: float) -> None:
-        for p in self.dead:
-            self._book_late(p)
-        self.dead.clear()
-        for q in self.quiet:
-            self._silence_kept(q)
-        self.quiet.clear()
-
+    # ------------------------------------------------------------------ resume and end
     def _resume(self, ev: WireEvent, what: str) -> None:
         """An interrupted run goes on (``run resumed`` note): what the interruption cut off is not
         judged (RH-ACK-1 INCONCLUSIVE for a command still inside its ACK window), the vehicle's

@@ -1,0 +1,96 @@
+"""The HTML report's first page, the certificate: verdict banner and scope, what was tested, the
+digest and the signature, clause counts.
+"""
+
+from __future__ import annotations
+
+from typing import Mapping
+
+from ..judge.verdict import Verdict
+from .html_markup import _e, _section
+from .identity import identity_rows
+from .rundir import Run
+from .scope import scope_of
+from .view import VERDICT_LABEL, counts
+
+
+def _banner(run: Run) -> str:
+    r = run.results
+    out = []
+    if r["partial"]:
+        out.append('<div class="partial" id="partial">PARTIAL RUN — the run was interrupted before it '
+                   "finished. Clauses it did not reach are missing or NOT-TESTED; this is not a "
+                   "complete certificate.</div>")
+    if not run.wire["present"]:
+        out.append(f'<div class="partial" id="no-wire-log">The wire log {_e(r["wire_log"])} is missing '
+                   "from the results directory: the evidence below cannot be checked against it.</div>")
+    strict = ' <span class="muted">(strict: SHOULD clauses count as MUST)</span>' if run.strict else ""
+    scope = scope_of(r)
+    word = VERDICT_LABEL.get(r["verdict"], r["verdict"])
+    partial_scope = not scope.certificate and r["verdict"] in (Verdict.PASS, Verdict.NON_STRICT)
+    cls = (f'banner v-{_e(r["verdict"])}' + ("" if scope.certificate else " not-certificate")
+           + (" scope-partial" if partial_scope else ""))
+    gaps = "".join(f"<li>{_e(line)}</li>" for line in scope.why())
+    out.append(f'<div class="{cls}" id="verdict" data-certificate="{str(scope.certificate).lower()}">'
+               f'<div class="word" id="scope"><span class="vw v-{_e(r["verdict"])}">{_e(word)}</span> — '
+               f'{_e(scope.statement)}{strict}</div>'
+               f'<div class="why">{_e(r["verdict_reason"])}</div>'
+               + (f'<ul class="gaps" id="scope-gaps">{gaps}</ul>' if gaps else "") + "</div>")
+    return "\n".join(out)
+
+
+def _identity_table(run: Run) -> str:
+    rows = []
+    for label, value, missing in identity_rows(run.results, run.wire["osi_vehicle_name"]):
+        cls = ' class="missing"' if missing else ""
+        rows.append(f"<tr><th>{_e(label)}</th><td{cls}>{_e(value)}</td></tr>")
+    return (f'<div class="who"><h2>What was tested</h2><table class="kv ident" id="identity"><tbody>'
+            f'{"".join(rows)}</tbody></table></div>')
+
+
+def _seal(run: Run) -> str:
+    sig = run.results.get("signature")
+    if isinstance(sig, Mapping):
+        signed = (f'<p id="signature"><span class="sig-ok">Signed</span> ({_e(sig.get("algorithm"))}, '
+                  f'<span class="mono">{_e(sig.get("file"))}</span>) by key '
+                  f'<span class="mono">{_e(sig.get("key_id"))}</span>. Check it with '
+                  f'<span class="mono">helmcheck verify DIR --public-key KEY.pub</span>.</p>')
+    else:
+        signed = ('<p id="signature"><span class="sig-none">Not signed.</span> The digest below can be '
+                  "recomputed by anyone, so on its own it proves nothing; "
+                  '<span class="mono">helmcheck verify DIR</span> re-judges the wire log.</p>')
+    return f'<div class="seal"><h2>Digest and signature</h2>{signed}{_digest(run, "digest")}</div>'
+
+
+def _certificate_page(run: Run) -> str:
+    """Everything that belongs on the first page: verdict, scope, identity, digest, signature."""
+    r = run.results
+    name = next((v for label, v, missing in identity_rows(r, run.wire["osi_vehicle_name"])
+                 if label in ("vehicle", "backseat") and not missing), None)
+    kind = "certificate" if scope_of(r).certificate else "report"
+    heading = f'helmcheck {r["role"]} {kind}' + (f" — {name}" if name else "")
+    return "\n".join([
+        '<div id="certificate-page">',
+        f"<h1>{_e(heading)}</h1>",
+        _banner(run),
+        f'<div class="cert" id="certificate">{_identity_table(run)}{_seal(run)}</div>',
+        _section("summary", "Summary", _counts(run)),
+        "</div>",
+    ])
+
+
+def _digest(run: Run, anchor: str) -> str:
+    d = run.digest
+    return (f'<div class="digest" id="{anchor}">'
+            f"<div><b>Certificate digest (SHA-256):</b> {d.combined}</div>"
+            f"<div><b>results.json SHA-256:</b> {d.results}</div>"
+            f"<div><b>wire log SHA-256:</b> {d.wire or 'absent'}</div></div>")
+
+
+def _counts(run: Run) -> str:
+    c = counts(run.results)
+    head = "".join(f'<th class="v-{v}">{VERDICT_LABEL[v]}</th>' for v in c)
+    body = "".join(f'<td class="v-{v}" id="count-{v}">{n}</td>' for v, n in c.items())
+    total = sum(c.values())
+    return (f'<table class="counts"><thead><tr>{head}<th>total</th></tr></thead>'
+            f"<tbody><tr>{body}<td>{total}</td></tr></tbody></table>")

@@ -1,0 +1,67 @@
+"""The HTML report's model coverage (modes, transitions, interrupt pairs) and the event summary
+and event table that go with the mode timeline.
+"""
+
+from __future__ import annotations
+
+from typing import Any, Mapping
+
+from .html_markup import _e
+from .rundir import Run
+from .timeline import MODE_ORDER, event_counts
+
+_REMOTE_MODES = ("A", "M", "mP", "W")
+
+
+def _coverage(run: Run) -> str:
+    cov = run.results["coverage"]
+    reached = set(cov["modes"])
+    modes = list(MODE_ORDER) + sorted(reached - set(MODE_ORDER))
+    chips = "".join(f'<span class="chip {"reached" if m in reached else "unreached"}">{_e(m)}</span>' for m in modes)
+    out = [f'<h3>Modes reached ({len(reached & set(modes))} of {len(modes)})</h3><p id="modes">{chips}</p>']
+    out.append(f'<h3>Transitions exercised ({len(cov["transitions"])})</h3>')
+    if cov["transitions"]:
+        rows = "".join(f"<tr><td>{_e(a)}</td><td>{_e(b)}</td><td><code>{_e(via)}</code></td></tr>"
+                       for a, b, via in cov["transitions"])
+        out.append(f'<table class="transitions"><thead><tr><th>From</th><th>To</th><th>Via</th></tr></thead>'
+                   f"<tbody>{rows}</tbody></table>")
+    else:
+        out.append('<p class="muted">none recorded</p>')
+    pairs = {tuple(p) for p in cov["interrupt_pairs"]}
+    axis = list(_REMOTE_MODES) + sorted({m for p in pairs for m in p} - set(_REMOTE_MODES))
+    out.append(f"<h3>Interrupt pairs exercised ({len(pairs)}) — RH-INT-1</h3>")
+    head = "".join(f"<th>{_e(m)}</th>" for m in axis)
+    body = []
+    for active in axis:
+        cells = []
+        for new in axis:
+            hit = (active, new) in pairs
+            cls = "hit" if hit else ("self" if active == new else "")
+            cells.append(f'<td class="{cls}">{"✓" if hit else ""}</td>')
+        body.append(f"<tr><th>{_e(active)}</th>{''.join(cells)}</tr>")
+    out.append(f'<table class="pairs"><thead><tr><th>active ↓ / interrupted by →</th>{head}</tr></thead>'
+               f"<tbody>{''.join(body)}</tbody></table>")
+    return "\n".join(out)
+
+
+def _events_table(run: Run) -> str:
+    events = sorted(run.results["events"], key=lambda ev: ev["t"])
+    if not events:
+        return ""
+    rows = "".join(f'<tr><td class="mono">{ev["t"]:.3f}</td><td>{_e(_kind(ev))}</td>'
+                   f'<td class="mono">{_e(ev["label"])}</td></tr>' for ev in events[:2000])
+    more = f'<p class="muted">… {len(events) - 2000} more events in results.json</p>' if len(events) > 2000 else ""
+    return (f"<details><summary>Events ({len(events)})</summary><table><thead><tr><th>t (s)</th>"
+            f"<th>kind</th><th>label</th></tr></thead><tbody>{rows}</tbody></table>{more}</details>")
+
+
+def _kind(ev: Mapping[str, Any]) -> str:
+    if ev.get("negative_test"):
+        return "expected refusal (negative test)"
+    return str(ev["kind"])
+
+
+def _event_summary(run: Run) -> str:
+    c = event_counts(run.results)
+    return (f'<p id="event-counts">{c["ack-error"]} ACK error(s); {c["negative-test"]} expected refusal(s) '
+            f'— negative tests the tester provoked on purpose, drawn in grey; {c["lockout"]} lockout event(s).</p>')

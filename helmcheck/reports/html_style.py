@@ -1,0 +1,89 @@
+"""The HTML reports' stylesheet and Content-Security-Policy: the inline CSS (screen and print) of
+:mod:`~helmcheck.reports.html`, and the policy that forbids scripts and fetches.
+"""
+
+_CSP = "default-src 'none'; style-src 'unsafe-inline'; img-src data:; form-action 'none'; base-uri 'none'"
+
+_CSS = """
+:root{--pass:#1a7f37;--pass-bg:#dafbe1;--ns:#9a6700;--ns-bg:#fff8c5;--fail:#cf222e;--fail-bg:#ffebe9;
+--inc:#8250df;--inc-bg:#fbefff;--nt:#57606a;--nt-bg:#f6f8fa;--line:#d0d7de}
+*{box-sizing:border-box}
+body{font:14px/1.45 system-ui,-apple-system,"Segoe UI",Roboto,sans-serif;color:#1f2328;margin:0 auto;
+max-width:1180px;padding:16px 24px 48px}
+h1{font-size:22px;margin:8px 0 12px}h2{font-size:18px;margin:28px 0 8px;border-bottom:1px solid var(--line);
+padding-bottom:4px}h3{font-size:15px;margin:18px 0 6px}
+table{border-collapse:collapse;width:100%;margin:6px 0}th,td{border:1px solid var(--line);padding:4px 8px;
+text-align:left;vertical-align:top}th{background:#f6f8fa;font-weight:600}
+table.kv{width:auto;min-width:50%}table.kv th{width:16em}
+code,pre,.mono{font-family:ui-monospace,SFMono-Regular,Menlo,Consolas,monospace;font-size:12.5px}
+code{background:#f6f8fa;padding:0 3px;border-radius:3px;word-break:break-all}
+pre{background:#f6f8fa;border:1px solid var(--line);padding:8px;overflow-x:auto;white-space:pre-wrap;
+word-break:break-all;margin:6px 0}
+.banner{border-radius:8px;padding:14px 18px;margin:10px 0;border:2px solid}
+.banner .word{font-size:28px;font-weight:800;letter-spacing:.04em}.banner .why{font-size:15px;margin-top:4px}
+.partial{background:repeating-linear-gradient(45deg,#fff8c5,#fff8c5 12px,#ffe58f 12px,#ffe58f 24px);
+border:3px solid #9a6700;border-radius:8px;padding:12px 18px;font-size:16px;font-weight:700;margin:10px 0}
+.v-pass{color:var(--pass);background:var(--pass-bg)}
+.v-non-strict{color:var(--ns);background:var(--ns-bg)}
+.v-fail{color:var(--fail);background:var(--fail-bg)}
+.v-inconclusive{color:var(--inc);background:var(--inc-bg)}
+.v-not-tested{color:var(--nt);background:var(--nt-bg)}
+.banner{border-color:currentColor}
+td.verdict{font-weight:700;white-space:nowrap}
+tr.clause[data-verdict=fail] td.id{box-shadow:inset 4px 0 var(--fail)}
+tr.clause[data-verdict=inconclusive] td.id{box-shadow:inset 4px 0 var(--inc)}
+tr.clause[data-verdict=non-strict] td.id{box-shadow:inset 4px 0 var(--ns)}
+td.id,td.cases{white-space:nowrap}td.id{font-weight:600}td.level{white-space:nowrap}
+.digest{font-family:ui-monospace,Menlo,Consolas,monospace;font-size:12.5px;background:#f6f8fa;
+border:1px solid var(--line);border-radius:6px;padding:8px 12px;word-break:break-all}
+.digest b{font-family:system-ui,sans-serif}
+.counts td{text-align:center;font-weight:700}.counts th{text-align:center}
+.finding{border:1px solid var(--line);border-left:6px solid;border-radius:6px;padding:4px 14px 10px;margin:12px 0;
+background:#fff;color:#1f2328}
+.finding.v-fail{border-left-color:var(--fail)}.finding.v-non-strict{border-left-color:var(--ns)}
+.finding.v-inconclusive{border-left-color:var(--inc)}.finding.v-not-tested{border-left-color:var(--nt)}
+ol.replay li{margin:2px 0}
+.chip{display:inline-block;padding:2px 10px;margin:2px;border-radius:12px;border:1px solid var(--line);
+font-weight:600}.chip.reached{background:var(--pass-bg);color:var(--pass);border-color:var(--pass)}
+.chip.unreached{color:var(--nt);background:#fff;text-decoration:line-through}
+table.pairs,table.transitions{width:auto}table.pairs td{text-align:center;min-width:3em}td.hit{background:var(--pass-bg);
+color:var(--pass);font-weight:700}td.self{background:#f6f8fa}
+.warn{color:var(--fail);font-weight:600}.muted{color:#57606a}
+svg.timeline{border:1px solid var(--line);border-radius:6px;background:#fff;margin:6px 0}
+svg .lane0{fill:#f6f8fa}svg .lane1{fill:#fff}svg .lane-label,svg .row-label{font:12px system-ui,sans-serif;
+fill:#1f2328}svg .tick,svg .empty{font:11px system-ui,sans-serif;fill:#57606a}
+svg .grid{stroke:#d0d7de;stroke-width:.5}svg .row-rule{stroke:#eaeef2}
+svg .step{fill:none;stroke:#0969da;stroke-width:2}svg .seg{fill:#0969da;fill-opacity:.12}
+svg .ev-command{fill:#0969da}svg .ev-ack-error{fill:#cf222e}svg .ev-lockout{fill:#bc4c00}
+svg .ev-lockout-line{stroke:#bc4c00;stroke-dasharray:4 3}svg .ev-note{fill:#57606a}
+footer{margin-top:32px;border-top:1px solid var(--line);padding-top:8px}
+.banner.scope-partial{color:#3d444d;border-color:#8c959f;
+background:repeating-linear-gradient(135deg,#f6f8fa,#f6f8fa 14px,#eaeef2 14px,#eaeef2 28px)}
+.banner .word .vw{border-radius:4px}.banner.not-certificate .word{font-size:22px}
+.banner ul.gaps{margin:6px 0 0;padding-left:20px;font-size:13.5px}.banner ul.gaps li{margin:1px 0}
+.cert{display:grid;grid-template-columns:minmax(0,1.15fr) minmax(0,1fr);gap:14px;align-items:start;margin:10px 0}
+.cert h2{font-size:15px;margin:0 0 4px;border:0;padding:0}
+table.ident{width:100%;min-width:0;margin:0;table-layout:fixed}table.ident th{width:12.5em;font-weight:600}
+table.ident td,table.ident th{padding:2px 8px}table.ident td{overflow-wrap:anywhere}
+td.missing{color:var(--fail);font-style:italic}
+.seal,.who{border:1px solid var(--line);border-radius:6px;padding:8px 12px;font-size:13px}
+.seal .digest{margin:4px 0;padding:4px 8px;font-size:11.5px}
+.sig-ok{color:var(--pass);font-weight:700}.sig-none{color:var(--ns);font-weight:700}
+.pass-evidence{border-left:4px solid var(--pass);padding:0 12px;margin:8px 0}
+.pass-evidence h3{margin:10px 0 2px;font-size:14px}.pass-evidence p{margin:2px 0}
+svg .ev-negative{fill:#8c959f}
+@page{size:A4;margin:14mm 12mm}
+@media print{
+.banner,.partial,.v-pass,.v-fail,.v-non-strict,.v-inconclusive,.v-not-tested,.scope-partial,td.hit,.chip{
+-webkit-print-color-adjust:exact;print-color-adjust:exact}
+body{max-width:none;padding:0;font-size:10pt;color:#000}
+#certificate-page{break-after:page;page-break-after:always}
+.cert{grid-template-columns:1fr;gap:8px}
+h2{break-after:avoid;page-break-after:avoid}h3{break-after:avoid;page-break-after:avoid}
+tr,.finding,.pass-evidence,pre,svg.timeline,.seal{break-inside:avoid;page-break-inside:avoid}
+a{color:inherit;text-decoration:none}
+details>summary{list-style:none}
+pre{white-space:pre-wrap}
+footer{break-before:avoid}
+}
+"""
