@@ -27,9 +27,12 @@ import sys
 from pathlib import Path
 from typing import Any, Callable
 
+import helmcheck
+
 __all__ = ["SideJob", "SideJobLost", "cores", "child"]
 
-_PACKAGE_ROOT = str(Path(__file__).resolve().parents[3])  # the directory holding helmcheck/
+#: the directory holding helmcheck/ (found as the child finds it, wherever this module lies in the package)
+_PACKAGE_ROOT = str(Path(helmcheck.__file__).resolve().parents[1])
 
 
 class SideJobLost(RuntimeError):
@@ -54,7 +57,6 @@ def cores() -> int:
 def child() -> None:
     """The second process: read ``(package root, fn, args)`` pickled from stdin, write
     ``(ok, value)`` to stdout."""
-    import helmcheck
     answer_to = sys.stdout.buffer
     sys.stdout = sys.stderr  # whatever fn prints must not mix with the answer
     try:
