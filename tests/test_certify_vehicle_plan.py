@@ -117,13 +117,13 @@ def test_plan_text_shows_every_case_the_exploration_budget_and_the_total(capsys)
 
 
 def test_plan_follows_the_time_scale(capsys):
-    slow = _plan(capsys, "--time-scale", "1", "--examples", "0", "--select", "RH-SRV-4,RH-FRM-2")
-    fast = _plan(capsys, "--time-scale", "20", "--examples", "0", "--select", "RH-SRV-4,RH-FRM-2")
+    slow = _plan(capsys, "--time-scale", "1", "--examples", "0", "--select", "RH-SRV-4,RH-FRM-4")
+    fast = _plan(capsys, "--time-scale", "20", "--examples", "0", "--select", "RH-SRV-4,RH-FRM-4")
     by = {k: {x["id"]: x for x in p["cases"]} for k, p in (("slow", slow), ("fast", fast))}
     # the servo timeout (10 vehicle seconds) shrinks with k; the ACK windows sat out do not
     assert by["slow"]["V-28"]["wall_s"] > 8 * by["fast"]["V-28"]["wall_s"]
-    assert by["slow"]["V-02"]["wall_s"] == pytest.approx(by["fast"]["V-02"]["wall_s"], rel=0.15)
-    assert by["fast"]["V-02"]["wall_s"] > 2 * DEFAULT.ack_window_s
+    assert by["slow"]["V-04"]["wall_s"] == pytest.approx(by["fast"]["V-04"]["wall_s"], rel=0.15)
+    assert by["fast"]["V-04"]["wall_s"] > 2 * DEFAULT.ack_window_s
 
 
 def test_plan_uses_the_missions_given(tmp_path, capsys):

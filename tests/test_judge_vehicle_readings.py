@@ -185,7 +185,7 @@ def test_RH_ACK_2_an_answer_after_the_tester_gave_up_belongs_to_its_command(tmp_
 
 
 @pytest.mark.parametrize("line,clause", [
-    ("$OMSTOP,0*07", "RH-FRM-2"),  # wrong checksum
+    ("$OMSTOP,0*07", "RH-FRM-4"),  # wrong checksum: RH-FRM-4's discard (RH-FRM-2 defines the right one)
     ("$OMSTOP,0", "RH-FRM-4"),  # no checksum
     ("$omstop,0*06", "RH-FRM-5"),  # lower-case ID
 ])
@@ -352,3 +352,82 @@ def test_RH_FRM_1_the_same_bytes_before_every_reply_are_a_finding_quoting_them(t
     assert verdict(v, "RH-FRM-1") == want, v["RH-FRM-1"]
     if want == "fail":
         assert "AT>" in v["RH-FRM-1"]["reason"], v["RH-FRM-1"]["reason"]
+
+
+def test_RH_FRM_2_a_zero_padded_checksum_must_be_read(tmp_path):
+    """RH-FRM-2: "two hex digits, zero-padded" — a request whose checksum is 0X is read like any
+    other: answered, it passes RH-FRM-2; left unanswered, RH-FRM-2 is the clause that fails."""
+    from helmcheck.certify.vehicle.interpreter import zero_padded
+
+    body = zero_padded("OSD,S", DEFAULT)
+    assert checksum_hex(body).startswith("0") and body.startswith("OSD,S")
+    rec = start() + [(1.0, ">", body), (1.01, "<", osi(mode="N", dist=150.0)), (1.02, "<", "ACK,8,0,0")]
+    v = judge(tmp_path, rec)
+    assert verdict(v, "RH-FRM-2") == "pass", v["RH-FRM-2"]["reason"]
+    rec = start() + [(1.0, ">", body)] + poll(6.0, mode="N", dist=150.0)
+    v = judge(tmp_path, rec)
+    assert verdict(v, "RH-FRM-2") == "fail", v["RH-FRM-2"]["reason"]
+
+
+def test_RH_OSD_2_data_for_a_request_it_must_refuse_is_a_finding_not_a_tester_error(tmp_path):
+    """``$OSD,S,Q`` answered with the ``$OSI`` and an accepting ACK: RH-OSD-2 fails (a conforming
+    vehicle sends no data and err 27), and judging goes on."""
+    rec = start() + [(1.0, ">", "OSD,S,Q"), (1.005, "<", osi(mode="N", dist=150.0)), (1.01, "<", "ACK,8,0,0")]
+    rec += poll(2.0, mode="N", dist=150.0)
+    v = judge(tmp_path, rec)
+    assert verdict(v, "RH-OSD-2") == "fail", v["RH-OSD-2"]["reason"]
+
+
+def test_RH_SAF_5_a_violation_after_unseen_way_is_adopted_with_the_way(tmp_path):
+    """Between two polls 120 s apart the vehicle reached its waypoint, began the mission park
+    there, then raised a violation by itself: the lockout shows the frozen mission mode P with
+    the park time left (RH-RD-11). Both unseen events are adopted together — no FAIL."""
+    rec = start() + poll(120.0, mode="P", park=256, err="Sfp", dist=2.0)
+    rec += [(121.0, ">", "OMS,90,2,20,0.5,10"), (121.01, "<", "ACK,9,1,26")]
+    v = judge(tmp_path, rec)
+    assert no_fail(v) == []
+    assert verdict(v, "RH-OUT-4") == "pass"
+
+
+def test_RH_INT_1_an_interrupted_control_that_comes_back_is_no_stack_in_its_case(tmp_path):
+    """Inside RH-INT-1's case: $OMW (W), interrupted by $OMS (A); when the servo times out the
+    vehicle goes back to W. There is no stack of remote controls: booked on RH-INT-1 (and the
+    queue's own RH-OMW-5 outside that case)."""
+    rec = start() + [(0.5, "!", "case V-21 RH-INT-1: no stack of remote controls")]
+    rec += [(1.0, ">", f"OMW,{LAT + 0.001:.6f},{LON:.6f},2,,15,1,0,"), (1.01, "<", "ACK,16,0,0")]
+    rec += poll(1.5, mode="W", dist=111.0, speed=1.0)
+    rec += [(2.0, ">", "OMS,90,2,20,1,5"), (2.01, "<", "ACK,9,0,0")]
+    rec += poll(2.5, mode="A", dist=111.0, speed=1.0)
+    rec += poll(10.0, mode="W", dist=111.0, speed=1.0)
+    v = judge(tmp_path, rec)
+    assert verdict(v, "RH-INT-1") == "fail", v["RH-INT-1"]["reason"]
+
+
+def test_RH_MSN_4_a_mission_that_loops_after_its_last_waypoint_fails_in_its_case(tmp_path):
+    """Inside RH-MSN-4's case: heading for the last waypoint, the vehicle is next seen heading for
+    waypoint 0 again — it did not end the mission there (booked on RH-MSN-4, not only RH-OUT-4)."""
+    from helmcheck.model.testing import catalog, conformance_mission
+
+    last = conformance_mission().waypoints[-1]
+    rec = start() + [(0.5, "!", "case V-47 RH-MSN-4: the mission ends at its last waypoint")]
+    rec += [(1.0, ">", "OJW,3"), (1.01, "<", "ACK,7,0,0")]
+    rec += poll(1.5, mode="N", wp=3, dist=40.0, speed=2.0)
+    rec += poll(60.0, mode="N", wp=0, dist=150.0, speed=2.0, lat=last.lat, lon=last.lon)
+    v = judge(tmp_path, rec, catalog=catalog())
+    assert verdict(v, "RH-MSN-4") == "fail", v["RH-MSN-4"]["reason"]
+
+
+@pytest.mark.parametrize("heads_for, want", [(0, "pass"), (1, "fail")])
+def test_RH_OMW_2_field_7_in_W_shows_the_first_queued_waypoint(tmp_path, heads_for, want):
+    """Two $OMW queued: a vehicle in W heads for the first (field 7 the distance to it from the
+    reported position); one that heads for the second at once has not kept the arrival order."""
+    from helmcheck.model.geo import distance_m
+
+    wps = [(LAT + 0.001, LON), (LAT + 0.001, LON + 0.0012)]
+    dist = distance_m(LAT, LON, *wps[heads_for])
+    rec = start()
+    for i, (lat, lon) in enumerate(wps):
+        rec += [(1.0 + i, ">", f"OMW,{lat:.6f},{lon:.6f},2,,15,1,0,"), (1.01 + i, "<", "ACK,16,0,0")]
+    rec += poll(3.0, mode="W", dist=round(dist, 2), speed=1.0)
+    v = judge(tmp_path, rec)
+    assert verdict(v, "RH-OMW-2") == want, v["RH-OMW-2"]["reason"]

@@ -17,12 +17,22 @@ __all__ = ["MUTANTS"]
 
 
 class AcceptsBadChecksum(EmulatorCore):
-    """RH-FRM-2: acts on a line whose checksum is wrong."""
+    """RH-FRM-4: acts on a line whose checksum is wrong (it must be discarded)."""
 
     def _line(self, raw, now, v):
         if b"*" in raw and raw.startswith(b"$"):
             raw = reframe(raw, body(raw))
         return super()._line(raw, now, v)
+
+
+class UnpaddedChecksumOut(EmulatorCore):
+    """RH-FRM-2: writes a checksum under 0x10 as one hex digit (``%X``, not zero-padded)."""
+
+    def _send(self, raw, now):
+        star = raw.rfind(b"*")
+        if raw.startswith(b"$") and star > 0 and raw[star + 1:star + 2] == b"0":
+            raw = raw[:star + 1] + raw[star + 2:]
+        return super()._send(raw, now)
 
 
 class LowercaseOut(EmulatorCore):
@@ -366,7 +376,8 @@ class OrwsetCountsValuesOnly(Model):
 
 
 MUTANTS = (
-    Mutant("accepts-bad-checksum", "RH-FRM-2", ("RH-FRM-2",), core=AcceptsBadChecksum),
+    Mutant("accepts-bad-checksum", "RH-FRM-4", ("RH-FRM-4",), core=AcceptsBadChecksum),
+    Mutant("unpadded-checksum-out", "RH-FRM-2", ("RH-FRM-2",), core=UnpaddedChecksumOut),
     Mutant("lowercase-checksum-out", "RH-FRM-3", ("RH-FRM-3",), core=LowercaseOut),
     Mutant("rejects-lowercase-checksum-in", "RH-FRM-3", ("RH-FRM-3",),
            profile_changes=(("lowercase_checksum_in", False),)),

@@ -43,10 +43,9 @@ from hypothesis.database import DirectoryBasedExampleDatabase
 from hypothesis.errors import Flaky
 from hypothesis.stateful import RuleBasedStateMachine, initialize, precondition, rule, run_state_machine_as_test
 
-from ...grammar import checksum_hex
 from ...judge.timing import JITTER_S
 from .flow import CaseStop, LinkLost
-from .interpreter import _here, context, fill
+from .interpreter import _here, context, fill, raw_line
 from .replay import save_replay
 from .safety import BenchSafetyRefused
 from .session import frame
@@ -122,15 +121,9 @@ def invalid_lines():
     )
 
 
-def _raw(kind: str, body: str) -> bytes:
-    if kind == "frame":
-        return frame(body)
-    if kind == "badck":
-        ck = int(checksum_hex(body), 16) ^ 0x21
-        return b"$" + body.encode() + b"*" + f"{ck:02X}".encode() + b"\r\n"
-    if kind == "lowerid":
-        return frame(body.lower())
-    return b"$" + body.encode() + b"\r\n"
+def _raw(kind: str, body: str, profile) -> bytes:
+    """The line of one drawn mutation: a framed body as it is, or :func:`.interpreter.raw_line`'s."""
+    return frame(body) if kind == "frame" else raw_line(kind, body, profile)
 
 
 class VehicleFailure(AssertionError):
@@ -246,7 +239,7 @@ def _machine(state: _State, start_states, nwp, speed, motor, oxflt, tos=_TIMEOUT
         @rule(line=invalid_lines())
         def send_invalid(self, line):
             kind, body = line
-            self._guard(lambda: session.exchange(_raw(kind, fill(body, self.ctx))))
+            self._guard(lambda: session.exchange(_raw(kind, fill(body, self.ctx), session.profile)))
 
         @rule(v=st.sampled_from([1.0, 2.0, 5.0, 12.0]))
         def wait_a_while(self, v):

@@ -99,6 +99,8 @@ def raw_line(kind: str, body: str, profile: Profile) -> bytes:
     if kind == "badck":
         ck = int(checksum_hex(body), 16) ^ 0x5A
         return b"$" + body.encode() + b"*" + f"{ck:02X}".encode() + b"\r\n"
+    if kind == "zerock":
+        return frame(zero_padded(body, profile))
     if kind == "lowerck":
         pad = body
         while body.startswith("OSD") and not any(c in "ABCDEF" for c in checksum_hex(pad)) and len(pad) < 60:
@@ -133,6 +135,23 @@ def raw_line(kind: str, body: str, profile: Profile) -> bytes:
     if kind == "barelf":
         return frame(body, terminator="\n")
     raise ValueError(f"unknown raw line kind {kind!r}")
+
+
+def zero_padded(body: str, profile: Profile) -> str:
+    """``body`` (an ``$OSD`` request) made into one whose checksum is under 0x10, so that it is
+    written with a leading zero (RH-FRM-2: "two hex digits, zero-padded"): letters the vehicle
+    serves and empty fields are added (RH-RD-7: any number of fields, a repeated letter served
+    twice), fewest first. Another body, or none found, is returned as it is."""
+    if not body.startswith("OSD"):
+        return body
+    letters = [c for c in "SGCP" if c in profile.osd_letters] or ["S"]
+    tails = [""]
+    for _ in range(4):
+        for tail in tails:
+            if int(checksum_hex(body + tail), 16) < 0x10:
+                return body + tail
+        tails = [tail + "," + x for tail in tails for x in ["", *letters]]
+    return body
 
 
 # ============================================================================ steps

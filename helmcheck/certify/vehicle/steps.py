@@ -25,7 +25,8 @@ __all__ = ["Send", "Raw", "Poll", "Wait", "Settle", "Until", "Fault", "Start", "
 
 #: Mutations of a valid sentence (:func:`.interpreter.raw_line`), each tied to its clause.
 RAW_KINDS = {
-    "badck": "RH-FRM-2: a wrong checksum",
+    "badck": "RH-FRM-4: a wrong checksum (discarded; RH-FRM-2 defines the right one)",
+    "zerock": "RH-FRM-2: a right checksum under 0x10, written zero-padded (read and answered)",
     "lowerck": "RH-FRM-3: lower-case checksum hex",
     "nock": "RH-FRM-4: no *hh",
     "shortck": "RH-FRM-4: one hex digit",

@@ -171,7 +171,9 @@ class Answers:
             if res.before[0] in ("A", "M", "mP", "W") and res.row is not None and res.row.target != "=":
                 self.interrupt_pairs.add((res.before[0], p.kind.item.ID))
         cands = command_clauses(p.kind.item, want, res.row)
-        if p.kind.variant:
+        if p.kind.variant and a.status == 1 and (want is None or want.status == 0):
+            # refused where a conforming vehicle accepts: the form it must still read (RH-FRM-2/3/6/7)
+            # first; a wrong answer to a line it did read is about the command, not the form
             cands = (p.kind.variant,) + cands
         if res.matched:
             self._matched(p, a, res, cands, ev)
@@ -225,7 +227,7 @@ class Answers:
                                    f"{text_of(p)} refused with err 26", ev, self.case)
         elif row is not None and row.target == "=" and row.phase_to is None:
             self.passed(passable(cands), lambda: f"{text_of(p)} accepted in mode {res.before[0]}", ev)
-        elif p.kind.variant:
+        if p.kind.variant:  # answered as a conforming vehicle answers: the form was read (RH-FRM-2/3/6/7)
             self.passed((p.kind.variant,), lambda: f"{text_of(p)} read and answered", ev)
 
     def _mission_unknown(self, p: Sent, a: s.ACK, cands: tuple[str, ...], ev: list, why: str = "") -> None:

@@ -5,25 +5,25 @@ what was adopted to explain the wire), most plausible first (fewest unseen event
 
 * :meth:`Beliefs.command` — a command the vehicle answered, at the vehicle time its ACK went out
   (RH-RD-15; vehicle time is wall time × the declared time scale, RH-TIM-2). Each candidate
-  answers it nominally and, when the command lands within the RH-TIM-1 tolerance of a model timer,
-  on both sides of the race (also of a timer the model already ran: from its checkpoint, the state
-  before it); an accepted ``$OPK`` also with its countdown waiting for on station (RH-PK-2: where
-  the vehicle is at the ACK, no report settles); before a command that freezes the mission
-  (RH-INT-1) a candidate in ``N`` also offers the state where the next waypoint was reached unseen
-  just before it, where it can have got there (:func:`~.closure.reachable`). The
-  candidates whose answer is the vehicle's survive. When none does, unseen events that change the
-  answer are tried (:func:`~.closure.explain_reply`); when that fails too, the answer is a
-  finding, and the observer follows the nominal state marked *desynchronised* until a state that
-  is known again (an accepted ``$OMSTOP`` or ``$OMSTART``).
+  answers it in every state it may have met it in (:mod:`.branches`): nominally and, when the
+  command lands within the RH-TIM-1 tolerance of a model timer, on both sides of the race (also of
+  a timer the model already ran: from its checkpoint, the state before it); an accepted ``$OPK``
+  also with its countdown waiting for on station (RH-PK-2: where the vehicle is at the ACK, no
+  report settles); before a command that freezes the mission (RH-INT-1) a candidate in ``N`` also
+  offers the state where the next waypoint was reached unseen just before it, where it can have
+  got there (:func:`~.closure.reachable`). The candidates whose answer is the vehicle's survive.
+  When none does, unseen events that change the answer are tried (:func:`~.closure.explain_reply`);
+  when that fails too, the answer is a finding, and the observer follows the nominal state marked
+  *desynchronised* until a state that is known again (an accepted ``$OMSTOP`` or ``$OMSTART``).
 * :meth:`Beliefs.osi` — an ``$OSI`` produced between ``v_sent`` and ``v_recv``. The candidates
   that explain it survive (:meth:`~.candidate.Candidate.check`, the RH-TIM-1 shadows of
   :mod:`helmcheck.model.observe`); when none does, unseen plant events are adopted
   (:func:`~.closure.explain_osi`); when that fails, it is a finding. The surviving candidates are
   brought to ``v_sent`` and *confirmed*: the rows they applied since the last ``$OSI`` have been
   seen to take effect (their clauses pass), timer transitions get their RH-TIM-1 bracket
-  (:class:`~.candidate.Timed`), and the ``$OSI``'s position, speed and depth become the plant
-  snapshot (GPS fix and surface rules, ``$OPK`` distance) — not the depth during the ascent,
-  where reaching the surface is an event to be adopted.
+  (:class:`~.candidate.Timed`, :mod:`.brackets`), and the ``$OSI``'s position, speed and depth
+  become the plant snapshot (GPS fix and surface rules, ``$OPK`` distance) — not the depth during
+  the ascent, where reaching the surface is an event to be adopted.
 
 Decision (spec open): at most :data:`CAP` candidates are kept; beyond, the least plausible go.
 """
@@ -37,18 +37,19 @@ from typing import Optional
 from ...grammar import sentences as s
 from ...grammar.errors import SentenceError
 from ...model.timers import tolerance
-from ...model.transitions import INTERNAL_EVENTS, STAY, rows_for
+from ...model.transitions import INTERNAL_EVENTS, REMOTE_MODES, STAY, rows_for
 from ...model.vehicle import VehicleModel
 from ...profile import Profile
-from ..facts import ASCENT_REFUSED, INTERRUPTS, LOCKOUT_REFUSED
-from ..timing import judgeable
-from .candidate import Candidate, Timed
-from .closure import explain_osi, explain_reply, osi_depth_m, reachable, reply_keys
+from ..facts import ASCENT_REFUSED, LOCKOUT_REFUSED
+from .brackets import bracket, pre_shown, retime
+from .branches import branches
+from .candidate import Candidate
+from .closure import explain_osi, explain_reply, osi_depth_m, reply_keys
+from .sent import brief
 
 __all__ = ["Beliefs", "CommandResult", "OsiResult", "CAP"]
 
 CAP = 6
-_WP_ALT_EVENTS = INTERRUPTS
 #: Command events the lockout refuses (err 26) and the ascent does not: their answer tells them apart.
 _LOCK_ONLY = LOCKOUT_REFUSED - ASCENT_REFUSED
 
@@ -80,15 +81,6 @@ class OsiResult:
     own: set = field(default_factory=set)  #: clauses this report passes by their own evidence
 
 
-def _pre_shown(tt: Timed, osi: s.OSI) -> Optional[bool]:
-    """Does ``osi`` show the state before timer ``tt`` (True), after it (False), or neither?"""
-    if tt.timer == "lockout":
-        return None
-    if tt.timer == "qpark":
-        return osi.mode == "W" and osi.park_time > 0
-    return osi.mode == tt.pre_mode
-
-
 class Beliefs:
     """The candidate set (module docstring)."""
 
@@ -108,68 +100,13 @@ class Beliefs:
         return self.cands[0]
 
     # ------------------------------------------------------------------ commands
-    def _options(self, c: Candidate, item, v: float, slack_v: float) -> list:
-        m = c.model
-        times = [v]
-        dl = m.timer()
-        if dl is not None:
-            due, dur, _ = dl
-            if abs(due - v) <= tolerance(dur, slack_v + c.extra_v):
-                before = min(v, due - 1e-6)
-                if m.now is None or before >= m.now:
-                    times.append(before)
-                times.append(max(v, due + 1e-6))
-        out, late = [], []
-        base = m.checkpoint
-        fired = c.timed[-1] if (base is not None and c.timed) else None
-        if fired is not None and 0.0 <= v - fired.deadline <= tolerance(fired.duration, slack_v + c.extra_v):
-            # the model already ran a timer this command lands within RH-TIM-1's tolerance of: on
-            # a conforming vehicle it may not have run yet (the checkpoint is the state before it)
-            t = c.clone()
-            t.model = base.clone()
-            t.model.trace = []
-            t._mode, t._phase = base.mode, base.phase
-            t.timed = [x for x in t.timed if x is not fired and x.deadline != fired.deadline]
-            at = max(base.now if base.now is not None else fired.deadline, fired.deadline - 1e-6)
-            t.model.advance(at)
-            if (t.model.mode, t.model.phase) == (base.mode, base.phase):
-                before = (t.model.mode, t.model.phase)
-                row = None if isinstance(item, SentenceError) else t.model.row_for(item)
-                late.append((t, t.model.receive(item, at), row, before))
-        for at in dict.fromkeys(times):
-            t = c.clone()
-            t.model.advance(at)
-            before = (t.model.mode, t.model.phase)
-            row = None if isinstance(item, SentenceError) else t.model.row_for(item)
-            replies = t.model.receive(item, at)
-            out.append((t, replies, row, before))
-            if isinstance(item, s.OPK) and t.model.mode == "mP" and t.model.timers.armed("opk"):
-                # RH-PK-2: on station or not at the ACK is where the vehicle is then, which the
-                # last report (made before it moved on) does not settle: the count may start later
-                w = t.clone()
-                w.model.await_on_station()
-                out.append((w, replies, row, before))
-        if (isinstance(item, s.Command) and m.mode == "N" and m.phase == "none" and m.mission is not None
-                and VehicleModel.event_of(item) in _WP_ALT_EVENTS
-                and reachable(c, m.mission_wp, v, self.catalog)):  # only where it can have got there
-            tp = min(max(c.seen_v if c.seen_v is not None else v, m.now or 0.0), v)
-            t = c.clone()
-            t.model.plant(_wp(), tp)
-            if t.model.mode in ("N", "P"):
-                t.adopted(f"mission waypoint reached just before the command (v={tp:.1f}..{v:.1f})", tp, v)
-                t.model.advance(v)
-                before = (t.model.mode, t.model.phase)
-                row = t.model.row_for(item)
-                out.append((t, t.model.receive(item, v), row, before))
-        return out + late  # the nominal answer first: it is what a finding names
-
     def command(self, item, v: float, slack_v: float, observed: list) -> CommandResult:
         """Feed an answered command (module docstring); ``observed`` is the vehicle's replies."""
         desync = self.desync
         self.arm_v = max(self.arm_v, slack_v)
         options = []
         for c in self.cands:
-            options += self._options(c, item, v, slack_v)
+            options += branches(c, item, v, slack_v, self.catalog)
         nominal = options[0]
         got = reply_keys(observed)
         match = [o for o in options if reply_keys(o[1]) == got]
@@ -202,8 +139,8 @@ class Beliefs:
                 else:  # accepted where a conforming vehicle refuses: its state is now unknown
                     self._keep([nominal[0]])
                     if not self.desync:
-                        self.desync = (f"the vehicle answered {_brief(observed)} where a conforming "
-                                       f"vehicle answers {_brief(nominal[1])}")
+                        self.desync = (f"the vehicle answered {brief(observed)} where a conforming "
+                                       f"vehicle answers {brief(nominal[1])}")
         self._after_command(item, observed, v, slack_v, result)
         return result
 
@@ -252,7 +189,7 @@ class Beliefs:
                     if tt.timer == "lockout":
                         c.timed.remove(tt)
                         if c is self.cands[0]:
-                            result.timings.append(self._bracket(tt, v, slack_v))
+                            result.timings.append(bracket(tt, v, slack_v))
 
     def _keep(self, cands: list[Candidate]) -> None:
         if len(cands) == 1:
@@ -329,6 +266,20 @@ class Beliefs:
                 causes.insert(0, "RH-INT-3")  # the interrupted park came back: not abandoned
             if released and "queue" in p.abandoned:
                 causes.insert(0, "RH-OMW-5")
+            released_from = {src for row in p.pending + ahead if "RH-INT-2" in row.clauses for src in row.sources}
+            if released and osi.mode in _REMOTE and osi.mode not in released_from:
+                # another remote control came back after the release: there is no stack of remote
+                # controls (RH-INT-1), after the interrupted kind's own clause
+                at = sum(1 for c in causes[:2] if c in ("RH-INT-3", "RH-OMW-5"))
+                causes.insert(at, "RH-INT-1")
+            m = p.model
+            if m.mode == "N" and m.mission is not None and osi.mode != "S" and (
+                    (not m.mission.is_open and m.mission_wp == m.mission.last)
+                    or (osi.mode == "N" and osi.next_waypoint < m.mission_wp)):
+                # on the way to the last waypoint (or, in a mission of unknown length, seen going
+                # back to an earlier one, as a mission that did not end at its last would): the
+                # end it owes there
+                causes.append("RH-MSN-4")
             if p.refused_locked and p.model.phase != "lockout":
                 causes.insert(0, "RH-SAF-2")
             if osi.mode == p.model.mode:  # the mode is right: a countdown is what differs
@@ -387,7 +338,7 @@ class Beliefs:
         c.drain()
         out: set = set()
         for tt in list(c.timed):
-            shown = _pre_shown(tt, osi)
+            shown = pre_shown(tt, osi)
             if shown is None:
                 continue
             if shown:
@@ -395,7 +346,7 @@ class Beliefs:
                 continue
             c.timed.remove(tt)
             if passes is not None:
-                passes.append(self._bracket(tt, v_recv, slack_v))
+                passes.append(bracket(tt, v_recv, slack_v))
         released = False
         if osi.mode == m.mode:  # the rows' effect is visible (a report still showing the state
             for row in c.pending:  # before a timer, within its tolerance, confirms nothing yet)
@@ -414,41 +365,11 @@ class Beliefs:
             c.refused_locked = False
         self._plant(c, osi)
         c.saw(v_sent, osi.mode)
-        self._retime(c, osi, v_sent, v_recv, slack_v)
+        retime(c, osi, v_sent, v_recv, slack_v)
         c.lapse_uncertainty()
         if not c.timed:
             m.drop_checkpoint()
         return out
-
-    def _bracket(self, tt: Timed, v_new: float, slack_v: float) -> tuple:
-        """RH-TIM-1: how closely the observations bracket a timer's transition.
-
-        ``pass`` — the before-state was seen close enough before the deadline and the after-state
-        close enough after it (within half the duration, RH-TIM-1's last sentence, widened by the
-        tolerance); ``inconclusive`` — the observer's own measuring uncertainty (timestamp step,
-        jitter, the arming command's round trip) is already too large; ``not-tested`` — the timer
-        started with an unseen event placed within a window too wide to time it (nobody set it
-        going where it could be timed), or the transition was seen but not sampled near its
-        deadline, so its timing was not exercised (a later, closer observation may time it).
-        """
-        tol = tolerance(tt.duration)
-        own = slack_v + tt.extra_v
-        what = f"the {tt.duration:g} s {_name(tt)}"
-        if not judgeable(tt.duration, slack_v):
-            return (tt, "inconclusive", f"the observer's own uncertainty of {slack_v:.1f} s of vehicle time "
-                                        f"cannot bound {what} (RH-TIM-1)")
-        if not judgeable(tt.duration, own):
-            return (tt, "not-tested", f"{what} started with an unseen event placed within {tt.extra_v:.1f} s of "
-                                      f"vehicle time, too wide to time it: its timing was not exercised")
-        if tt.t_old is None:
-            return (tt, "not-tested", f"{what} ended, but the state before it was not observed after it "
-                                      f"started, so its timing was not exercised")
-        u = max(0.0, (tt.deadline - tol) - tt.t_old, v_new - (tt.deadline + tol)) + own
-        if judgeable(tt.duration, u):
-            return (tt, "pass", f"{what} ended within max(0.5 s, 5 %) = {tol:g} s, bracketed to ±{u:.2f} s "
-                                f"of vehicle time by the observations")
-        return (tt, "not-tested", f"{what} ended, but observations {u:.1f} s of vehicle time from its end "
-                                  f"did not time it")
 
     def _plant(self, c: Candidate, osi: s.OSI) -> None:
         """The ``$OSI``'s measured values become the candidate's plant snapshot."""
@@ -466,52 +387,9 @@ class Beliefs:
             m.update_plant(snap.with_(**changes))
             c.drain()
 
-    def _retime(self, c: Candidate, osi: s.OSI, v_sent: float, v_recv: float, slack_v: float) -> None:
-        """A countdown started by an adopted event: the displayed park time narrows its start."""
-        if c.window is None or c.extra_v <= 0:
-            return
-        m = c.model
-        name = {"mP": "opk", "P": "park", "W": "qpark"}.get(m.mode)
-        if name is None or not m.timers.armed(name) or osi.mode != m.mode:
-            return
-        dur = m.timers.duration(name) or 0.0
-        deadline = m.timers.deadline(name) or 0.0
-        start = deadline - dur
-        lo_w, hi_w = c.window
-        if not lo_w - 1e-6 <= start <= hi_w + 1e-6:
-            return
-        lo = max(lo_w, v_sent - dur + osi.park_time - 1.0 - slack_v)
-        hi = min(hi_w, v_recv - dur + osi.park_time + slack_v)
-        if lo > hi:
-            return
-        mid = (lo + hi) / 2
-        m.timers.arm(name, mid, dur)
-        c.window = (lo, hi)
-        c.extra_v = (hi - lo) / 2
-        for tt in c.timed:
-            tt.extra_v = min(tt.extra_v, c.extra_v)
 
-
-def _wp():
-    from ...model.plant import WaypointReached
-    return WaypointReached()
-
-
-def _name(tt: Timed) -> str:
-    return {"remote": "timeout", "opk": "$OPK park", "qpark": "park on a queued waypoint",
-            "park": "mission park", "lockout": "lockout"}.get(tt.timer, tt.timer)
-
-
-def _brief(replies: list) -> str:
-    if not replies:
-        return "nothing"
-    out = []
-    for r in replies:
-        if isinstance(r, s.ACK):
-            out.append(f"$ACK,{r.type},{r.status},{r.err}")
-        else:
-            out.append("$" + r.ID)
-    return ", ".join(out)
+#: the modes of remote-helm control (RH-INT-1)
+_REMOTE = frozenset(REMOTE_MODES)
 
 
 def finite(x: Optional[float]) -> bool:

@@ -16,7 +16,8 @@ the candidate's mode, and keeps the first that explains the ``$OSI``:
 ``surface``            in the ascent (or a lockout that ends in the window), the ``$OSI``
                        depth is at the surface: the at-surface action runs (RH-SAF-4)
 ``violation``          field 8 shows a safety code the candidate lacks (RH-SAF-1, RH-SAF-5);
-                       with ``surface`` after it when the window also covers the lockout
+                       with ``surface`` after it when the window also covers the lockout; after
+                       any of the motion events below when the way made before it is unseen too
 ``waypoint`` ×n        mode ``N``: the next mission waypoint(s) reached, up to
                        :data:`MAX_WAYPOINTS` (legs of any length)
 ``mission park``       a mission park at a waypoint whose park time is not known yet, maybe
@@ -131,12 +132,31 @@ def explain_osi(c: Candidate, osi: s.OSI, v: float, slack_v: float, tp: float, c
             trials.append((f"safety violation {osi.error_state} and the surface",
                            lambda t: violation(t, True), 2, None))
     if m.phase == "none":
-        trials += _motion_trials(c, osi, tp, gap, catalog)
+        motion = _motion_trials(c, osi, tp, gap, catalog)
+        trials += motion
+        if osi.error_state in _SAFETY and osi.error_state != m.error_state:
+            # the way made first, then a violation the vehicle raised by itself (RH-SAF-5) — the
+            # lockout shows the mission mode the way left it in (RH-RD-11), the surface after it
+            for name, build, n, learn in motion:
+                trials.append((f"{name}, then safety violation {osi.error_state}", _then(build, violation),
+                               n + 1, learn))
+                if at_surface:
+                    trials.append((f"{name}, then safety violation {osi.error_state} and the surface",
+                                   _then(build, lambda t: violation(t, True)), n + 2, learn))
     for name, build, n, learn in trials:
         got = run(name, build, n, learn)
         if got is not None:
             return got
     return None
+
+
+def _then(first: Callable[[Candidate], Optional[Candidate]],
+          second: Callable[[Candidate], Candidate]) -> Callable[[Candidate], Optional[Candidate]]:
+    """A trial's build followed by another's on the same copy (None when the first finds nothing)."""
+    def build(t: Candidate) -> Optional[Candidate]:
+        got = first(t)
+        return second(got) if got is not None else None
+    return build
 
 
 def _motion_trials(c: Candidate, osi: s.OSI, tp: float, gap: float, catalog) -> list:

@@ -1,7 +1,9 @@
 """One line at a time: what a backseat line is to a vehicle, and whether a vehicle line is valid.
 
 :func:`classify` reads a line (or a discarded run) the backseat sent the way a conforming vehicle
-does (RH-FRM-4..7, RH-RD-16) and says what it owes: an ``$ACK`` of a type (a command, or a
+does (RH-FRM-4..7, RH-RD-16) and says what it owes: an ``$ACK`` of a type (a command — tagged with
+the clause of a form the vehicle must still read: a zero-padded checksum RH-FRM-2, lower-case hex
+RH-FRM-3, a bare LF RH-FRM-7, a line of exactly the limit RH-FRM-6 — or a
 malformed command answered with its "incorrect values" error, RH-ACK-3), nothing (a line it must
 discard silently, with the clause that says so), or nothing because it is the ``$OXFLT`` test
 extension (RH-SAF-5). A command the profile does not claim is an unknown ID (RH-FRM-5).
@@ -38,6 +40,8 @@ PREFIX_REPEAT = 3
 _ID = re.compile(rb"\$([A-Za-z]+)[,*\r\n]")
 #: Vehicle-output decode errors → the clause a vehicle breaks by sending it.
 _OUT_CLAUSE = {"RH-FRM-4": "RH-FRM-2", "RH-FRM-5": "RH-FRM-1", "RH-FRM-7": "RH-FRM-1", "RH-ACK-3": "RH-FRM-1"}
+#: Backseat-line decode errors → the clause that says the vehicle discards such a line.
+_DISCARD_CLAUSE = {"RH-FRM-2": "RH-FRM-4"}
 
 
 @dataclass(frozen=True, slots=True)
@@ -68,6 +72,8 @@ def classify(d: Optional[Decoded], raw: bytes, profile: Profile, discard_clause:
             variant = f.clause
     if len(raw) >= profile.max_line_bytes:
         variant = "RH-FRM-6"  # a line of exactly the limit must still be read
+    elif not variant and raw[raw.rfind(b"*") + 1:][:1] == b"0":
+        variant = "RH-FRM-2"  # a checksum under 0x10 written zero-padded must still be read
     if isinstance(sent, s.OXFLT):
         if profile.fault_injection == "oxflt":
             return Kind("oxflt", sent)
@@ -82,7 +88,9 @@ def classify(d: Optional[Decoded], raw: bytes, profile: Profile, discard_clause:
     if err.answered and err.sentence_id in profile.commands:
         return Kind("error", err, err.ack_type, variant=variant)
     clause = err.clause if err.clause.startswith("RH-FRM") else "RH-FRM-5"
-    return Kind("discard", clause=clause, would_be=_id_type(raw))
+    # RH-FRM-2 only says what the checksum is; discarding a line whose checksum is wrong is
+    # RH-FRM-4's rule ("missing, malformed … or wrong: no $ACK, no state change")
+    return Kind("discard", clause=_DISCARD_CLAUSE.get(clause, clause), would_be=_id_type(raw))
 
 
 class OutputJudge:

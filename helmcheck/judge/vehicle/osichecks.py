@@ -22,6 +22,7 @@ A report carries more, and these checks use it:
   :data:`~helmcheck.judge.timing.PLANT_REACT_S` (+ RH-TIM-1 tolerance and slack) without acting
   fails the clause of the act it owes: the queued waypoint (RH-OMW-4), the mission's end at its
   last waypoint (RH-MSN-4; a waypoint of a mission of unknown length: RH-OUT-4);
+* **the ``$OMW`` queue's order** (field 7 in ``W``, RH-OMW-2): :mod:`.queuetarget`;
 * **the way made** (fields 4, 5, 6 and 7): every report's position, and field 7 in ``N``/``P`` at
   the mission's next waypoint, are kept on the mirror's candidates (``fix_seen``, ``nav_seen``)
   for the closure to tell whether an unseen waypoint reached is physically possible (RH-INT-2:
@@ -51,6 +52,7 @@ from ...model.plant import NEUTRAL
 from ...model.timers import tolerance
 from ..timing import JITTER_S, PLANT_REACT_S
 from .closure import osi_depth_m
+from .queuetarget import QueueTarget
 
 __all__ = ["OsiChecks"]
 
@@ -114,6 +116,8 @@ class OsiChecks:
         self.watch: Optional[tuple] = None  #: (key, first v on station/at surface, clause, what)
         self.park: Optional[_OpkPark] = None  #: the accepted $OPK the mP reports are judged on (RH-PK-2)
         self.shown_code = ""  #: field 8 of the last report (a code newly shown without $OXFLT: RH-SAF-5)
+        #: the queued waypoint a W report heads for (RH-OMW-2)
+        self.queue = QueueTarget(obs.ledger, obs.profile.on_station_m, obs.profile.max_speed_kn)
 
     # ------------------------------------------------------------------ answers
     def oxflt_sent(self, code: str, t: float) -> None:
@@ -223,6 +227,8 @@ class OsiChecks:
         if osi.error_state != "N" and m.phase == "lockout":
             o.ledger.passed("RH-SAF-1", f"field 8 shows {osi.error_state} in the lockout", ev, p.case)
         self._actuators(osi, m, p, ev)
+        self.queue.report(osi, m, o.v(p.t) - o.slack_v(), o.v(t) + o.slack_v(), ev, p.case,
+                          lambda verdict, clauses, reason: o.book(verdict, clauses, reason, ev, at=p))
         self._position(osi, p, ev)
         self._surface_action(osi, passes, p, ev)
         if "RH-MSN-4" in passes:
