@@ -4,7 +4,8 @@
   (§1–8); library entry :func:`helmcheck.certify.vehicle.runner.certify`;
 * :mod:`.backseat` — ``certify backseat``: helmcheck plays the vehicle (the reference emulator's
   core, in-process) and judges a backseat (§9); library entry
-  :func:`helmcheck.certify.backseat.runner.certify`.
+  :func:`helmcheck.certify.backseat.certifier.certify`;
+* :mod:`.outcome` — :class:`~.outcome.Outcome`, what both return.
 
 Both judge through the observers of :mod:`helmcheck.judge`, fed by the recorder of
 :mod:`helmcheck.line.recorder` exactly as the wire log records the bytes, and turn the ledger into

@@ -28,6 +28,7 @@ from ...profile import Profile
 from ...reports.certificate import RunDeclaration, finish_run
 from ...reports.render import render_all
 from ...reports.results import ReportError, exit_code
+from ..outcome import Outcome
 from .report import build_results
 from .scenarios import SCENARIOS, make_plan
 
@@ -60,15 +61,6 @@ class Options:
     link: Optional[Link] = None
     log: Optional[IO[str]] = None
     settings: dict[str, Any] = field(default_factory=dict)  #: recorded too (``settings`` in results.json)
-
-
-@dataclass
-class Outcome:
-    verdict: str
-    reason: str
-    exit_code: int
-    report_dir: Path
-    results: dict = field(default_factory=dict)
 
 
 def _positive(x: Optional[float]) -> bool:

@@ -33,7 +33,7 @@ from __future__ import annotations
 
 import shutil
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from fnmatch import fnmatchcase
 from pathlib import Path
 from typing import IO, Any, Callable, Optional
@@ -46,11 +46,12 @@ from ...judge import Ledger
 from ...judge.runfacts import RunFacts, partial_note, selection_note
 from ...judge.vehicle import VehicleObserver
 from ...judge.wire import tester_note
+from ...line.recorder import Recorder
+from ...line.transport import open_link
 from ...profile import Profile
 from ...reports import results as R
-from ...line.recorder import Recorder
 from ...reports.certificate import RunDeclaration, finish_run
-from ...line.transport import open_link
+from ..outcome import Outcome
 from . import resultsfile
 from .catalogue import select_cases
 from .clockprobe import ClockMismatch, check_clock
@@ -100,15 +101,6 @@ class Options:
     #: continue the interrupted run in ``report_dir`` (:mod:`.resume`): its record is replayed
     #: into the observer, its wire log appended to, its completed cases not run again
     resume: bool = False
-
-
-@dataclass
-class Outcome:
-    verdict: str
-    reason: str
-    exit_code: int
-    report_dir: Path
-    results: dict = field(default_factory=dict)
 
 
 def selected_ids(select: Optional[list]) -> list[str]:

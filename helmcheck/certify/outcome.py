@@ -1,0 +1,23 @@
+"""What a certification hands back to its caller: :class:`Outcome`, the same for both roles.
+
+``certify vehicle`` (:func:`helmcheck.certify.vehicle.runner.certify`) and ``certify backseat``
+(:func:`helmcheck.certify.backseat.certifier.certify`) return one after writing the results
+directory: the run verdict (a :class:`helmcheck.judge.verdict.Verdict` word), its reason, the exit
+status the command line gives it, where the results are and ``results.json`` as a dict.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+__all__ = ["Outcome"]
+
+
+@dataclass
+class Outcome:
+    verdict: str
+    reason: str
+    exit_code: int
+    report_dir: Path
+    results: dict = field(default_factory=dict)
