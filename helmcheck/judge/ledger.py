@@ -24,18 +24,21 @@ numbers per clause), so a ledger stays small whatever the length of the run.
 
 from __future__ import annotations
 
+from collections import deque
 from dataclasses import dataclass, field
 from typing import Callable, Iterable, NamedTuple, Optional, Union
 
 from ..clauses import catalogue
 from .verdict import Verdict
 
-__all__ = ["Ledger", "Evidence", "ClauseVerdict", "MAX_EVIDENCE", "MAX_LINES", "RANK", "combine"]
+__all__ = ["Ledger", "Evidence", "ClauseVerdict", "MAX_EVIDENCE", "MAX_LINES", "MAX_FAIL_LOG", "RANK", "combine"]
 
 #: A finding's reason, or a function that makes it (see :meth:`Ledger.passed`).
 Reason = Union[str, Callable[[], str]]
 MAX_EVIDENCE = 8
 MAX_LINES = 50
+#: Failures kept for :meth:`Ledger.failures_since` (the counts and verdicts keep every one).
+MAX_FAIL_LOG = 1024
 #: The combining rule: a higher rank wins.
 RANK = {Verdict.NOT_TESTED: 0, Verdict.PASS: 1, Verdict.INCONCLUSIVE: 2, Verdict.NON_STRICT: 3, Verdict.FAIL: 3}
 
@@ -100,8 +103,9 @@ class Ledger:
         self.order = [c for c in clause_ids if c in known]
         self._level = {c: known[c].level for c in self.order}
         self._e: dict[str, _Entry] = {c: _Entry() for c in self.order}
-        #: every failure in order: (serial, clause, reason) — drivers read :meth:`failures_since`
-        self._fail_log: list[tuple[int, str, str]] = []
+        #: the latest failures in order: (serial, clause, reason) — drivers read :meth:`failures_since`
+        #: (bounded: a ledger stays small however long the run, and however many its failures)
+        self._fail_log: deque[tuple[int, str, str]] = deque(maxlen=MAX_FAIL_LOG)
         self._serial = 0
         #: violations waiting for their confirmation (:meth:`hold`), or None when none is awaited
         self._held: Optional[list[tuple[str, str, list, str]]] = None
@@ -238,8 +242,14 @@ class Ledger:
         return self._serial
 
     def failures_since(self, mark: int) -> list[tuple[str, str]]:
-        """(clause, reason) of every failure recorded after :meth:`mark` returned ``mark``."""
-        return [(c, r) for n, c, r in self._fail_log if n > mark]
+        """(clause, reason) of every failure recorded after :meth:`mark` returned ``mark`` — the
+        latest :data:`MAX_FAIL_LOG` of them (a driver reads them after each step)."""
+        out = []
+        for n, c, r in reversed(self._fail_log):
+            if n <= mark:
+                break
+            out.append((c, r))
+        return out[::-1]
 
     def counts(self, cid: str) -> dict[str, int]:
         e = self._e[cid]

@@ -53,7 +53,12 @@ from typing import Any, Optional
 from ..grammar.wirelog import FROM_VEHICLE, NOTE, TO_VEHICLE, WireEvent
 from ..profile import SAFETY_CODES
 
-__all__ = ["WireEvent", "TO_VEHICLE", "FROM_VEHICLE", "NOTE", "Note", "parse_note", "case_note",
+#: Lines a judge's per-line caches keep (decoded sentences, classifications, evidence text, by
+#: the line's bytes): enough for the lines a session repeats (polls, acknowledgements), small
+#: enough that a session of hours, whose reports all differ, keeps its memory flat.
+LINE_CACHE = 512
+
+__all__ = ["LINE_CACHE", "WireEvent", "TO_VEHICLE", "FROM_VEHICLE", "NOTE", "Note", "parse_note", "case_note",
            "case_end_note", "tester_note", "parse_plant"]
 
 

@@ -38,7 +38,7 @@ from ...profile import Profile
 from ..facts import LOCKOUT_REFUSED, NEEDS_MISSION, NEEDS_RUNNING, NEEDS_STOPPED
 from ..ledger import Evidence, Ledger
 from ..timing import ack_allowance, ack_give_up_after
-from ..wire import FROM_VEHICLE, NOTE, TO_VEHICLE, WireEvent, parse_note
+from ..wire import FROM_VEHICLE, LINE_CACHE, NOTE, TO_VEHICLE, WireEvent, parse_note
 from .budget import LineBudget
 from .common import BS_CLAUSES, SentLine, Settings
 from .knowledge import Arrivals, Lockout, Pending, StateReports
@@ -50,7 +50,6 @@ from .servo import ServoRefresh
 
 __all__ = ["BackseatObserver", "BS_CLAUSES"]
 
-_CACHE = 4096
 _NOT_TESTED = {
     "RH-BS-1": "the backseat sent no line",
     "RH-BS-2": "the backseat sent no well-framed command",
@@ -150,7 +149,7 @@ class BackseatObserver:
     def _decode(self, raw: bytes) -> Decoded:
         d = self._cache.get(raw)
         if d is None:
-            if len(self._cache) >= _CACHE:
+            if len(self._cache) >= LINE_CACHE:
                 self._cache.clear()
             d = self._cache[raw] = decode(raw, self.profile)
         return d

@@ -28,6 +28,7 @@ from ...grammar.wirelog import escape
 from ...grammar.errors import SentenceError
 from ...profile import Profile
 from ..ledger import Evidence, Ledger
+from ..wire import LINE_CACHE
 
 __all__ = ["Kind", "classify", "OutputJudge", "ID_ACK_TYPE", "PREFIX_REPEAT"]
 
@@ -160,7 +161,7 @@ class OutputJudge:
                     passes.append(("RH-FRM-8", "$C has no commas"))
         led.passed_all(passes, [ev], case)
         if d.terminator == "\r\n" and not d.findings and d.raw.isascii():  # judged by its bytes alone
-            if len(self._clean) >= 4096:
+            if len(self._clean) >= LINE_CACHE:
                 self._clean.clear()
             self._clean[d.raw] = (sent, tuple(passes))
         return sent

@@ -40,7 +40,7 @@ from ...model import plant as P
 from ...profile import Profile
 from ..ledger import Evidence, Ledger, Reason
 from ..timing import JITTER_S
-from ..wire import FROM_VEHICLE, NOTE, TO_VEHICLE, WireEvent, parse_note
+from ..wire import FROM_VEHICLE, LINE_CACHE, NOTE, TO_VEHICLE, WireEvent, parse_note
 from . import osichecks
 from .belief import Beliefs
 from .answers import Answers
@@ -175,7 +175,7 @@ class VehicleObserver(Answers, Deadlines):
             known = self._whole[d]
             whole = known.get(data)
             if whole is None:  # sessions repeat their lines: the shape of each is worked out once
-                if len(known) >= 4096:
+                if len(known) >= LINE_CACHE:
                     known.clear()
                 whole = known[data] = ((Line(data, 0),) if data[:1] == b"$" and data.count(b"$") == 1
                                        and data.find(b"\n") == len(data) - 1 and len(data) <= fr.max_line
@@ -188,7 +188,7 @@ class VehicleObserver(Answers, Deadlines):
         """:func:`~helmcheck.grammar.decode` with a bounded cache (sessions repeat their lines)."""
         hit = self._decoded.get(raw)
         if hit is None:
-            if len(self._decoded) >= 4096:
+            if len(self._decoded) >= LINE_CACHE:
                 self._decoded.clear()
             hit = self._decoded[raw] = decode(raw, self.profile)
         return hit
@@ -198,7 +198,7 @@ class VehicleObserver(Answers, Deadlines):
         if text is not None:
             return Evidence(ev.t, direction, text, ev.lineno)
         if raw.endswith(b"\r\n") and b"\n" not in raw[:-1]:
-            if len(self._escaped) >= 4096:
+            if len(self._escaped) >= LINE_CACHE:
                 self._escaped.clear()
             text = self._escaped[raw] = escape(raw[:-2])
             return Evidence(ev.t, direction, text, ev.lineno)
@@ -258,7 +258,7 @@ class VehicleObserver(Answers, Deadlines):
             raw = fe.raw
             k = self._kinds.get(raw)
             if k is None:  # a line's kind depends on its bytes alone (sessions repeat their lines)
-                if len(self._kinds) >= 4096:
+                if len(self._kinds) >= LINE_CACHE:
                     self._kinds.clear()
                 k = self._kinds[raw] = classify(self.decode(raw), raw, self.profile)
             if self.after_discard and k.kind in ("command", "error") and not k.variant:
