@@ -3,7 +3,9 @@
 This module owns :func:`check_log` — Jepsen's ``analyze`` / TLA+ trace validation for the remote
 helm line: the whole log is consumed, in order, and every byte is attributed. Its steps:
 
-1. detect the format and the timestamp resolution from the first 64 KiB (:mod:`.readers`);
+1. detect the format and the timestamp resolution from the first 64 KiB (:mod:`.readers`); a wire
+   log in segments (``wire.log``, ``wire.001.log``, …) is read as one session, the segments one
+   after another (:mod:`helmcheck.reports.segments`);
 2. stream the records (:class:`~helmcheck.grammar.wirelog.WireEvent` s, with their time and log
    line; a wire log through the one wire-log reader, :mod:`helmcheck.grammar.wirelog`)
    and feed each to the role's observer: the vehicle observer
@@ -31,6 +33,7 @@ import io
 import itertools
 import os
 import time
+from contextlib import ExitStack
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import BinaryIO, Callable, Optional
@@ -43,11 +46,12 @@ from ..judge.runfacts import RunFacts
 from ..judge.vehicle import VehicleObserver
 from ..model.missions import MissionCatalog
 from ..profile import DEFAULT, Profile
+from ..reports.segments import session_files
 from .readers import (HEAD_BYTES, NOTE, UNREADABLE, Chunk, LogMeta, Unreadable, detect_format, header_comment, read_chunks,
                       timestamp_resolution)
 from .sidejob import SideJob, SideJobLost, cores
 
-__all__ = ["check_log", "CheckOutcome", "LogFormatError", "ROLES", "VEHICLE_CLAUSES"]
+__all__ = ["check_log", "log_meta", "CheckOutcome", "LogFormatError", "SessionJudge", "ROLES", "VEHICLE_CLAUSES"]
 
 ROLES = ("vehicle", "backseat", "both")
 MAX_FINDINGS = 50
@@ -82,6 +86,7 @@ class CheckOutcome:
     seconds: float = 0.0
     notes: list = field(default_factory=list)
     facts: RunFacts = field(default_factory=RunFacts)  #: the run facts of the log's notes
+    segments: list = field(default_factory=list)  #: the names of the session's further segments
 
 
 def check_log(path: Path | str, *, profile: Profile = DEFAULT, role: str = "both",
@@ -101,14 +106,16 @@ def check_log(path: Path | str, *, profile: Profile = DEFAULT, role: str = "both
         raise ValueError(f"role must be one of {ROLES}")
     path = Path(path)
     started = time.monotonic()
-    with open(path, "rb") as f:
-        size = os.fstat(f.fileno()).st_size
-        fmt, meta = _head(f, path, size)
+    session = session_files(path)
+    with ExitStack() as stack:
+        files = [stack.enter_context(open(p, "rb")) for p in session.files]
+        sizes = [os.fstat(f.fileno()).st_size for f in files]
+        fmt, meta = _head(files[0], path, sizes[0])
         scale = time_scale if time_scale is not None else (meta.time_scale or profile.time_scale or 1.0)
         baud = meta.baud or profile.baud
         if parallel is None:
-            parallel = role == "both" and size >= PARALLEL_BYTES and cores() > 1
-        job = (str(path), fmt, profile, scale, meta.resolution, baud, swap, size)
+            parallel = role == "both" and sum(sizes) >= PARALLEL_BYTES and cores() > 1
+        job = ([str(p) for p in session.files], fmt, profile, scale, meta.resolution, baud, swap, sizes)
         side = None
         if parallel and role == "both":
             try:
@@ -116,9 +123,9 @@ def check_log(path: Path | str, *, profile: Profile = DEFAULT, role: str = "both
             except Exception:  # no second process (none can start, or the job does not pickle): judge here
                 side = None
         try:
-            checker = _Checker(profile, role, catalog, scale, meta.resolution, baud,
+            checker = SessionJudge(profile, role, catalog, scale, meta.resolution, baud,
                                judge_backseat=side is None)
-            sha = _feed(f, size, checker, fmt, meta, swap, progress)
+            sha = _feed(files, sizes, checker, fmt, meta, swap, progress, session.missing)
             if side is not None:
                 try:
                     entries, side_sha = side.result()
@@ -131,8 +138,17 @@ def check_log(path: Path | str, *, profile: Profile = DEFAULT, role: str = "both
             if side is not None:
                 side.stop()
     out = checker.outcome(path, fmt, meta, sha)
+    out.segments = [p.name for p in session.files[1:]]
     out.seconds = time.monotonic() - started
     return out
+
+
+def log_meta(path: Path | str) -> tuple[str, LogMeta]:
+    """The format of the log at ``path`` and what its head says, as :func:`check_log` reads them
+    (``OSError``; :class:`LogFormatError` for no known format)."""
+    path = Path(path)
+    with open(path, "rb") as f:
+        return _head(f, path, os.fstat(f.fileno()).st_size)
 
 
 def _head(f: BinaryIO, path: Path, size: int) -> tuple[str, LogMeta]:
@@ -152,51 +168,63 @@ def _head(f: BinaryIO, path: Path, size: int) -> tuple[str, LogMeta]:
     return fmt, meta
 
 
-def _feed(f: BinaryIO, size: int, checker: "_Checker", fmt: str, meta: LogMeta, swap: bool,
-          progress: Optional[Callable[[int], None]]) -> str:
-    """Every record in the first ``size`` bytes of ``f`` to ``checker``, then close it; returns
-    the SHA-256 of the bytes read."""
+def _feed(files: list[BinaryIO], sizes: list[int], checker: "SessionJudge", fmt: str, meta: LogMeta, swap: bool,
+          progress: Optional[Callable[[int], None]], missing: Optional[str] = None) -> str:
+    """Every record in the first ``sizes[i]`` bytes of each of ``files`` (a session's segments,
+    :mod:`helmcheck.reports.segments`) to ``checker``, then close it; returns the SHA-256 of the
+    bytes read. A segment the session names but that is not there (``missing``) is a log line
+    that cannot be read: what it held is unknown."""
     sha = hashlib.sha256()
-    for chunk in read_chunks(_Hashing(f, sha, size), fmt, meta, swap=swap, progress=progress):
+    lines = _Hashing(list(zip(files, sizes)), sha)
+    for chunk in read_chunks(lines, fmt, meta, swap=swap, progress=progress):
         checker.chunk(chunk)
+    if missing is not None:
+        checker.chunk(Unreadable(checker.last_t, UNREADABLE, b"", f"the log continues in {missing}, which is "
+                                 f"not there", lines.count + 1, ""))
     checker.close()
     return sha.hexdigest()
 
 
-def _backseat_entries(path: str, fmt: str, profile: Profile, scale: float, resolution: float, baud: int,
-                      swap: bool, size: int) -> tuple[list, str]:
+def _backseat_entries(paths: list[str], fmt: str, profile: Profile, scale: float, resolution: float, baud: int,
+                      swap: bool, sizes: list[int]) -> tuple[list, str]:
     """The backseat role of a check on its own (the side job of a parallel check) over the first
-    ``size`` bytes: its ledger entries, and the SHA-256 of the bytes it read."""
-    with open(path, "rb") as f:
-        fmt2, meta = _head(f, Path(path), size)
+    ``sizes[i]`` bytes of each segment: its ledger entries, and the SHA-256 of the bytes it read."""
+    with ExitStack() as stack:
+        files = [stack.enter_context(open(p, "rb")) for p in paths]
+        fmt2, meta = _head(files[0], Path(paths[0]), sizes[0])
         if fmt2 != fmt:
-            raise LogFormatError(f"{path}: the file changed while it was being checked")
-        checker = _Checker(profile, "backseat", None, scale, resolution, baud)
-        sha = _feed(f, size, checker, fmt, meta, swap, None)
+            raise LogFormatError(f"{paths[0]}: the file changed while it was being checked")
+        checker = SessionJudge(profile, "backseat", None, scale, resolution, baud)
+        sha = _feed(files, sizes, checker, fmt, meta, swap, None)
     return checker.backseat.ledger.entries(), sha  # type: ignore[union-attr]
 
 
 class _Hashing:
-    """Iterates the lines (each ending in LF, as a binary file's lines do; the last may not) of
-    the first ``limit`` bytes of a binary file while hashing them. The file is read in blocks of
-    whole lines, and each block's lines come from :class:`io.BytesIO`: no Python code runs per
-    line here."""
+    """Iterates the lines (each ending in LF, as a binary file's lines do; a file's last may not)
+    of the first ``limit`` bytes of each ``(file, limit)`` — a session's segments, one after
+    another — while hashing them. Each file is read in blocks of whole lines, and each block's
+    lines come from :class:`io.BytesIO`: no Python code runs per line here. ``count`` is the
+    number of lines read so far (known once the iteration is over)."""
 
     BLOCK = 1 << 20
 
-    def __init__(self, f, h, limit: int):
-        self.f = f
+    def __init__(self, files: list, h):
+        self.files = files
         self.h = h
-        self.limit = limit
+        self.count = 0
 
     def __iter__(self):
         return itertools.chain.from_iterable(map(io.BytesIO, self._blocks()))
 
     def _blocks(self):
-        left = self.limit
+        for f, limit in self.files:
+            yield from self._file(f, limit)
+
+    def _file(self, f, limit: int):
+        left = limit
         carry = b""
         while left > 0:
-            block = self.f.read(min(self.BLOCK, left))
+            block = f.read(min(self.BLOCK, left))
             if not block:
                 break
             left -= len(block)
@@ -205,8 +233,11 @@ class _Hashing:
             cut = buf.rfind(b"\n") + 1
             carry = buf[cut:]
             if cut:
-                yield buf[:cut] if carry else buf
-        if carry:
+                out = buf[:cut]
+                self.count += out.count(b"\n")
+                yield out
+        if carry:  # a segment whose last line has no end: a line of its own, never joined to the next
+            self.count += 1
             yield carry
 
 
@@ -271,7 +302,12 @@ class _Vehicle(_Side):
         return self.ledger.entries()
 
 
-class _Checker:
+class SessionJudge:
+    """Every record of a session, in order, to each role's observer (:meth:`chunk`), the run facts
+    its notes give, and at the end (:meth:`close`, :meth:`outcome`) what :func:`check_log`
+    returns. ``check-log`` feeds it a log's records; ``helmcheck monitor`` feeds it the records of
+    a live session as they are written — the same judges, the same verdicts."""
+
     def __init__(self, profile: Profile, role: str, catalog, scale: float, resolution: float, baud: int,
                  judge_backseat: bool = True):
         self.profile = profile

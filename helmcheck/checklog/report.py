@@ -35,6 +35,8 @@ def build_results(out: CheckOutcome, profile: Profile, command: str, *, strict: 
                         profile=profile.as_dict(),
                         settings={"time_scale": out.time_scale, "strict": strict}, wire_log=wire_log)
     entries = [{**c, "cases": [f"log:{out.path.name}", *c.get("cases", ())]} for c in out.clauses]
+    if out.segments:  # the session goes on in these files beside the first (helmcheck.reports.segments)
+        res["wire_segments"] = list(out.segments)
     apply(res, assemble("log", entries, out.facts, strict=strict), duration_s=round(out.seconds, 3))
     res["timeline"] = out.timeline
     res["events"] = out.events
@@ -56,7 +58,8 @@ def write_report_dir(directory: Path, out: CheckOutcome, profile: Profile, comma
                      strict: bool = False, render: bool = True) -> dict[str, Any]:
     """Write the results directory; returns the results document. ``OSError``/``ReportError``."""
     directory.mkdir(parents=True, exist_ok=True)
-    size = out.path.stat().st_size
+    segments = [out.path.parent / name for name in out.segments]
+    size = sum(p.stat().st_size for p in (out.path, *segments))
     wire_name = "wire.log"
     copied: Optional[str] = None
     if size <= COPY_LIMIT:
@@ -67,6 +70,8 @@ def write_report_dir(directory: Path, out: CheckOutcome, profile: Profile, comma
             wire_name = copied
         if out.path.resolve() != (directory / copied).resolve():
             copy_file_atomic(out.path, directory / copied)
+            for p in segments:  # each further segment under its own name: the first one's note names it
+                copy_file_atomic(p, directory / p.name)
     res = build_results(out, profile, command, strict=strict, wire_log=wire_name)
     res["log"]["copy"] = copied
     if copied is None:

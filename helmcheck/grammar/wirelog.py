@@ -30,7 +30,13 @@ This module owns all of it; nothing else in helmcheck writes or parses a record:
   (``certify vehicle --resume``); :func:`parse_record` reads one line (``helmcheck parse``);
 * **the writer** — :class:`WireLogWriter`: the header, then one record a line, flushed record by
   record (the emulator; the certifiers and ``replay`` through
-  :class:`~helmcheck.line.recorder.Recorder`).
+  :class:`~helmcheck.line.recorder.Recorder`);
+* **segments** — a long session's log may go on in further files beside the first
+  (``wire.log``, ``wire.001.log``, …): a segment ends with the note :data:`CONTINUED` naming the
+  next (:func:`continued_in` reads it), and the next begins with the header and a comment naming
+  the one before (:meth:`WireLogWriter.continue_in`). Line numbers and time go on across
+  segments, so the segments read one after another are the session's log, numbered as written
+  (finding the files is :mod:`helmcheck.reports.segments`).
 
 Pure text processing: no clock, and no I/O beyond the lines and the stream it is handed.
 """
@@ -43,7 +49,8 @@ from typing import IO, Callable, Iterable, Iterator, NamedTuple, Optional, Union
 __all__ = ["HEADER", "TAG", "VERSION", "HEADER_LINES", "TO_VEHICLE", "FROM_VEHICLE", "TO_VEHICLE_RUN",
            "FROM_VEHICLE_RUN", "NOTE", "UNREADABLE", "DIRECTIONS", "SWAPPED", "BITS_PER_BYTE", "transmit_time",
            "WireEvent", "Unreadable", "Record", "WireLogError", "escape", "unescape", "is_line", "column",
-           "format_record", "RECORD_HEAD", "read_wire_log", "read_records", "parse_record", "WireLogWriter"]
+           "format_record", "RECORD_HEAD", "read_wire_log", "read_records", "parse_record", "WireLogWriter",
+           "CONTINUED", "continued_in", "segment_name"]
 
 # ---------------------------------------------------------------------- the format
 TAG = "# helmcheck wire-log"  #: the first line's start, whatever the version
@@ -242,6 +249,30 @@ def parse_record(line: bytes, lineno: int = 0) -> Optional[WireEvent]:
     return None
 
 
+# ---------------------------------------------------------------------- segments
+#: The note that ends a segment: the session's log goes on in the file it names, beside this one.
+CONTINUED = "continued in "
+
+
+def continued_in(note: str) -> Optional[str]:
+    """The file name a :data:`CONTINUED` note names (a plain name in the same directory), or None."""
+    if not note.startswith(CONTINUED):
+        return None
+    name = note[len(CONTINUED):].strip()
+    if not name or "/" in name or "\\" in name or name in (".", "..") or name.startswith("."):
+        return None
+    return name
+
+
+def segment_name(first: str, n: int) -> str:
+    """The name of segment ``n`` (0 is ``first`` itself) of a log named ``first``:
+    ``wire.log`` → ``wire.001.log``, ``wire.002.log``, …"""
+    if n == 0:
+        return first
+    stem, dot, ext = first.rpartition(".")
+    return f"{stem}.{n:03d}.{ext}" if dot and stem else f"{first}.{n:03d}"
+
+
 # ---------------------------------------------------------------------- the writer
 class WireLogWriter:
     """Writes a wire log to a text stream: the header, then one record a line, each flushed so a
@@ -308,6 +339,14 @@ class WireLogWriter:
         n = self._write(format_record(t, NOTE, note=text))
         self.records += 1
         return WireEvent(t, NOTE, b"", text, n)
+
+    def continue_in(self, stream: IO[str], previous: str) -> None:
+        """Go on in a new segment ``stream`` (the caller wrote the :data:`CONTINUED` note to the
+        old one, and closes it): the header and a comment naming ``previous`` first; numbering
+        and time go on (module docstring, *segments*)."""
+        self._f = stream
+        self._write(HEADER)
+        self._write(f"# continues {previous}")
 
     def close(self) -> None:
         if self._f is not None:

@@ -10,7 +10,8 @@ Modules, one concern each:
   ``verify``).
 * :mod:`~helmcheck.reports.atomic` — atomic file writes.
 * :mod:`~helmcheck.reports.digest` — the certificate digest (SHA-256 of both files).
-* :mod:`~helmcheck.reports.wirelog` — a tolerant summary of the wire log.
+* :mod:`~helmcheck.reports.wirelog` — a tolerant summary of the wire log;
+  :mod:`~helmcheck.reports.segments` — a session's log in segments (``wire.log``, ``wire.001.log``, …).
 * :mod:`~helmcheck.reports.rundir` — one read of a results directory (:class:`Run`).
 * :mod:`~helmcheck.reports.view` — clause rows joined with the profile, grouped and counted.
 * :mod:`~helmcheck.reports.text` — printable text, short titles.

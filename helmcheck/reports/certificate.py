@@ -35,6 +35,7 @@ from .identity import Declared, build_identity
 from .manifest import PROFILE_NAME, build_manifest, sha256_bytes, sha256_file
 from .results import write_results_atomic
 from .scope import scope_of
+from .segments import recorded_segments
 from .signing import ALGORITHM, SigningKey, sign
 from .wirelog import summarise
 
@@ -66,7 +67,9 @@ def record_certificate(results: dict[str, Any], run_dir: Path | str, profile: Pr
     except FileNotFoundError:
         wire = None
     profile_sha = sha256_bytes(text.encode("utf-8"))
-    results["digests"] = {wire_name: sha256_bytes(wire) if wire is not None else None, PROFILE_NAME: profile_sha}
+    results["digests"] = {wire_name: sha256_bytes(wire) if wire is not None else None,
+                          **{name: sha256_file(run_dir / name) for name in recorded_segments(results)},
+                          PROFILE_NAME: profile_sha}
     given = sha256_file(declared.profile_file) if declared.profile_file else None
     name_on_wire = summarise(wire)["osi_vehicle_name"] if results.get("role") != "backseat" else None
     results["identity"] = build_identity(results, profile, declared=declared, profile_sha256=profile_sha,

@@ -19,6 +19,8 @@ import hashlib
 from pathlib import Path, PurePosixPath
 from typing import Any, Mapping
 
+from .segments import recorded_segments
+
 __all__ = ["MANIFEST_FORMAT", "PROFILE_NAME", "RESULTS_NAME", "sha256_file", "sha256_bytes", "evidence_files",
            "build_manifest", "differing_files"]
 
@@ -51,7 +53,8 @@ def evidence_files(results: Mapping[str, Any]) -> tuple[str, str]:
 def build_manifest(directory: Path | str, results: Mapping[str, Any]) -> dict[str, Any]:
     """The manifest of the files as they are on disk now (``None`` for a missing file)."""
     directory = Path(directory)
-    names = (RESULTS_NAME, *evidence_files(results))
+    wire, profile = evidence_files(results)
+    names = (RESULTS_NAME, wire, *recorded_segments(results), profile)
     tester = (results.get("identity") or {}).get("tester") or {}
     tool = results.get("tool") or {}
     return {

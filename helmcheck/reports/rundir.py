@@ -12,6 +12,7 @@ from typing import Any
 
 from .digest import Digest, digest_bytes
 from .results import ReportError, parse_results, read_results_bytes
+from .segments import read_session, recorded_segments
 from .wirelog import summarise
 
 __all__ = ["Run", "load_run"]
@@ -40,7 +41,7 @@ def load_run(directory: Path | str) -> Run:
     results = parse_results(data, path)
     wire_path = path.parent / results["wire_log"]
     try:
-        wire: bytes | None = wire_path.read_bytes()
+        wire: bytes | None = read_session([wire_path, *(path.parent / n for n in recorded_segments(results))])
     except FileNotFoundError:
         wire = None
     except OSError as exc:

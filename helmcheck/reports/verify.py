@@ -46,6 +46,7 @@ from .assemble import Assembly, assemble
 from .manifest import MANIFEST_FORMAT, PROFILE_NAME, RESULTS_NAME, differing_files, evidence_files, sha256_file
 from .results import parse_results
 from .schema import validate
+from .segments import recorded_segments
 from .signing import ALGORITHM, key_id, public_key_from_b64
 from .view import VERDICT_LABEL
 
@@ -139,7 +140,7 @@ def check_digests(out: Verification, directory: Path, results: Mapping[str, Any]
         out.add(RESULTS_NAME, "records no digests of the wire log and profile (a run made before they were "
                               "recorded cannot be verified)")
         return
-    for name in (wire_name, PROFILE_NAME):
+    for name in (wire_name, *recorded_segments(results), PROFILE_NAME):
         if name not in recorded:
             out.add(RESULTS_NAME, f"records no digest of {name}")
     for name, want, got in differing_files(directory, recorded):
@@ -366,7 +367,8 @@ def check_signature(out: Verification, directory: Path, results: Optional[Mappin
     if not isinstance(files, dict):
         out.add(_SIGNATURE_NAME, "the signed manifest lists no files")
         return
-    wanted = {RESULTS_NAME, PROFILE_NAME, evidence_files(results)[0] if results is not None else "wire.log"}
+    wanted = {RESULTS_NAME, PROFILE_NAME, evidence_files(results)[0] if results is not None else "wire.log",
+              *(recorded_segments(results) if results is not None else ())}
     for name in sorted(wanted - set(files)):
         out.add(_SIGNATURE_NAME, f"the signed manifest does not cover {name}")
     for name, want, got in differing_files(directory, files):
