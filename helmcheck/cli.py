@@ -39,6 +39,7 @@ SUBCOMMANDS = {
     "certify": ("helmcheck.commands.certify_cmd", "certify a vehicle or a backseat over a serial port"),
     "replay": ("helmcheck.commands.replay_cmd", "re-drive a saved failing sequence against a vehicle"),
     "check-log": ("helmcheck.commands.checklog_cmd", "check a recorded serial log against the model"),
+    "monitor": ("helmcheck.commands.monitor_cmd", "judge a live backseat-vehicle session (tap or in line)"),
     "report": ("helmcheck.commands.report_cmd", "render a results directory as HTML, JUnit, Markdown"),
     "matrix": ("helmcheck.commands.matrix_cmd", "one overview of several runs: clauses x implementations"),
     "verify": ("helmcheck.commands.verify_cmd", "check a results directory against its evidence and signature"),
@@ -60,6 +61,7 @@ Typical use:
   helmcheck report reports/demo                    # render results.json to HTML/JUnit/Markdown
   helmcheck matrix out/a out/b --out out/          # several runs side by side, clause by clause
   helmcheck verify reports/demo                    # re-judge the wire log; check the signature
+  helmcheck monitor --tap /dev/ttyUSB0 /dev/ttyUSB1  # judge a live session from a Y-cable, live
   helmcheck parse wire.log                         # validate a capture line by line
   helmcheck profile init iver3.toml                # a commented profile for a vehicle to fill in
 

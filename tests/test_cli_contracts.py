@@ -72,6 +72,7 @@ USAGE = {
     "certify backseat": ["certify", "backseat", "--duration", "0"],
     "replay": ["replay"],
     "check-log": ["check-log"],
+    "monitor": ["monitor", "--tap", "pty"],
     "report": ["report", "--format", "pdf", "x"],
     "docs": ["docs", "--bogus"],
 }
@@ -125,6 +126,7 @@ PORT_COMMANDS = {
     "certify vehicle": lambda port, tmp: ["certify", "vehicle", "--port", port, "--report-dir", tmp / "r"],
     "certify backseat": lambda port, tmp: ["certify", "backseat", "--port", port, "--report-dir", tmp / "r"],
     "replay": lambda port, tmp: ["replay", replay_file(tmp), "--port", port],
+    "monitor": lambda port, tmp: ["monitor", "--between", "pty", port, "--report-dir", tmp / "r"],
 }
 
 
@@ -170,6 +172,7 @@ PROFILE_COMMANDS = {
     "certify backseat": lambda prof, tmp: ["certify", "backseat", "--profile", prof, "--report-dir", tmp / "r"],
     "replay": lambda prof, tmp: ["replay", replay_file(tmp), "--port", "/dev/null", "--profile", prof],
     "check-log": lambda prof, tmp: ["check-log", LOGS / "nominal.log", "--profile", prof, "--report-dir", tmp / "r"],
+    "monitor": lambda prof, tmp: ["monitor", "--tap", "pty", "pty", "--profile", prof, "--report-dir", tmp / "r"],
 }
 
 
@@ -278,6 +281,7 @@ TESTER_BUG = {  # (argv, the function a bug is planted in)
     "certify backseat": (["certify", "backseat"], "helmcheck.profile.load_profile"),
     "replay": (["replay", "REPLAY", "--port", "/dev/null"], "helmcheck.certify.vehicle.replay.load_replay"),
     "check-log": (["check-log", LOGS / "nominal.log"], "helmcheck.profile.load_profile"),
+    "monitor": (["monitor", "--tap", "pty", "pty"], "helmcheck.profile.load_profile"),
     "report": (["report", PASS_RUN], "helmcheck.reports.rundir.load_run"),
     "docs": (["docs", "--check"], "helmcheck.grammar.docs.render_markdown"),
 }

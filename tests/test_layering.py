@@ -11,7 +11,8 @@ import only its own layer and the layers below it:
   may import it, never the other way round, and never a driver or a command;
 * the drivers, lowest first: ``line`` (``helmcheck/line``: ports, the recorder, the implementation
   under test as a process), ``emulator`` (``helmcheck/emulator``), ``checklog``
-  (``helmcheck/checklog``: the offline checker) and ``certify`` (``helmcheck/certify``: the live
+  (``helmcheck/checklog``: the offline checker), ``monitor`` (``helmcheck/monitor``: check-log's
+  judges on a live session) and ``certify`` (``helmcheck/certify``: the live
   certifiers, which may run the emulator in-process to plan a run);
 * ``commands`` (``helmcheck/commands``, ``helmcheck/cli.py`` and the other entry points).
 
@@ -33,8 +34,8 @@ import pytest
 ROOT = Path(__file__).resolve().parents[1] / "helmcheck"
 
 #: The layers, lowest first: a module may import its own layer and those before it.
-LAYERS = ("foundation", "grammar", "model", "judge", "reports", "line", "emulator", "checklog", "certify",
-          "commands")
+LAYERS = ("foundation", "grammar", "model", "judge", "reports", "line", "emulator", "checklog", "monitor",
+          "certify", "commands")
 RANK = {name: i for i, name in enumerate(LAYERS)}
 
 #: Subpackages of ``helmcheck`` and their layer.
@@ -47,6 +48,7 @@ PACKAGES = {
     "line": "line",
     "emulator": "emulator",
     "checklog": "checklog",
+    "monitor": "monitor",
     "certify": "certify",
     "commands": "commands",
 }

@@ -1,0 +1,243 @@
+"""The monitor's I/O core (:class:`Relay`): one thread that reads both sides of a live line with
+one clock, forwards every byte in line, and hands a copy of each chunk on.
+
+It owns the bytes on the wire while ``helmcheck monitor`` runs, and nothing above them: no
+framing, no judging, no log format (the callback does that). Two modes:
+
+* **in line** (``forward=True``, ``--between``): every chunk read from one side is written to
+  the other at once, unchanged, in arrival order (no line buffering). It never alters, delays on
+  purpose, drops, reorders or injects a byte. When the far side cannot take the bytes now, they
+  wait in a per-direction buffer, in order, and are written as soon as its descriptor is
+  writable. The only bytes not delivered (counted in :attr:`Relay.stats` as ``undelivered``) are
+  those going to a side that has closed for good or to a TCP server with no client (like bytes
+  sent down an unplugged line), including what waited for a client that left;
+* **tap** (``forward=False``, ``--tap``): the two receive lines of a Y-cable; only read, never
+  a byte written to either.
+
+Each chunk is reported as ``on_bytes(t, direction, data)``: ``direction`` is
+:data:`~helmcheck.grammar.wirelog.TO_VEHICLE` for bytes the backseat sent and
+:data:`~helmcheck.grammar.wirelog.FROM_VEHICLE` for the vehicle's; ``t`` is read from ``clock``
+(one clock for both directions) right after the read, before forwarding. The callback runs after
+the forwarding write, so slow judging never delays a forwarded byte; it should be quick (append
+to a log) because the next read waits for it. The judges run in a process of their own
+(:mod:`.live`); any other thread of this process (the main loop, a live screen) shares the
+interpreter lock with this one, so while a relay runs the interpreter's switch interval is
+:data:`SWITCH_INTERVAL_S`: such a thread holds a read byte back at most that long
+(``benchmarks/monitor_bench.py`` measures what it all comes to). Sides coming and going are
+``on_event(t, kind, side)``: ``connect``/``disconnect`` (a TCP server link's client) or
+``closed`` (the link raised :class:`~helmcheck.line.link.LinkClosed`: a pty or device gone);
+the relay keeps serving the other side. RH-FRM-9: the line is 8N1 and a TCP byte stream carries
+the same bytes, so every link is the same byte stream here. The caller opens and closes links.
+"""
+
+from __future__ import annotations
+
+import os
+import select
+import sys
+import threading
+import time
+from typing import Callable, Optional
+
+from ..grammar.wirelog import FROM_VEHICLE, TO_VEHICLE
+from ..line.link import Link, LinkClosed
+
+__all__ = ["Relay", "SIDES"]
+
+SIDES = ("backseat", "vehicle")
+_READS = {"backseat": TO_VEHICLE, "vehicle": FROM_VEHICLE}  # direction of the bytes read from a side
+_GOES_TO = {TO_VEHICLE: "vehicle", FROM_VEHICLE: "backseat"}  # the side a direction is written to
+_IDLE = 0.05  # the longest select wait: a side without a descriptor, a missed wake-up
+_NO_FD_WAIT = 0.005  # the wait when a side has no descriptor (pyserial loop://) and is polled
+_MAX_WRITE = 65536  # the most offered to one write_some
+#: The interpreter's thread switch interval while a relay runs (Python's default is 5 ms): another
+#: thread holding the interpreter lock hands it over within this, so a byte read waits on it at
+#: most this long before it is forwarded.
+SWITCH_INTERVAL_S = 0.0002
+
+
+def _ignore(t: float, kind: str, side: str) -> None:  # noqa: ARG001 - the default on_event
+    pass
+
+
+class Relay(threading.Thread):
+    """Reads ``backseat`` and ``vehicle`` (both :class:`~helmcheck.line.link.Link`), forwards
+    when ``forward``, reports each chunk to ``on_bytes(t, direction, data)`` and each side's
+    ``connect``/``disconnect``/``closed`` to ``on_event(t, kind, side)``.
+
+    :meth:`start` it; :meth:`stop` ends it promptly (a self-pipe wakes the loop). An exception
+    that ended the thread (raised by a link or a callback) is in :attr:`error`."""
+
+    def __init__(self, backseat: Link, vehicle: Link, *, forward: bool,
+                 on_bytes: Callable[[float, str, bytes], None],
+                 on_event: Callable[[float, str, str], None] = _ignore,
+                 clock: Callable[[], float] = time.monotonic, name: str = "helmcheck-relay"):
+        super().__init__(name=name, daemon=True)
+        self.links = {"backseat": backseat, "vehicle": vehicle}
+        self.forward = forward
+        self.on_bytes = on_bytes
+        self.on_event = on_event
+        self.clock = clock
+        self.error: Optional[BaseException] = None
+        self.closed: set[str] = set()  #: sides gone for good
+        self._pending = {TO_VEHICLE: bytearray(), FROM_VEHICLE: bytearray()}
+        self._stats = {k: {TO_VEHICLE: 0, FROM_VEHICLE: 0}
+                       for k in ("bytes", "chunks", "max_pending", "undelivered")}
+        self._stopping = threading.Event()
+        self._pipe_lock = threading.Lock()  # the self-pipe is closed once, never written after
+        self._wake_r, self._wake_w = os.pipe()
+        os.set_blocking(self._wake_r, False)
+        os.set_blocking(self._wake_w, False)
+
+    # ------------------------------------------------------------------ control
+    @property
+    def stats(self) -> dict:
+        """``bytes``, ``chunks``, ``max_pending``, ``pending`` and ``undelivered``, each a dict
+        keyed by direction (``">"``, ``"<"``); a snapshot."""
+        out = {k: dict(v) for k, v in self._stats.items()}
+        out["pending"] = {d: len(p) for d, p in self._pending.items()}
+        return out
+
+    def stop(self, timeout: Optional[float] = 1.0) -> bool:
+        """Ask the loop to end, wait up to ``timeout`` s; True when the thread has ended."""
+        self._stopping.set()
+        with self._pipe_lock:
+            if self._wake_w >= 0:
+                try:
+                    os.write(self._wake_w, b"x")
+                except OSError:  # full: already woken
+                    pass
+        if self.ident is None:  # never started: nothing will close the self-pipe
+            self._close_pipe()
+        elif self.is_alive():
+            self.join(timeout)
+        return not self.is_alive()
+
+    # ------------------------------------------------------------------ the loop
+    def run(self) -> None:
+        switch = sys.getswitchinterval()
+        sys.setswitchinterval(min(switch, SWITCH_INTERVAL_S))
+        try:
+            while not self._stopping.is_set() and len(self.closed) < len(SIDES):
+                self._once()
+        except BaseException as e:  # noqa: BLE001 - reported through .error
+            self.error = e
+        finally:
+            sys.setswitchinterval(switch)
+            self._close_pipe()
+
+    def _close_pipe(self) -> None:
+        with self._pipe_lock:
+            for fd in (self._wake_r, self._wake_w):
+                if fd >= 0:
+                    os.close(fd)
+            self._wake_r = self._wake_w = -1
+
+    def _once(self) -> None:
+        rfds: dict[int, str] = {}
+        wfds: dict[int, str] = {}
+        unselectable: list[str] = []
+        for side in SIDES:
+            if side in self.closed:
+                continue
+            try:
+                fd = self.links[side].fileno()  # re-read each turn: a TCP server's changes
+            except OSError:
+                unselectable.append(side)
+                continue
+            rfds[fd] = side
+            if self.forward and self._pending[_READS[_other(side)]]:
+                wfds[fd] = side
+        timeout = _NO_FD_WAIT if unselectable else _IDLE
+        r, w, _ = select.select([self._wake_r, *rfds], list(wfds), [], timeout)
+        if self._wake_r in r:
+            try:
+                os.read(self._wake_r, 64)
+            except OSError:
+                pass
+        if self._stopping.is_set():
+            return
+        for fd in w:
+            self._flush(_READS[_other(wfds[fd])])
+        for side in [rfds[fd] for fd in r if fd in rfds] + unselectable:
+            if side not in self.closed:
+                self._read(side)
+        if self.forward:
+            for side in unselectable:  # no descriptor to wait on for writability
+                self._flush(_READS[_other(side)])
+
+    def _read(self, side: str) -> None:
+        link = self.links[side]
+        try:
+            events = link.poll()
+        except LinkClosed:
+            self._gone(side)
+            return
+        t = self.clock()  # right after the read, before forwarding
+        direction = _READS[side]
+        for ev in events:
+            if ev.kind == "data" and ev.data:
+                if self.forward:
+                    self._send(direction, ev.data)
+                self._stats["bytes"][direction] += len(ev.data)
+                self._stats["chunks"][direction] += 1
+                self.on_bytes(t, direction, ev.data)
+            elif ev.kind in ("connect", "disconnect"):
+                if ev.kind == "disconnect":  # what waited for that client is not for the next one
+                    self._forget(_READS[_other(side)])
+                self.on_event(t, ev.kind, side)
+
+    def _send(self, direction: str, data: bytes) -> None:
+        """Forward ``data``: at once when nothing waits before it, else behind what waits."""
+        pending = self._pending[direction]
+        if not self._reachable(_GOES_TO[direction]):
+            self._stats["undelivered"][direction] += len(data)
+            return
+        if not pending:
+            n = self._write(direction, data)
+            if n >= len(data) or _GOES_TO[direction] in self.closed:
+                return
+            data = data[n:]
+        pending += data
+        self._flush(direction)
+
+    def _reachable(self, side: str) -> bool:
+        """False for a side closed for good and a TCP server with no client (its link would
+        take the bytes and drop them, like an unplugged line)."""
+        return side not in self.closed and self.links[side].connected
+
+    def _flush(self, direction: str) -> None:
+        pending = self._pending[direction]
+        while pending:
+            n = self._write(direction, bytes(pending[:_MAX_WRITE]))
+            if n <= 0:
+                break
+            del pending[:n]
+        if len(pending) > self._stats["max_pending"][direction]:
+            self._stats["max_pending"][direction] = len(pending)
+
+    def _write(self, direction: str, data: bytes) -> int:
+        side = _GOES_TO[direction]
+        if side in self.closed:
+            return 0
+        try:
+            return self.links[side].write_some(data)
+        except (LinkClosed, BrokenPipeError, ConnectionError):
+            self._gone(side)
+            return 0
+
+    def _gone(self, side: str) -> None:
+        """A side closed for good: report it, forget what waited for it, serve the other."""
+        if side in self.closed:
+            return
+        self.closed.add(side)
+        self._forget(_READS[_other(side)])
+        self.on_event(self.clock(), "closed", side)
+
+    def _forget(self, direction: str) -> None:
+        self._stats["undelivered"][direction] += len(self._pending[direction])
+        self._pending[direction].clear()
+
+
+def _other(side: str) -> str:
+    return "vehicle" if side == "backseat" else "backseat"
