@@ -65,6 +65,7 @@ class LogFollower:
         self.lineno = 0  #: lines read so far (all segments)
         self.rest = b""
         self.next_name: Optional[str] = None
+        self._f = None
 
     def read(self) -> list:
         """The records of the whole lines written since the last call, up to :data:`BLOCK` bytes
@@ -73,13 +74,14 @@ class LogFollower:
             nxt = self.path.parent / self.next_name
             if not nxt.exists():
                 return []
+            self.close()
             self.path, self.offset, self.rest, self.next_name = nxt, 0, b"", None
-        try:
-            with open(self.path, "rb") as f:
-                f.seek(self.offset)
-                data = f.read(BLOCK)
-        except FileNotFoundError:
-            return []
+        if self._f is None:
+            try:
+                self._f = open(self.path, "rb")  # kept open: the writer only ever appends
+            except FileNotFoundError:
+                return []
+        data = self._f.read(BLOCK)
         self.offset += len(data)
         data = self.rest + data
         cut = data.rfind(b"\n") + 1
@@ -95,6 +97,11 @@ class LogFollower:
                 if name is not None:
                     self.next_name = name
         return records
+
+    def close(self) -> None:
+        if self._f is not None:
+            self._f.close()
+            self._f = None
 
     @property
     def at_end(self) -> bool:
@@ -252,6 +259,7 @@ def _follow(conn, first: Path, profile: Profile, role: str, time_scale: float, b
             break
         if not records:
             time.sleep(FOLLOW_S)
+    follower.close()
     judge.close()
     conn.send(("state", {**_state(judge, sides), "findings": count, "newest": newest}))
     fmt, meta = log_meta(first)
