@@ -29,7 +29,7 @@ from dataclasses import dataclass, field
 from typing import Callable, Iterable, NamedTuple, Optional, Union
 
 from ..clauses import catalogue
-from .verdict import Verdict
+from .verdict import FAIL, INCONCLUSIVE, NON_STRICT, NOT_TESTED, PASS
 
 __all__ = ["Ledger", "Evidence", "ClauseVerdict", "MAX_EVIDENCE", "MAX_LINES", "MAX_FAIL_LOG", "RANK", "combine"]
 
@@ -40,7 +40,7 @@ MAX_LINES = 50
 #: Failures kept for :meth:`Ledger.failures_since` (the counts and verdicts keep every one).
 MAX_FAIL_LOG = 1024
 #: The combining rule: a higher rank wins.
-RANK = {Verdict.NOT_TESTED: 0, Verdict.PASS: 1, Verdict.INCONCLUSIVE: 2, Verdict.NON_STRICT: 3, Verdict.FAIL: 3}
+RANK = {NOT_TESTED: 0, PASS: 1, INCONCLUSIVE: 2, NON_STRICT: 3, FAIL: 3}
 
 
 class Evidence(NamedTuple):
@@ -88,8 +88,8 @@ class _Level:
 
 @dataclass(slots=True)
 class _Entry:
-    levels: dict = field(default_factory=lambda: {k: _Level() for k in (Verdict.PASS, Verdict.FAIL, Verdict.INCONCLUSIVE,
-                                                                          Verdict.NOT_TESTED)})
+    levels: dict = field(default_factory=lambda: {k: _Level() for k in (PASS, FAIL, INCONCLUSIVE,
+                                                                          NOT_TESTED)})
     cases: dict = field(default_factory=dict)
     remarks: list = field(default_factory=list)
     withdrawn: Optional[tuple[str, str]] = None  #: (reason, prefix of an observed violation's reason)
@@ -149,11 +149,11 @@ class Ledger:
         e = self._e.get(cid)
         if e is None:
             return
-        lv = e.levels[Verdict.PASS]
+        lv = e.levels[PASS]
         if lv.full and (not case or case in e.cases):
             lv.count += 1  # the common, repeated pass: only the count changes
             return
-        self._add(cid, Verdict.PASS, reason, evidence, case)
+        self._add(cid, PASS, reason, evidence, case)
 
     def passed_all(self, passes: Iterable[tuple[str, str]], evidence: Iterable[Evidence] = (),
                    case: str = "") -> None:
@@ -163,11 +163,11 @@ class Ledger:
             e = get(cid)
             if e is None:
                 continue
-            lv = e.levels[Verdict.PASS]
+            lv = e.levels[PASS]
             if lv.full and (not case or case in e.cases):
                 lv.count += 1
             else:
-                self._add(cid, Verdict.PASS, reason, evidence, case)
+                self._add(cid, PASS, reason, evidence, case)
 
     def failed(self, cid: str, reason: str, evidence: Iterable[Evidence] = (), case: str = "") -> None:
         """The clause was violated: ``fail`` for a MUST, ``non-strict`` for a SHOULD."""
@@ -176,17 +176,17 @@ class Ledger:
         if self._held is not None:
             self._held.append((cid, reason, list(evidence)[:MAX_EVIDENCE], case))
         else:
-            self._add(cid, Verdict.FAIL, reason, evidence, case)
+            self._add(cid, FAIL, reason, evidence, case)
         self._serial += 1
         self._fail_log.append((self._serial, cid, reason))
 
     def inconclusive(self, cid: str, reason: str, evidence: Iterable[Evidence] = (), case: str = "") -> None:
         """The clause was exercised but could not be judged (the reason says why)."""
-        self._add(cid, Verdict.INCONCLUSIVE, reason, evidence, case)
+        self._add(cid, INCONCLUSIVE, reason, evidence, case)
 
     def not_tested(self, cid: str, reason: str, case: str = "") -> None:
         """Why the clause could not be exercised (shown only if nothing else was found)."""
-        self._add(cid, Verdict.NOT_TESTED, reason, (), case)
+        self._add(cid, NOT_TESTED, reason, (), case)
 
     def withdraw(self, cid: str, reason: str, observed: str = "") -> None:
         """The clause is outside what the run judged: its verdict is NOT-TESTED with *reason*
@@ -213,9 +213,9 @@ class Ledger:
         held, self._held = self._held or [], None
         for cid, reason, evidence, case in held:
             if confirmed:
-                self._add(cid, Verdict.FAIL, reason, evidence, case)
+                self._add(cid, FAIL, reason, evidence, case)
             else:
-                self._add(cid, Verdict.INCONCLUSIVE, f"{why}: {reason}", evidence, case)
+                self._add(cid, INCONCLUSIVE, f"{why}: {reason}", evidence, case)
 
     def remark(self, cid: str, text: str) -> None:
         """A remark appended to the clause's reason (an inference its verdict rests on)."""
@@ -226,7 +226,7 @@ class Ledger:
     # ------------------------------------------------------------------ queries
     def has_failed(self, cid: str) -> bool:
         e = self._e.get(cid)
-        return e is not None and e.levels[Verdict.FAIL].count > 0
+        return e is not None and e.levels[FAIL].count > 0
 
     def has_finding(self, cid: str) -> bool:
         """Anything at all was recorded for the clause (a pass, fail, inconclusive or reason)."""
@@ -235,7 +235,7 @@ class Ledger:
 
     def judged(self, cid: str) -> bool:
         e = self._e.get(cid)
-        return e is not None and any(e.levels[k].count for k in (Verdict.PASS, Verdict.FAIL, Verdict.INCONCLUSIVE))
+        return e is not None and any(e.levels[k].count for k in (PASS, FAIL, INCONCLUSIVE))
 
     def mark(self) -> int:
         """A position in the failure log (see :meth:`failures_since`)."""
@@ -260,39 +260,39 @@ class Ledger:
         e = self._e[cid]
         level = self._level[cid]
         lv = e.levels
-        judged = lv[Verdict.PASS].count + lv[Verdict.FAIL].count + lv[Verdict.INCONCLUSIVE].count
+        judged = lv[PASS].count + lv[FAIL].count + lv[INCONCLUSIVE].count
         cases = tuple(e.cases)
-        if lv[Verdict.FAIL].count:
-            f = lv[Verdict.FAIL]
-            verdict = Verdict.FAIL if level == "MUST" else Verdict.NON_STRICT
+        if lv[FAIL].count:
+            f = lv[FAIL]
+            verdict = FAIL if level == "MUST" else NON_STRICT
             reason = (f"{f.count} violation(s) in {judged} observation(s){_where(f.lines, f.count)}; "
                       f"first: {f.reason}")
             out = ClauseVerdict(cid, verdict, reason, level, cases, tuple(f.evidence), tuple(f.lines),
                                 f.count, judged)
-        elif lv[Verdict.INCONCLUSIVE].count:
-            i = lv[Verdict.INCONCLUSIVE]
+        elif lv[INCONCLUSIVE].count:
+            i = lv[INCONCLUSIVE]
             reason = (f"{i.count} of {judged} observation(s) could not be judged"
                       f"{_where(i.lines, i.count)}: {i.reason}")
-            out = ClauseVerdict(cid, Verdict.INCONCLUSIVE, reason, level, cases, tuple(i.evidence),
+            out = ClauseVerdict(cid, INCONCLUSIVE, reason, level, cases, tuple(i.evidence),
                                 tuple(i.lines), 0, judged)
-        elif lv[Verdict.PASS].count:
-            p = lv[Verdict.PASS]
+        elif lv[PASS].count:
+            p = lv[PASS]
             reason = f"{p.count} observation(s) met the clause" + (f"; first: {p.reason}" if p.reason else ".")
-            out = ClauseVerdict(cid, Verdict.PASS, reason, level, cases, tuple(p.evidence), (), 0, judged)
+            out = ClauseVerdict(cid, PASS, reason, level, cases, tuple(p.evidence), (), 0, judged)
         else:
-            n = lv[Verdict.NOT_TESTED]
+            n = lv[NOT_TESTED]
             reason = n.reason or "no occasion to exercise this clause"
-            out = ClauseVerdict(cid, Verdict.NOT_TESTED, reason, level, cases, (), (), 0, 0)
-        if e.remarks and out.verdict != Verdict.NOT_TESTED:
+            out = ClauseVerdict(cid, NOT_TESTED, reason, level, cases, (), (), 0, 0)
+        if e.remarks and out.verdict != NOT_TESTED:
             out = ClauseVerdict(out.id, out.verdict, out.reason + " Note: " + " ".join(e.remarks), out.level,
                                 out.cases, out.evidence, out.lines, out.offending_count, out.observations)
         if e.withdrawn is not None:
             why, observed = e.withdrawn
-            if out.verdict in (Verdict.FAIL, Verdict.NON_STRICT):
+            if out.verdict in (FAIL, NON_STRICT):
                 out = ClauseVerdict(out.id, out.verdict, observed + out.reason, out.level, out.cases, out.evidence,
                                     out.lines, out.offending_count, out.observations)
             else:
-                out = ClauseVerdict(cid, Verdict.NOT_TESTED, why, level, (), (), (), 0, 0)
+                out = ClauseVerdict(cid, NOT_TESTED, why, level, (), (), (), 0, 0)
         return out
 
     def verdicts(self) -> list[ClauseVerdict]:

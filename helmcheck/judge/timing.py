@@ -41,7 +41,7 @@ from __future__ import annotations
 
 from ..grammar.wirelog import BITS_PER_BYTE, transmit_time
 from ..model.timers import tolerance
-from .verdict import Verdict
+from .verdict import FAIL, INCONCLUSIVE, PASS
 
 __all__ = ["tolerance", "slack", "judgeable", "ack_allowance", "ack_uncertainty", "ack_verdict",
            "ack_give_up_after", "transmit_time", "JITTER_S", "REACTION_S", "BITS_PER_BYTE", "PLANT_REACT_S"]
@@ -88,10 +88,10 @@ def ack_verdict(dt: float, allowance: float, ack_window_s: float, resolution: fl
     even the worst case of the steps keeps the ACK inside the window; else ``"inconclusive"``
     (coarse steps could hide an ACK past the window)."""
     if dt > allowance:
-        return Verdict.FAIL
+        return FAIL
     if resolution <= ack_window_s / 10 or dt + 2 * ack_uncertainty(resolution) <= allowance:
-        return Verdict.PASS
-    return Verdict.INCONCLUSIVE
+        return PASS
+    return INCONCLUSIVE
 
 
 def ack_give_up_after(allowance: float) -> float:
