@@ -42,7 +42,11 @@ STATE_S = 0.25
 #: Where the idle scheduling class is not there: how much lower the judges' priority is (``nice``).
 NICE = 19
 #: The most the follower reads at once (memory stays flat when judging is far behind).
-BLOCK = 1 << 20
+BLOCK = 1 << 16
+#: The share of one CPU the judges take at most while the session runs (on a small machine a
+#: process that never sleeps costs the relay its latency, whatever its priority); after the
+#: session they run flat out.
+DUTY = 0.5
 
 
 @dataclass(frozen=True)
@@ -234,6 +238,7 @@ def _follow(conn, first: Path, profile: Profile, role: str, time_scale: float, b
     last_state = 0.0
     count, newest = 0, None
     while True:
+        busy = time.process_time()
         records = follower.read()
         for ev in records:
             judge.chunk(ev)
@@ -259,6 +264,8 @@ def _follow(conn, first: Path, profile: Profile, role: str, time_scale: float, b
             break
         if not records:
             time.sleep(FOLLOW_S)
+        elif sha is None:  # while the session runs, judging takes at most DUTY of a CPU: it waits, not forwarding
+            time.sleep((time.process_time() - busy) * (1 - DUTY) / DUTY)
     follower.close()
     judge.close()
     conn.send(("state", {**_state(judge, sides), "findings": count, "newest": newest}))
