@@ -8,8 +8,9 @@ observers ``check-log`` runs, vehicle (§1–8) and backseat (§9). It reads the
 ``check-log`` reads from the same files, so the verdicts are ``check-log``'s by construction.
 
 The judges are a process, not a thread, so that judging never takes the interpreter from the
-relay: if judging falls behind, it falls behind on the file, and forwarding does not wait
-(``benchmarks/monitor_bench.py``). The process sends back, over a pipe, the first failure of each
+relay: if judging falls behind, it falls behind on the file, and forwarding does not wait. The
+process runs in the idle CPU class and, while the session runs, takes at most :data:`DUTY` of a
+CPU (``benchmarks/monitor_bench.py``); once the log is closed it judges the rest flat out. The process sends back, over a pipe, the first failure of each
 clause as a :class:`Finding` the moment it is made (what a person watching must see), and a few
 times a second a state snapshot for a view (the count of all findings, the newest one, the
 clauses so far); :meth:`LiveJudge.poll` collects them in the caller's thread.
