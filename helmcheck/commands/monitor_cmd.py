@@ -146,10 +146,8 @@ def run(args: argparse.Namespace) -> int:
     tui = sys.stderr.isatty() and not args.no_tui
     screen = LiveScreen(f"helmcheck monitor --{mode}") if tui else None
 
-    def on_finding(f) -> None:
-        if screen is not None:
-            screen.finding(f)
-        elif f.first:
+    def on_finding(f) -> None:  # a live screen gets its findings from the session (it is the view)
+        if screen is None and f.first:
             print(finding_line(f), flush=True)
 
     def on_port(side: str, name: str) -> None:

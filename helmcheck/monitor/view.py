@@ -13,7 +13,7 @@ from __future__ import annotations
 import sys
 from typing import IO, Optional
 
-from .live import Finding  # noqa: F401 - the type of what finding_line shows
+from .live import Finding
 
 __all__ = ["finding_line", "LiveScreen"]
 
