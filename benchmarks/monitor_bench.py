@@ -8,7 +8,11 @@ the session's wire log (:class:`~helmcheck.monitor.sessionlog.SessionLog`: a rec
 which the live judges (:class:`~helmcheck.monitor.live.LiveJudge`: check-log's vehicle and
 backseat observers, in a process of their own) follow as it grows. The backseat and the vehicle
 are one other process, both ends in one ``select`` loop; send and arrival times are ``time.monotonic`` (one
-system-wide clock). Traffic is realistic: ``$OSD`` polls, ``$OMS``, ``$OPOS``, ``$OMSTOP`` one
+system-wide clock). The relay asks for real-time priority as ``helmcheck monitor`` does
+(``--no-realtime``: not), and the far ends, which stand for UARTs, run just above it where
+permitted, so that their time stamps are not delayed by other work on the machine. The pty
+layer under both (the kernel's tty buffer work) runs at normal priority: on a machine busy with
+other work every figure here, the pty hop without a relay included, grows with that work. Traffic is realistic: ``$OSD`` polls, ``$OMS``, ``$OPOS``, ``$OMSTOP`` one
 way; ``$ACK``, long ``$OSI``, ``$OPI``, ``$C``, ``$GPRMC`` the other. Figures printed:
 
 1. latency per byte at 19200 and 115200 baud: each end sends single bytes at the baud's byte time
@@ -49,6 +53,10 @@ from helmcheck.monitor.sessionlog import SessionLog  # noqa: E402
 from helmcheck.profile import DEFAULT  # noqa: E402
 
 TARGET_P99_MS = 1.0
+#: The far ends' real-time priority where permitted (above the relay's
+#: :data:`~helmcheck.monitor.relay.RT_PRIORITY`): their send and arrival stamps are not delayed
+#: by the machine's other work, so the figures are the relay's, not the harness's.
+ENDS_RT_PRIORITY = 2
 
 
 def frame(body: str) -> bytes:
@@ -102,6 +110,10 @@ def _fine_timers() -> None:
         ctypes.CDLL(None).prctl(29, 1000, 0, 0, 0)
     except Exception:  # noqa: BLE001 - not Linux: coarser pacing, same measurement
         pass
+    try:  # the far ends stand for UARTs, which no scheduler delays: above the relay where permitted
+        os.sched_setscheduler(0, os.SCHED_FIFO, os.sched_param(ENDS_RT_PRIORITY))
+    except (AttributeError, OSError):  # timed at normal priority: the figures include their waits
+        pass
 
 
 def paced_ends(paths, byte_time: float, seconds: float, conn) -> None:
@@ -146,6 +158,7 @@ def paced_ends(paths, byte_time: float, seconds: float, conn) -> None:
             got_t[k].extend([t] * len(data))
     lat = [[b - a for a, b in zip(sent_t[k], got_t[k])] for k in (0, 1)]
     conn.send({"lat": lat, "exact": [bytes(got[k]) == streams[k] for k in (0, 1)], "n": n,
+               "ends": "real-time" if os.sched_getscheduler(0) == getattr(os, "SCHED_FIFO", -1) else "normal",
                "span": [sent_t[k][-1] - sent_t[k][0] if sent_t[k] else 0 for k in (0, 1)]})
 
 
@@ -200,7 +213,7 @@ class Monitor:
     (a process of its own), as ``helmcheck monitor`` runs them. ``judge=False``: the log is
     written, nothing is judged."""
 
-    def __init__(self, log_path: Path, baud: int, judge: bool = True):
+    def __init__(self, log_path: Path, baud: int, judge: bool = True, realtime: bool = True):
         self.backseat, self.vehicle = PtyLink(baud), PtyLink(baud)
         self.forward_s: list[float] = []
         self.session = SessionLog(log_path.parent, [f"benchmark  baud {baud}  time_scale 1"], name=log_path.name)
@@ -209,8 +222,9 @@ class Monitor:
         self.records = 0
         self.findings = 0
         self.t0 = time.monotonic()
-        self.relay = Relay(self.backseat, self.vehicle, forward=True, on_bytes=self.on_bytes)
+        self.relay = Relay(self.backseat, self.vehicle, forward=True, on_bytes=self.on_bytes, realtime=realtime)
         self.relay.start()
+        self.relay.started()
 
     @property
     def parsed(self) -> int:
@@ -251,9 +265,9 @@ def run_child(target, *args):
     return out
 
 
-def latency(tmp: str, baud: int, seconds: float, judge: bool = True) -> bool:
+def latency(tmp: str, baud: int, seconds: float, judge: bool = True, realtime: bool = True) -> bool:
     bt = 10 / baud
-    mon = Monitor(Path(tmp) / f"wire-{baud}.log", baud, judge)
+    mon = Monitor(Path(tmp) / f"wire-{baud}.log", baud, judge, realtime)
     r = run_child(paced_ends, (mon.backseat.name, mon.vehicle.name), bt, seconds)
     mon.close()
     p99 = max(pct(sorted(x), .99) for x in r["lat"]) * 1e3
@@ -262,7 +276,9 @@ def latency(tmp: str, baud: int, seconds: float, judge: bool = True) -> bool:
         print(f"  without the judges: p99 {p99:.3f} ms through the relay, byte-exact: {all(r['exact'])}")
         return met
     base = run_child(paced_ends, None, bt, seconds / 2)
-    print(f"{baud} baud: byte time {bt * 1e3:.3f} ms; {r['n']:,} single bytes each way in "
+    print(f"{baud} baud: byte time {bt * 1e3:.3f} ms; relay priority {mon.relay.priority}; far ends "
+          f"{r['ends']}; "
+          f"{r['n']:,} single bytes each way in "
           f"{max(r['span']):.1f} s, byte-exact: {all(r['exact'])}; "
           f"{mon.parsed:,} records judged ({mon.findings:,} findings)")
     for k, d in enumerate((TO_VEHICLE, FROM_VEHICLE)):
@@ -303,13 +319,15 @@ def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--seconds", type=float, default=4.0, help="each latency run")
     ap.add_argument("--blast-seconds", type=float, default=4.0, help="the sustained-rate run")
+    ap.add_argument("--no-realtime", action="store_true",
+                    help="the relay at normal priority, as where real-time priority is not permitted")
     a = ap.parse_args()
     print(f"monitor relay, in line between two ptys, both directions at once; each chunk a wire-log record "
           f"written and flushed, judged by check-log's observers following the log in a process of their own; "
           f"{os.cpu_count()} CPUs")
     with tempfile.TemporaryDirectory(prefix="monitor-bench-") as tmp:
-        ok = latency(tmp, 19200, a.seconds)
-        ok &= latency(tmp, 115200, a.seconds)
+        ok = latency(tmp, 19200, a.seconds, realtime=not a.no_realtime)
+        ok &= latency(tmp, 115200, a.seconds, realtime=not a.no_realtime)
         latency(tmp, 115200, a.seconds, judge=False)
         ok &= blast(tmp, a.blast_seconds)
         blast(tmp, a.blast_seconds, judge=False)

@@ -140,6 +140,9 @@ def test_between_the_emulator_and_a_good_backseat_the_verdicts_are_check_logs(tm
     assert not [c for c, v in judged.items() if v == "fail"], res["verdict_reason"]
     assert code in (0, 2)
     assert res["monitor"]["mode"] == "between" and res["monitor"]["relay"]["undelivered"] == {">": 0, "<": 0}
+    priority = res["monitor"]["relay_priority"]
+    assert priority.startswith(("real-time", "normal (")), priority
+    assert f" ! monitor: relay priority {priority}\n" in (mon.dir / "wire.log").read_text()
     same_as_check_log(res, mon.dir)
     assert (mon.dir / "profile.toml").is_file() and (mon.dir / "report.html").is_file()
 

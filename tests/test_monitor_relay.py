@@ -303,3 +303,35 @@ def test_a_callback_that_raises_ends_the_relay_with_its_error():
         assert wait_until(lambda: not line.relay.is_alive())
         assert isinstance(line.relay.error, RuntimeError)
         assert read_exactly(line.veh_peer, 1, 2.0) == b"x"  # forwarded before the callback ran
+
+
+@pytest.mark.parametrize("realtime", [True, False])
+def test_relay_priority_is_what_it_says(realtime):
+    """The relay's thread runs at the priority it reports (real-time where permitted, asked for
+    by default; normal with ``realtime=False``), and the bytes are forwarded either way."""
+    policies: list[int] = []
+    b, v = PtyLink(115200), PtyLink(115200)
+
+    def on_bytes(t, direction, data):
+        policies.append(os.sched_getscheduler(0))  # the callback runs in the relay's thread
+
+    relay = Relay(b, v, forward=True, on_bytes=on_bytes, realtime=realtime)
+    relay.start()
+    bs, veh = open_peer(b.name), open_peer(v.name)
+    try:
+        said = relay.started()
+        os.write(bs, b"$OSD,G*00\r\n")
+        assert read_exactly(veh, 11) == b"$OSD,G*00\r\n"
+        assert wait_until(lambda: policies)
+    finally:
+        relay.stop()
+        os.close(bs)
+        os.close(veh)
+        b.close()
+        v.close()
+    assert os.sched_getscheduler(0) == os.SCHED_OTHER  # only the relay's thread, not the process
+    if said.startswith("real-time"):
+        assert realtime and set(policies) == {os.SCHED_FIFO}
+    else:
+        assert said.startswith("normal (") and set(policies) == {os.SCHED_OTHER}
+        assert realtime or "not asked" in said

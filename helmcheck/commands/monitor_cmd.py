@@ -75,6 +75,8 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
                    help="start a new wire-log segment every MB megabytes (default 64)")
     p.add_argument("--strict", action="store_true", help="a SHOULD not met fails the session")
     p.add_argument("--no-tui", action="store_true", help="plain finding lines even on a terminal")
+    p.add_argument("--no-realtime", action="store_true",
+                   help="do not ask for real-time priority for the relay (by default it does, where permitted)")
     p.add_argument("--vehicle", metavar="NAME", help="the vehicle's name in the report (default: the profile's)")
     p.add_argument("--overwrite", action="store_true", help="replace an earlier run in --report-dir")
     add_certificate_arguments(p, "backseat")
@@ -153,6 +155,11 @@ def run(args: argparse.Namespace) -> int:
     def on_port(side: str, name: str) -> None:
         print(f"{side} port: {name}", flush=True)
 
+    def on_relay(priority: str) -> None:
+        hint = "" if priority.startswith("real-time") or args.no_realtime else \
+            " — for the lowest added latency allow it real-time priority (README: At sea)"
+        print(f"helmcheck monitor: relay priority {priority}{hint}", file=sys.stderr, flush=True)
+
     print(f"helmcheck monitor: {mode} — backseat {links[0].name}, vehicle {links[1].name}, baud {baud}, "
           f"time scale {scale:g}; {'forwarding every byte' if mode == 'between' else 'reading only'}; "
           f"wire log in {report_dir / 'wire.log'}", file=sys.stderr, flush=True)
@@ -161,7 +168,7 @@ def run(args: argparse.Namespace) -> int:
                           time_scale=float(scale), baud=baud, duration=args.duration, until=until,
                           rotate_bytes=int(args.rotate_mb * 1024 * 1024), strict=bool(args.strict),
                           command=command, certificate=cert, on_finding=on_finding, on_port=on_port,
-                          view=screen, links=links))
+                          view=screen, links=links, realtime=not args.no_realtime, on_relay=on_relay))
     print(f"{headline(out.results)}. {out.reason} ({out.ended}; {out.findings} finding(s))", flush=True)
     print(f"helmcheck monitor: report in {out.report_dir}", file=sys.stderr)
     return out.exit_code

@@ -23,7 +23,12 @@ to a log) because the next read waits for it. The judges run in a process of the
 (:mod:`.live`); any other thread of this process (the main loop, a live screen) shares the
 interpreter lock with this one, so while a relay runs the interpreter's switch interval is
 :data:`SWITCH_INTERVAL_S`: such a thread holds a read byte back at most that long
-(``benchmarks/monitor_bench.py`` measures what it all comes to). Sides coming and going are
+(``benchmarks/monitor_bench.py`` measures what it all comes to). With ``realtime`` (the
+default) the thread asks for the lowest real-time priority (Linux ``SCHED_FIFO``
+:data:`RT_PRIORITY`), so that a waking relay is not queued behind whatever else keeps the CPUs
+busy; it blocks in ``select`` between chunks, so it takes no CPU it does not use. Without the
+permission (root, ``CAP_SYS_NICE``, or an ``rtprio`` limit of at least :data:`RT_PRIORITY`) it
+runs at normal priority; :attr:`Relay.priority` says which, once :meth:`started` returns. Sides coming and going are
 ``on_event(t, kind, side)``: ``connect``/``disconnect`` (a TCP server link's client) or
 ``closed`` (the link raised :class:`~helmcheck.line.link.LinkClosed`: a pty or device gone);
 the relay keeps serving the other side. RH-FRM-9: the line is 8N1 and a TCP byte stream carries
@@ -54,6 +59,9 @@ _MAX_WRITE = 65536  # the most offered to one write_some
 #: thread holding the interpreter lock hands it over within this, so a byte read waits on it at
 #: most this long before it is forwarded.
 SWITCH_INTERVAL_S = 0.0002
+#: The real-time priority the relay thread asks for (the lowest: above every normal process,
+#: below every real-time one the system has, such as interrupt threads).
+RT_PRIORITY = 1
 
 
 def _ignore(t: float, kind: str, side: str) -> None:  # noqa: ARG001 - the default on_event
@@ -71,8 +79,13 @@ class Relay(threading.Thread):
     def __init__(self, backseat: Link, vehicle: Link, *, forward: bool,
                  on_bytes: Callable[[float, str, bytes], None],
                  on_event: Callable[[float, str, str], None] = _ignore,
-                 clock: Callable[[], float] = time.monotonic, name: str = "helmcheck-relay"):
+                 clock: Callable[[], float] = time.monotonic, name: str = "helmcheck-relay",
+                 realtime: bool = True):
         super().__init__(name=name, daemon=True)
+        self.realtime = realtime
+        #: the thread's scheduling, once running: "real-time" or "normal (…why…)"
+        self.priority = ""
+        self._running = threading.Event()
         self.links = {"backseat": backseat, "vehicle": vehicle}
         self.forward = forward
         self.on_bytes = on_bytes
@@ -98,6 +111,11 @@ class Relay(threading.Thread):
         out["pending"] = {d: len(p) for d, p in self._pending.items()}
         return out
 
+    def started(self, timeout: float = 5.0) -> str:
+        """Wait until the thread runs (its priority set); returns :attr:`priority`."""
+        self._running.wait(timeout)
+        return self.priority
+
     def stop(self, timeout: Optional[float] = 1.0) -> bool:
         """Ask the loop to end, wait up to ``timeout`` s; True when the thread has ended."""
         self._stopping.set()
@@ -117,6 +135,8 @@ class Relay(threading.Thread):
     def run(self) -> None:
         switch = sys.getswitchinterval()
         sys.setswitchinterval(min(switch, SWITCH_INTERVAL_S))
+        self.priority = _raise_priority() if self.realtime else "normal (real-time priority not asked for)"
+        self._running.set()
         try:
             while not self._stopping.is_set() and len(self.closed) < len(SIDES):
                 self._once()
@@ -237,6 +257,17 @@ class Relay(threading.Thread):
     def _forget(self, direction: str) -> None:
         self._stats["undelivered"][direction] += len(self._pending[direction])
         self._pending[direction].clear()
+
+
+def _raise_priority() -> str:
+    """Give the calling thread :data:`RT_PRIORITY` (module docstring); what it got."""
+    try:
+        os.sched_setscheduler(0, os.SCHED_FIFO, os.sched_param(RT_PRIORITY))  # 0: this thread (Linux)
+    except AttributeError:
+        return "normal (no real-time scheduling on this system)"
+    except OSError as e:
+        return f"normal (real-time priority refused: {e.strerror or e})"
+    return f"real-time (SCHED_FIFO {RT_PRIORITY})"
 
 
 def _other(side: str) -> str:

@@ -65,6 +65,8 @@ class Options:
     on_port: Optional[Callable[[str, str], None]] = None  #: (side, name) of a pty the monitor created
     view: Any = None  #: has ``refresh(state)``/``close()`` (``.view``), or None
     links: Optional[tuple[Link, Link]] = None  #: command hook: the two sides, opened by the command
+    realtime: bool = True  #: the relay asks for real-time priority (:mod:`.relay`)
+    on_relay: Optional[Callable[[str], None]] = None  #: told the relay's priority once it runs
 
 
 @dataclass
@@ -119,9 +121,12 @@ def monitor(opts: Options) -> Result:
     relay = Relay(b_link, v_link, forward=opts.mode == "between",
                   on_bytes=lambda t, direction, data: slog.bytes(t - t0, direction, data),
                   on_event=lambda t, kind, side: slog.note(t - t0, f"monitor: the {side} side: {kind}"),
-                  clock=time.monotonic)
+                  clock=time.monotonic, realtime=opts.realtime)
     slog.note(0.0, f"monitor started ({opts.mode}): backseat {b_link.name}, vehicle {v_link.name}")
     relay.start()
+    slog.note(time.monotonic() - t0, f"monitor: relay priority {relay.started()}")
+    if opts.on_relay is not None:
+        opts.on_relay(relay.priority)
     ended = "the session ended"
     try:
         ended = _wait(opts, relay, live, interim, t0)
@@ -189,7 +194,7 @@ def _results(out, opts: Options, ended: str, relay: Relay, live: LiveJudge) -> d
     res = build_results(out, profile, opts.command or f"helmcheck monitor --{opts.mode}", strict=opts.strict)
     res["log"]["copy"] = res["wire_log"]
     res["monitor"] = {"mode": opts.mode, "backseat": opts.backseat, "vehicle": opts.vehicle,
-                      "ended": ended, "in_progress": False, "relay": relay.stats,
+                      "ended": ended, "in_progress": False, "relay": relay.stats, "relay_priority": relay.priority,
                       "findings": live.findings, "segments": len(out.segments) + 1}
     return res
 
