@@ -27,8 +27,14 @@ ROOT = Path(__file__).resolve().parents[1]
 
 
 def rss_kib(pid: int) -> int:
-    text = Path(f"/proc/{pid}/status").read_text()
-    return int(re.search(r"VmRSS:\s+(\d+)", text).group(1))
+    """Resident KiB of ``pid``; 0 for a process that has ended (gone, or a zombie: an interim
+    check that finished between the listing and the reading)."""
+    try:
+        text = Path(f"/proc/{pid}/status").read_text()
+    except OSError:
+        return 0
+    m = re.search(r"VmRSS:\s+(\d+)", text)
+    return int(m.group(1)) if m else 0
 
 
 def children(pid: int) -> list[int]:

@@ -158,9 +158,10 @@ def _first_fail(mon: Monitor, clause: str) -> float:
     raise AssertionError(f"no live FAIL for {clause}: {mon.lines}")
 
 
-def test_a_faulty_backseat_is_reported_within_a_second(tmp_path):
+@pytest.mark.parametrize("mode", ["between", "tap"])
+def test_a_faulty_backseat_is_reported_within_a_second(tmp_path, mode):
     with EmulatorProcess(time_scale=K) as emu:
-        mon, code = session(tmp_path, 8.0, emu.port, faulty="bad-checksum")
+        mon, code = RUN[mode](tmp_path, 8.0, emu.port, faulty="bad-checksum")
     assert code == 1
     lag = _first_fail(mon, "RH-BS-1")
     assert lag < 1.0, lag
@@ -169,14 +170,15 @@ def test_a_faulty_backseat_is_reported_within_a_second(tmp_path):
     same_as_check_log(mon.results(), mon.dir)
 
 
-def test_a_faulty_vehicle_is_reported_within_a_second(tmp_path):
+@pytest.mark.parametrize("mode", ["between", "tap"])
+def test_a_faulty_vehicle_is_reported_within_a_second(tmp_path, mode):
     sys.path.insert(0, str(ROOT))
     from tests.faulty_vehicles.base import make_core, serve
     from tests.faulty_vehicles.wire import MUTANTS
 
     [mutant] = [m for m in MUTANTS if m.name == "lowercase-checksum-out"]
     with serve(lambda start: make_core(mutant, K, start)) as port:
-        mon, code = session(tmp_path, 6.0, port)
+        mon, code = RUN[mode](tmp_path, 6.0, port)
     assert code == 1
     assert _first_fail(mon, "RH-FRM-3") < 1.0
     same_as_check_log(mon.results(), mon.dir)
@@ -219,21 +221,34 @@ class YCable(threading.Thread):
             link.close()
 
 
+def tap_session(tmp_path: Path, seconds: float, vehicle_port: str, *, faulty: str = ""):
+    """A session through a Y-cable (:class:`YCable`) with the monitor on its two tap lines; the
+    monitor must write nothing to either."""
+    y = YCable(vehicle_port)
+    y.start()
+    mon = Monitor(["--tap", y.tap_bs.name, y.tap_veh.name, "--duration", f"{seconds:g}"], tmp_path / "mon")
+    deadline = time.monotonic() + 20  # reading both lines once its relay runs (the log says so)
+    while "relay priority" not in ((mon.dir / "wire.log").read_text() if (mon.dir / "wire.log").exists() else ""):
+        assert time.monotonic() < deadline and mon.proc.poll() is None, "the monitor did not start"
+        time.sleep(0.05)
+    bs = backseat(y.bs.name, faulty=faulty)
+    try:
+        code = mon.finish(seconds + 60)
+    finally:
+        stop(bs)
+        written = [os.read(link.master, 65536) if select.select([link.master], [], [], 0)[0] else b""
+                   for link in (y.tap_bs, y.tap_veh)]
+        y.close()
+    assert written == [b"", b""]  # the monitor wrote nothing to either line
+    return mon, code
+
+
+RUN = {"between": session, "tap": tap_session}
+
+
 def test_a_tap_reads_both_lines_writes_nothing_and_gets_check_logs_verdicts(tmp_path):
     with EmulatorProcess(time_scale=K) as emu:
-        y = YCable(emu.port)
-        y.start()
-        mon = Monitor(["--tap", y.tap_bs.name, y.tap_veh.name, "--duration", "8"], tmp_path / "mon")
-        time.sleep(0.5)
-        bs = backseat(y.bs.name)
-        try:
-            code = mon.finish(70)
-        finally:
-            stop(bs)
-            written = [os.read(link.master, 65536) if select.select([link.master], [], [], 0)[0] else b""
-                       for link in (y.tap_bs, y.tap_veh)]
-            y.close()
-    assert written == [b"", b""]  # the monitor wrote nothing to either line
+        mon, code = tap_session(tmp_path, 8.0, emu.port)
     res = mon.results()
     judged = {c["id"]: c["verdict"] for c in res["clauses"] if c["verdict"] != "not-tested"}
     assert judged.get("RH-ACK-1") == "pass" and judged.get("RH-BS-1") == "pass", judged
