@@ -18,9 +18,9 @@ imported when it is asked for: the reference engine, locating a syntax error, th
 
 from __future__ import annotations
 
-import hashlib
 import re
 import typing
+import zlib
 from dataclasses import dataclass, fields
 from decimal import Decimal
 from functools import lru_cache
@@ -41,8 +41,11 @@ def grammar_text() -> str:
 
 
 def grammar_digest(text: str) -> str:
-    """SHA-256 of the grammar's text: the tables in :mod:`.derived` are for that grammar only."""
-    return hashlib.sha256(text.encode("utf-8")).hexdigest()
+    """CRC-32 of the grammar's text: the tables in :mod:`.derived` are for that grammar only.
+    (It tells an edited grammar from the one the tables were made from; the suite checks the
+    tables against the derivation itself. CRC-32, not a cryptographic hash: loading OpenSSL
+    for it would cost more start-up than the tables save.)"""
+    return f"{zlib.crc32(text.encode('utf-8')):08x}"
 
 
 @lru_cache(maxsize=1)
@@ -117,7 +120,7 @@ def _rows() -> dict:
     """The derived tables: :mod:`.derived` while it was made from this grammar, else derived now."""
     from . import derived
 
-    if derived.GRAMMAR_SHA256 == grammar_digest(grammar_text()):
+    if getattr(derived, "GRAMMAR_DIGEST", None) == grammar_digest(grammar_text()):
         return derived.RULES
     from .derive import derive_rows  # the grammar changed since `helmcheck docs`: Lark reads it
 
@@ -232,8 +235,9 @@ def _items(f: FieldSpec, text: Optional[str]) -> tuple:
 
 
 def _builder_args(spec: SentenceSpec, index: dict, env: dict, tag: str) -> list[str]:
-    """Source of the field values of ``spec.cls``, in field order, from ``t`` (the groups of a
-    match whose group numbers are ``index``); embedded sentences are built from the same groups."""
+    """Source of the field values of ``spec.cls``, in field order, from ``g0``, ``g1``, … (the
+    groups of a match whose group numbers are ``index``); embedded sentences are built from the
+    same groups."""
     cls = spec.cls
     by_attr = {f.attr: f for f in spec.fields}
     required = dict(_REQUIRED.get(cls, ()))
@@ -247,7 +251,7 @@ def _builder_args(spec: SentenceSpec, index: dict, env: dict, tag: str) -> list[
             first = index[sub_spec.fields[0].rule] - 1
             env[f"cls{k}"] = sub_spec.cls
             sub_args = ", ".join(_builder_args(sub_spec, index, env, k))
-            args.append(f"(cls{k}({sub_args}) if t[{first}] is not None else None)")
+            args.append(f"(cls{k}({sub_args}) if g{first} is not None else None)")
             continue
         f = by_attr.get(name)
         if f is None:
@@ -255,7 +259,7 @@ def _builder_args(spec: SentenceSpec, index: dict, env: dict, tag: str) -> list[
             continue
         env[f"c{k}"] = f.convert
         conv = f"c{k}" if f.convert is not str else ""
-        g = f"t[{index[f.rule] - 1}]"
+        g = f"g{index[f.rule] - 1}"
         if f.kind == "flag":
             args.append(f"({g} is not None)")
         elif f.kind == "items":
@@ -286,7 +290,10 @@ def fast_builder(rule: str) -> Callable[[re.Match], S.Sentence]:
     args = _builder_args(spec, spec.regex.groupindex, env, "")
     # The object is filled through its slot descriptors, as the frozen dataclass __init__ would
     # do field by field, at half the cost (the classes have no __post_init__ to skip).
-    lines = ["def build(m):", "    t = m.groups()", "    o = _new(cls)"]
+    # The groups are unpacked into locals once: reading a local is cheaper than indexing a tuple.
+    n = spec.regex.groups
+    lines = ["def build(m):", *([f"    {''.join(f'g{i}, ' for i in range(n))}= m.groups()"] if n else []),
+             "    o = _new(cls)"]
     for i, (f, expr) in enumerate(zip(fields(cls), args)):
         env[f"set{i}"] = getattr(cls, f.name).__set__
         lines.append(f"    set{i}(o, {expr})")
