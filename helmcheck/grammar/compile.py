@@ -18,13 +18,13 @@ imported when it is asked for: the reference engine, locating a syntax error, th
 
 from __future__ import annotations
 
+import os
 import re
 import typing
 import zlib
 from dataclasses import dataclass, fields
 from decimal import Decimal
 from functools import lru_cache
-from importlib import resources
 from typing import Any, Callable, Optional
 
 from . import sentences as S
@@ -37,7 +37,15 @@ GRAMMAR_FILE = "remote_helm.lark"
 
 @lru_cache(maxsize=1)
 def grammar_text() -> str:
-    return resources.files("helmcheck.grammar").joinpath(GRAMMAR_FILE).read_text(encoding="utf-8")
+    """The grammar file's text: beside this module, or through importlib.resources where the
+    package is not a directory (a zip); the direct read spares every start-up that import."""
+    try:
+        with open(os.path.join(os.path.dirname(__file__), GRAMMAR_FILE), encoding="utf-8") as f:
+            return f.read()
+    except OSError:
+        from importlib import resources
+
+        return resources.files("helmcheck.grammar").joinpath(GRAMMAR_FILE).read_text(encoding="utf-8")
 
 
 def grammar_digest(text: str) -> str:
