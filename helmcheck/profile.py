@@ -39,7 +39,6 @@ from __future__ import annotations
 
 import dataclasses
 import math
-import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -378,6 +377,8 @@ EMULATOR_TABLE = "emulator"
 def load_emulator_table(path: str | Path | None) -> dict[str, Any]:
     """The ``[emulator]`` table of the profile file at ``path`` (``{}`` when none); call after
     :func:`load_profile` has accepted the file."""
+    import tomllib
+
     if path is None:
         return {}
     data = tomllib.loads(Path(path).read_bytes().decode("utf-8"))
@@ -392,6 +393,7 @@ EMULATOR_PROFILE = "profiles/emulator.toml"
 def emulator_profile() -> Profile:
     """What ``helmcheck emulate`` claims (its ``$OXFLT`` extension and the missions it ships):
     the profile every certification of the built-in emulator uses (``make demo``, the tests)."""
+    import tomllib
     from importlib import resources
 
     text = resources.files("helmcheck").joinpath(EMULATOR_PROFILE).read_text(encoding="utf-8")
@@ -407,6 +409,8 @@ def load_profile(path: str | Path | None) -> Profile:
     """Read a TOML profile; ``None`` gives the ``rh5`` defaults."""
     if path is None:
         return DEFAULT
+    import tomllib  # only when there is a file to read
+
     p = Path(path)
     try:
         raw = p.read_bytes()

@@ -57,3 +57,49 @@ def test_shortcut_and_full_reading_agree(s):
     from helmcheck.grammar import codec
     from helmcheck.profile import DEFAULT
     assert codec._fast(raw, DEFAULT) == decode(raw.rstrip(b"\r\n") + b"\r\n", engine="lark").sentence
+
+
+def _chars_outside(items, allowed: set[int]) -> list[str]:
+    """Every way the parsed regex ``items`` could match a character not in ``allowed``."""
+    out: list[str] = []
+    for op, av in items:
+        name = str(op)
+        if name == "LITERAL":
+            out += [] if av in allowed else [chr(av)]
+        elif name == "IN":
+            for iop, iav in av:
+                kind = str(iop)
+                if kind == "LITERAL":
+                    out += [] if iav in allowed else [chr(iav)]
+                elif kind == "RANGE":
+                    out += [chr(c) for c in range(iav[0], iav[1] + 1) if c not in allowed]
+                else:  # NEGATE, CATEGORY (\s, \w, ...): more than the listed characters
+                    out.append(kind)
+        elif name == "SUBPATTERN":
+            out += _chars_outside(av[3], allowed)
+        elif name in ("MAX_REPEAT", "MIN_REPEAT"):
+            out += _chars_outside(av[2], allowed)
+        elif name == "BRANCH":
+            for branch in av[1]:
+                out += _chars_outside(branch, allowed)
+        elif name != "AT":  # ANY ("."), NOT_LITERAL, back references, ...
+            out.append(name)
+    return out
+
+
+def test_fast_path_regexes_match_only_clean_bodies():
+    """The fast path does not scan a line's body for bytes the framing forbids (RH-FRM-1, a
+    second '*'): it relies on every compiled sentence regex matching only printable ASCII
+    without '$' and '*'. A grammar change that breaks that premise fails here."""
+    import re._parser as sre_parse
+
+    from helmcheck.grammar.compile import specs
+
+    allowed = set(range(0x20, 0x7F)) - {ord("$"), ord("*")}
+    for rule, spec in specs().items():
+        assert _chars_outside(sre_parse.parse(spec.regex.pattern), allowed) == [], rule
+        for f in spec.fields:
+            if f.item_regex is not None:
+                assert _chars_outside(sre_parse.parse(f.item_regex.pattern), allowed) == [], (rule, f.rule)
+    assert _chars_outside(sre_parse.parse(r"A[^,a]\s.[^,]"), allowed) == ["NEGATE", "CATEGORY", "ANY", "NOT_LITERAL"]
+    assert _chars_outside(sre_parse.parse(r"(?:x|\$)"), allowed) == ["$"]

@@ -1,8 +1,9 @@
 """``helmcheck docs``: regenerate (or, with ``--check``, verify) every generated document.
 
-The grammar reference comes from ``remote_helm.lark``; the model's transition table and state
-diagram come from ``helmcheck/model/transitions.py``. Nothing in ``docs/`` is written by hand
-except ``contracts.md``. Each file is written atomically; one that cannot be written is exit 2
+The grammar reference comes from ``remote_helm.lark``, and so do the fast path's tables
+(``helmcheck/grammar/derived.py``, :mod:`helmcheck.grammar.derive`); the model's transition
+table and state diagram come from ``helmcheck/model/transitions.py``. Nothing in ``docs/`` is
+written by hand except ``contracts.md``. Each file is written atomically; one that cannot be written is exit 2
 naming it. ``--check`` exits 1 when a checked-in copy is stale.
 """
 
@@ -23,16 +24,18 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
 
 def run(args: argparse.Namespace) -> int:
     from ..failures import OutputLost
+    from ..grammar import derive
     from ..grammar import docs as grammar_docs
     from ..model import docs as model_docs
     from ..reports.atomic import write_text_atomic
 
     if args.check:
-        stale = (["docs/grammar.md"] if grammar_docs.stale() else []) + list(model_docs.stale())
+        stale = ((["docs/grammar.md"] if grammar_docs.stale() else [])
+                 + (["helmcheck/grammar/derived.py"] if derive.stale() else []) + list(model_docs.stale()))
         for name in stale:
             print(f"stale: {name} (run 'helmcheck docs')")
         return exitcodes.NONCONFORMANT if stale else exitcodes.OK
-    targets = {grammar_docs.DOCS_FILE: grammar_docs.render_markdown()}
+    targets = {grammar_docs.DOCS_FILE: grammar_docs.render_markdown(), derive.TABLE_FILE: derive.render_table()}
     targets.update({model_docs.DOCS_DIR / name: text for name, text in model_docs.render_all().items()})
     for path, text in targets.items():
         try:

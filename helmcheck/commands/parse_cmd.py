@@ -7,11 +7,16 @@ Invalid lines print as ``FILE:LINE: CLAUSE: message``; ``--json`` prints one JSO
 line instead.
 Exit 0 when every line is valid, 1 when any is not, 64 on usage errors or an unreadable file.
 
-Speed (the whole process is measured against a plain pynmea2 loop, ``benchmarks/parse_bench.py``):
-a line that starts with ``$`` goes straight to the codec's fast path (:func:`helmcheck.grammar.parse`,
-no :class:`~helmcheck.grammar.Decoded` built for a valid line without ``--json``); only other
-lines take the general path (blank lines, comments, wire-log records). Output is collected and
-written in blocks.
+Speed (the whole process is measured against plain pynmea2 loops, ``benchmarks/parse_bench.py``):
+the input is read in blocks of up to 1 MiB (as much as a pipe has, so a live capture is judged
+as it comes) and split into lines in C, with exactly the lines a file's line iterator gives
+(split at LF only). A line that starts with ``$`` goes straight to the codec's fast path
+(:func:`helmcheck.grammar.parse`, no :class:`~helmcheck.grammar.Decoded` built for a valid line
+without ``--json``); only other lines take the general path (blank lines, comments, wire-log
+records). A valid line is valid again under the same profile, so a line seen valid before is
+counted without being read again (captures repeat: the same polls, the same status). Output is
+collected and written in blocks, and nothing is imported that the lines at hand do not need
+(the JSON encoder with ``--json``, the wire-log reader with a wire log).
 
 A reader that goes away (``helmcheck parse … | head -1``) ends the command quietly: reading
 stops, and the exit status is the verdict on the lines judged so far (0 when all were valid,
@@ -21,9 +26,9 @@ stops, and the exit status is the verdict on the lines judged so far (0 when all
 from __future__ import annotations
 
 import argparse
-import json
+import re
 import sys
-from typing import IO, Iterable
+from typing import IO, Iterable, Iterator
 
 from .. import exitcodes
 from ..failures import PathError
@@ -40,6 +45,9 @@ notes (!) are skipped.
 """
 
 _BLOCK = 512  #: output lines collected before one write
+_READ = 1 << 20  #: bytes asked of the input at a time
+_SEEN = 1 << 14  #: valid lines remembered (distinct lines; about 2 MB for 80-byte lines)
+_LINE = re.compile(rb"[^\n]*\n|[^\n]+")  #: a line as a binary file's iterator gives it
 
 
 def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
@@ -62,40 +70,73 @@ class _Counts:
         self.bad = 0
 
 
-def _check_lines(name: str, lines: Iterable[bytes], profile, as_json: bool, out: IO[str], n: _Counts) -> bool:
+def read_lines(f) -> Iterator[list[bytes]]:
+    """The lines of a binary stream, a block at a time: each line with its LF, the last one
+    without when the stream does not end in one — what iterating over the stream gives."""
+    read = getattr(f, "read1", f.read)
+    rest = b""
+    while True:
+        block = read(_READ)
+        if not block:
+            break
+        if rest:
+            block = rest + block
+        cut = block.rfind(b"\n") + 1
+        rest = block[cut:]
+        if cut:
+            whole = block[:cut] if rest else block
+            # bytes.splitlines also splits at a lone CR; where there is none it splits as we do
+            yield whole.splitlines(True) if whole.count(b"\r") == whole.count(b"\r\n") else _LINE.findall(whole)
+    if rest:
+        yield [rest]
+
+
+def _check_lines(name: str, blocks: Iterable[list[bytes]], profile, as_json: bool, out: IO[str], n: _Counts) -> bool:
     """Judge every line; False when the output's reader went away (stop reading)."""
     from ..grammar import SentenceError, decode, parse
 
+    if as_json:
+        import json
     pending: list[str] = []
     emit = pending.append
+    seen: set[bytes] = set()  # lines found valid (plain output only: --json prints each)
+    remember = seen.add
     checked = bad = 0
     lineno = 0
     try:
-        for lineno, raw in enumerate(lines, 1):
-            if raw[:1] == b"$":  # a bare sentence: the common case, kept short
-                checked += 1
-                if as_json:
-                    d = decode(raw, profile)
-                    if d.sentence is None:
-                        bad += 1
-                    obj = d.as_dict()
-                    emit(json.dumps({"file": name, "line": lineno, **obj}))
+        for lines in blocks:
+            for raw in lines:
+                lineno += 1
+                if raw in seen:
+                    checked += 1
+                    continue
+                if raw[:1] == b"$":  # a bare sentence: the common case, kept short
+                    checked += 1
+                    if as_json:
+                        d = decode(raw, profile)
+                        if d.sentence is None:
+                            bad += 1
+                        obj = d.as_dict()
+                        emit(json.dumps({"file": name, "line": lineno, **obj}))
+                    else:
+                        try:
+                            parse(raw, profile)
+                        except SentenceError as e:
+                            bad += 1
+                            emit(f"{name}:{lineno}: {e}")
+                        else:
+                            if len(seen) < _SEEN:
+                                remember(raw)
+                            continue
                 else:
-                    try:
-                        parse(raw, profile)
-                        continue
-                    except SentenceError as e:
-                        bad += 1
-                        emit(f"{name}:{lineno}: {e}")
-            else:
-                c, b = _other_line(name, lineno, raw, profile, as_json, emit)
-                checked += c
-                bad += b
-            if len(pending) >= _BLOCK:
-                out.write("\n".join(pending) + "\n")
-                pending.clear()
-                if getattr(out, "lost", False):
-                    return False
+                    c, b = _other_line(name, lineno, raw, profile, as_json, emit)
+                    checked += c
+                    bad += b
+                if len(pending) >= _BLOCK:
+                    out.write("\n".join(pending) + "\n")
+                    pending.clear()
+                    if getattr(out, "lost", False):
+                        return False
         if pending:
             out.write("\n".join(pending) + "\n")
     finally:
@@ -129,6 +170,8 @@ def _other_line(name: str, lineno: int, raw: bytes, profile, as_json: bool, emit
 
 def _emit(emit, as_json, name, lineno, d, direction, failure) -> None:
     if as_json:
+        import json
+
         obj = {"file": name, "line": lineno}
         if d is None:
             obj.update({"type": None, "valid": False, "fields": None,
@@ -166,10 +209,10 @@ def run(args: argparse.Namespace) -> int:
     for name in args.files:
         try:
             if name == "-":
-                going = _check_lines(name, sys.stdin.buffer, profile, args.json, out, n)
+                going = _check_lines(name, read_lines(sys.stdin.buffer), profile, args.json, out, n)
             else:
-                with open(name, "rb", buffering=1 << 16) as f:
-                    going = _check_lines(name, f, profile, args.json, out, n)
+                with open(name, "rb") as f:
+                    going = _check_lines(name, read_lines(f), profile, args.json, out, n)
         except OSError as e:
             raise PathError(f"cannot read {name}: {_why(e)}") from None
         if not going:

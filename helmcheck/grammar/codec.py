@@ -9,7 +9,8 @@ canonical input, ``format(parse(b)) == b``.
 
 Two engines read the body: ``"fast"`` (regular expressions compiled from the grammar, the
 default) and ``"lark"`` (the Lark LALR parser over the same grammar). They agree; the property
-tests prove it. Errors are always located with Lark, which knows where a parse went wrong.
+tests prove it. Errors are always located with Lark, which knows where a parse went wrong;
+Lark is imported then, and not before (a process that reads only valid lines never needs it).
 """
 
 from __future__ import annotations
@@ -18,10 +19,7 @@ import builtins
 import re
 from dataclasses import dataclass
 from decimal import Decimal
-from typing import Optional
-
-from lark import Token, Tree
-from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, UnexpectedToken
+from typing import TYPE_CHECKING, Optional
 
 from ..profile import DEFAULT, Profile
 from . import sentences as S
@@ -29,6 +27,9 @@ from .checksum import checksum
 from .compile import build_sentence, fast_builder, lark_parser, specs
 from .errors import SYNTAX, Finding, SentenceError
 from .ranges import check_ranges
+
+if TYPE_CHECKING:
+    from lark import Tree
 
 __all__ = ["decode", "parse", "format", "format_body", "Decoded", "KNOWN_IDS", "rules_for_id", "prepare"]
 
@@ -67,12 +68,19 @@ def _first_literal(rule_pattern: str) -> str:
     return m.group(0) if m else ""
 
 
+class _Builders(dict):
+    """ID -> [(body regex's fullmatch, builder)], each ID's made on its first line (a capture
+    holds a few IDs of the protocol's thirty; :func:`prepare` makes them all)."""
+
+    def __missing__(self, sid: str) -> list:
+        entry = self[sid] = [(spec.regex.fullmatch, fast_builder(spec.rule)) for spec in _RULES_BY_ID[sid]]
+        return entry
+
+
 _RULES_BY_ID: dict[str, list] = {}
-_FAST: dict[str, list] = {}  # ID -> [(body regex, builder)]
+_FAST = _Builders()
 for _spec in specs().values():
     _RULES_BY_ID.setdefault(_first_literal(_spec.regex.pattern), []).append(_spec)
-    _FAST.setdefault(_first_literal(_spec.regex.pattern), []).append(
-        (_spec.regex.fullmatch, fast_builder(_spec.rule)))
 KNOWN_IDS = frozenset(_RULES_BY_ID)
 _COMMAND_ERR = {cls.ID: (cls.ACK_TYPE, cls.ERR) for cls in S.COMMAND_CLASSES if cls.ACK_TYPE}
 _REPLY_CLAUSE = {"OSI": "RH-OUT-1", "ACK": "RH-ACK-1"}
@@ -92,8 +100,6 @@ def _fail(raw: bytes, err: SentenceError, findings=(), sid=None, term="") -> Dec
     return Decoded(raw, None, err, tuple(findings), sid, term)
 
 
-#: The shape of a clean line: printable body without "$" or "*", upper-case checksum, CR LF.
-_CLEAN = re.compile(rb"\$([ -#%-)+-~]*)\*([0-9A-F]{2})\r\n")
 _RANGES = check_ranges
 _HEX_UPPER = {b"%02X" % i: i for i in range(256)}
 
@@ -101,22 +107,29 @@ _HEX_UPPER = {b"%02X" % i: i for i in range(256)}
 def _fast(raw: bytes, profile: Profile) -> Optional[S.Sentence]:
     """The sentence of a clean, valid line, or None to send the line through the full reading.
 
-    This is only a shortcut: it accepts nothing the full reading would refuse.
+    This is only a shortcut: it accepts nothing the full reading would refuse. A clean line is
+    ``$`` body ``*`` two upper-case hex digits CR LF; the body's bytes are not scanned here,
+    because the sentence regexes match only printable ASCII without ``$`` and ``*`` (proved for
+    every compiled regex by ``tests/test_grammar_fastpath.py``), so a body one of them matches
+    is clean, and any other goes to the full reading.
     """
-    m = _CLEAN.fullmatch(raw)
-    if m is None or len(raw) > profile.max_line_bytes:
+    n = len(raw)
+    if n < 6 or n > profile.max_line_bytes or raw[0] != 36 or raw[-5] != 42 or raw[-2] != 13 or raw[-1] != 10:
+        return None  # not "$" … "*" hh CR LF, or too long
+    want = _HEX_UPPER.get(raw[-4:-2])
+    body = raw[1:-5]
+    if want is None or checksum(body) != want:
         return None
-    body, cks = m.groups()
-    if checksum(body) != _HEX_UPPER[cks]:
-        return None
-    text = body.decode("ascii")
+    text = body.decode("latin-1")  # never fails; a byte beyond ASCII fails every regex below
     comma = text.find(",")
     head = text if comma < 0 else text[:comma]
     candidates = _FAST.get(head)
     if candidates is None:
-        if head[:1] != "C" or head[1:2] not in "-0123456789":
-            return None
-        candidates = _FAST["C"]
+        if head not in KNOWN_IDS:
+            if head[:1] != "C" or head[1:2] not in "-0123456789":
+                return None
+            head = "C"
+        candidates = _FAST[head]
     for fullmatch, build in candidates:
         mm = fullmatch(text)
         if mm is not None:
@@ -207,6 +220,8 @@ def _read_body(body: str, sid: str, engine: str):
                 return build(m)
         return _locate_error(body, sid)
     if engine == "lark":
+        from lark.exceptions import UnexpectedInput
+
         try:
             tree = lark_parser().parse(body, start="body")
         except UnexpectedInput:
@@ -217,6 +232,8 @@ def _read_body(body: str, sid: str, engine: str):
 
 def _from_tree(node: Tree) -> S.Sentence:
     """Build the sentence from a Lark tree, through the same builder as the fast path."""
+    from lark import Tree
+
     spec = specs()[str(node.data)]
     raw: dict[str, Optional[str]] = {}
     for child in node.children:
@@ -239,6 +256,8 @@ _ITEM_SEPARATOR = {"compass_extra_item": ""}
 
 def _text(t: Tree, with_separators: bool) -> str:
     """Text of a field subtree. Items and opts get their separator back (Lark drops literals)."""
+    from lark import Token
+
     parts = [str(c) for c in t.children if isinstance(c, Token)]
     if not with_separators:
         return "".join(parts)
@@ -251,6 +270,8 @@ def _text(t: Tree, with_separators: bool) -> str:
 
 def _locate_error(body: str, sid: str) -> SentenceError:
     """Why and where the body does not follow the grammar (RH-ACK-3 / RH-OUT-1/2)."""
+    from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedToken
+
     column = None
     what = "does not follow the grammar"
     try:
@@ -357,5 +378,7 @@ def prepare() -> None:
     timestamp what it reads, and building the parser takes 0.1 s on an idle host, several
     times that on a loaded one. Idempotent and cheap after the first call."""
     specs()
+    for sid in KNOWN_IDS:
+        _FAST[sid]  # noqa: B018 - builds the ID's fast-path builders
     lark_parser()
 

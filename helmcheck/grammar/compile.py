@@ -10,20 +10,22 @@ Two things come out of the one grammar file:
    and mutated input.
 
 Naming conventions the translation relies on are written at the top of the grammar file.
+The translation itself is :mod:`.derive`, which reads the grammar with Lark; its result is
+checked in as :mod:`.derived`, and :func:`specs` compiles that while the grammar's digest
+matches, so the fast path neither imports Lark nor derives anything at start-up. Lark is
+imported when it is asked for: the reference engine, locating a syntax error, the derivation.
 """
 
 from __future__ import annotations
 
+import os
 import re
 import typing
+import zlib
 from dataclasses import dataclass, fields
 from decimal import Decimal
 from functools import lru_cache
-from importlib import resources
 from typing import Any, Callable, Optional
-
-from lark import Lark, Token, Tree
-from lark.grammar import NonTerminal, Terminal
 
 from . import sentences as S
 
@@ -31,21 +33,38 @@ __all__ = ["grammar_text", "lark_parser", "specs", "SentenceSpec", "FieldSpec", 
            "sentence_classes_by_rule"]
 
 GRAMMAR_FILE = "remote_helm.lark"
-_NONCAPTURING = re.compile(r"(?<!\\)\((?!\?)")
 
 
 @lru_cache(maxsize=1)
 def grammar_text() -> str:
-    return resources.files("helmcheck.grammar").joinpath(GRAMMAR_FILE).read_text(encoding="utf-8")
+    """The grammar file's text: beside this module, or through importlib.resources where the
+    package is not a directory (a zip); the direct read spares every start-up that import."""
+    try:
+        with open(os.path.join(os.path.dirname(__file__), GRAMMAR_FILE), encoding="utf-8") as f:
+            return f.read()
+    except OSError:
+        from importlib import resources
+
+        return resources.files("helmcheck.grammar").joinpath(GRAMMAR_FILE).read_text(encoding="utf-8")
+
+
+def grammar_digest(text: str) -> str:
+    """CRC-32 of the grammar's text: the tables in :mod:`.derived` are for that grammar only.
+    (It tells an edited grammar from the one the tables were made from; the suite checks the
+    tables against the derivation itself. CRC-32, not a cryptographic hash: loading OpenSSL
+    for it would cost more start-up than the tables save.)"""
+    return f"{zlib.crc32(text.encode('utf-8')):08x}"
 
 
 @lru_cache(maxsize=1)
-def lark_parser() -> Lark:
+def lark_parser():
     """The reference parser (LALR, contextual lexer) with ``line`` and ``body`` start rules.
 
     Built on first use only (the Lark engine, locating an error, the property tests): the fast
     path needs just the rule definitions (:func:`grammar_defs`).
     """
+    from lark import Lark
+
     return Lark(grammar_text(), parser="lalr", start=["line", "body"], maybe_placeholders=True)
 
 
@@ -56,6 +75,12 @@ def grammar_defs():
 
     grammar, _used = load_grammar(grammar_text(), GRAMMAR_FILE, None, False)
     return grammar
+
+
+@lru_cache(maxsize=None)
+def type_hints(cls: type) -> dict[str, Any]:
+    """``typing.get_type_hints(cls)``, evaluated once per class (the annotations are strings)."""
+    return typing.get_type_hints(cls)
 
 
 def sentence_classes_by_rule() -> dict[str, type[S.Sentence]]:
@@ -94,206 +119,39 @@ def _park(text: str) -> int:
     return int(text[1:])
 
 
-def _converter(annotation: Any, terminal: str | None) -> Callable[[str], Any]:
-    if terminal == "PARK":
-        return _park
-    origin = typing.get_origin(annotation)
-    if origin is typing.Union:
-        annotation = next(a for a in typing.get_args(annotation) if a is not type(None))
-    if annotation is Decimal:
-        return _decimal
-    if annotation is int:
-        return int
-    return str
+#: The converters a field row names (:mod:`.derived`): the text of one terminal -> its value.
+CONVERTERS: dict[str, Callable[[str], Any]] = {"decimal": _decimal, "park": _park, "int": int, "str": str,
+                                                "bool": bool}
 
 
-def _attr_for(cls: type, rule: str) -> tuple[str, str]:
-    """Map a field rule name to (attribute, kind) following the grammar's naming conventions."""
-    names = {f.name for f in fields(cls)}
-    kind = "scalar"
-    base = rule
-    if rule.endswith("_item"):
-        kind, base = "items", rule[: -len("_item")]
-    elif rule.endswith("_opt"):
-        kind, base = "opt", rule[: -len("_opt")]
-    prefix = cls.RULE.split("_")[0] + "_"
-    candidates = [base]
-    if base.startswith(prefix):
-        candidates.insert(0, base[len(prefix):])
-    for family in ("omstart_", "omw_"):  # rule-family prefixes shared by two sentence forms
-        if base.startswith(family):
-            candidates.append(base[len(family):])
-    for c in candidates:
-        if c in names:
-            return c, kind
-    raise LookupError(f"grammar rule {rule!r} names no field of {cls.__name__}")
+def _rows() -> dict:
+    """The derived tables: :mod:`.derived` while it was made from this grammar, else derived now."""
+    from . import derived
 
+    if getattr(derived, "GRAMMAR_DIGEST", None) == grammar_digest(grammar_text()):
+        return derived.RULES
+    from .derive import derive_rows  # the grammar changed since `helmcheck docs`: Lark reads it
 
-# --------------------------------------------------------------------------- regex derivation
-
-class _Deriver:
-    """Translates Lark's EBNF rule trees into Python regular expressions."""
-
-    def __init__(self, grammar):
-        self.rules = {str(name): tree for name, _params, tree, _opts in grammar.rule_defs}
-        self.terms = {str(name): tree for name, (tree, _prio) in grammar.term_defs}
-        self.field_rules: list[str] = []
-
-    # Terminals ---------------------------------------------------------------------------
-    def literal(self, tok: Token) -> str:
-        text = str(tok)
-        if tok.type == "STRING":
-            flags = text[text.rindex('"') + 1:]
-            body = text[1: text.rindex('"')].encode().decode("unicode_escape")
-            out = re.escape(body)
-            return f"(?i:{out})" if "i" in flags else out
-        # REGEXP /.../flags; its own groups become non-capturing so group numbers stay ours
-        end = text.rindex("/")
-        body, flags = _NONCAPTURING.sub("(?:", text[1:end]), text[end + 1:]
-        return f"(?{flags}:{body})" if flags else f"(?:{body})"
-
-    def terminal_regex(self, name: str) -> str:
-        return self.tree(self.terms[name], inline_fields=False)
-
-    def terminal_of(self, rule: str) -> Optional[str]:
-        """The single named terminal a field rule holds, if any."""
-        for t in self.rules[rule].iter_subtrees():
-            for c in t.children:
-                if isinstance(c, Terminal):
-                    return c.name
-        return None
-
-    # Rules -------------------------------------------------------------------------------
-    def tree(self, t: Any, inline_fields: bool) -> str:
-        if isinstance(t, Token):
-            return self.literal(t)
-        if isinstance(t, Terminal):
-            return self.terminal_regex(t.name)
-        if isinstance(t, NonTerminal):
-            return self.nonterminal(t.name, inline_fields)
-        data = t.data
-        kids = t.children
-        if data == "expansions":
-            alts = [self.tree(k, inline_fields) for k in kids]
-            return alts[0] if len(alts) == 1 else "(?:" + "|".join(alts) + ")"
-        if data == "expansion":
-            return "".join(self.tree(k, inline_fields) for k in kids)
-        if data in ("value", "literal"):
-            return self.tree(kids[0], inline_fields)
-        if data == "maybe":
-            return "(?:" + self.tree(kids[0], inline_fields) + ")?"
-        if data == "expr":
-            inner_t = kids[0]
-            op = str(kids[1])
-            item_rule = self._item_rule(inner_t)
-            inner = self.tree(inner_t, inline_fields=False if item_rule else inline_fields)
-            if op == "~":
-                lo, hi = int(kids[2]), int(kids[3]) if len(kids) > 3 else int(kids[2])
-                q = f"{{{lo},{hi}}}"
-            else:
-                q = op
-            rx = f"(?:{inner}){q}"
-            if item_rule and inline_fields:
-                self.field_rules.append(item_rule)
-                return f"(?P<{item_rule}>{rx})"
-            return rx
-        raise ValueError(f"unsupported grammar construct {data!r}")
-
-    @staticmethod
-    def _item_rule(t: Any) -> Optional[str]:
-        if isinstance(t, Tree) and t.data == "value" and isinstance(t.children[0], NonTerminal):
-            name = t.children[0].name
-            if name.endswith("_item"):
-                return name
-        return None
-
-    def nonterminal(self, name: str, inline_fields: bool) -> str:
-        if name.startswith("_"):  # an inlined helper rule: its fields belong to the sentence
-            return self.tree(self.rules[name], inline_fields)
-        body = self.tree(self.rules[name], inline_fields=False)
-        if not inline_fields:
-            return body
-        self.field_rules.append(name)
-        return f"(?P<{name}>{body})"
-
-    def sentence(self, rule: str) -> tuple[str, list[str]]:
-        self.field_rules = []
-        rx = self.tree(self.rules[rule], inline_fields=True)
-        return rx, list(self.field_rules)
-
-    def item_pattern(self, rule: str) -> tuple[re.Pattern, int]:
-        """A regex for one item with one capturing group per terminal, for ``finditer``."""
-        groups = 0
-
-        def walk(t: Any) -> str:
-            nonlocal groups
-            if isinstance(t, Terminal):
-                groups += 1
-                return "(" + self.terminal_regex(t.name) + ")"
-            if isinstance(t, Token):
-                if t.type == "REGEXP":
-                    groups += 1
-                    return "(" + self.literal(t) + ")"
-                return self.literal(t)
-            if isinstance(t, NonTerminal):
-                return walk(self.rules[t.name])
-            d, k = t.data, t.children
-            if d == "expansions":
-                return "(?:" + "|".join(walk(x) for x in k) + ")"
-            if d == "expansion":
-                return "".join(walk(x) for x in k)
-            if d in ("value", "literal"):
-                return walk(k[0])
-            if d == "maybe":
-                return "(?:" + walk(k[0]) + ")?"
-            raise ValueError(f"unsupported construct {d!r} in item rule {rule!r}")
-
-        rx = walk(self.rules[rule])
-        return re.compile(rx), groups
+    return derive_rows()
 
 
 @lru_cache(maxsize=1)
 def specs() -> dict[str, SentenceSpec]:
     """Every sentence rule of the grammar, compiled. Keyed by rule name."""
-    d = _Deriver(grammar_defs())
     by_rule = sentence_classes_by_rule()
     out: dict[str, SentenceSpec] = {}
-    for rule, cls in by_rule.items():
-        rx, field_rules = d.sentence(rule)
-        hints = typing.get_type_hints(cls)
-        layout = []
-        for fr in field_rules:
-            try:
-                attr, kind = _attr_for(cls, fr)
-                ann = hints[attr]
-            except LookupError:  # a field of an embedded sentence ($OMW,CLEAR,<waypoint>)
-                sub = next(iter(_sub_sentence_attrs(cls).values()), None)
-                if sub is None:
-                    raise
-                attr, kind = _attr_for(sub, fr)
-                ann = typing.get_type_hints(sub)[attr]
-            if kind == "items":
-                pattern, ngroups = d.item_pattern(fr)
-                elem = typing.get_args(ann)[0]
-                if typing.get_origin(elem) is tuple:
-                    convs = tuple(_converter(a, None) for a in typing.get_args(elem))
-                else:
-                    convs = (_converter(elem, None),)
-                if len(convs) != ngroups:
-                    raise ValueError(f"{fr}: {ngroups} terminals but {cls.__name__}.{attr} holds {len(convs)}")
-                layout.append(FieldSpec(fr, attr, kind, str, pattern, convs))
-            elif ann is bool:
-                layout.append(FieldSpec(fr, attr, "flag", bool))
-            else:
-                layout.append(FieldSpec(fr, attr, kind, _converter(ann, d.terminal_of(fr))))
-        out[rule] = SentenceSpec(rule, cls, re.compile(rx), tuple(layout))
+    for rule, (rx, rows) in _rows().items():
+        layout = tuple(FieldSpec(fr, attr, kind, CONVERTERS[conv], re.compile(item) if item else None,
+                                 tuple(CONVERTERS[c] for c in item_convs))
+                       for fr, attr, kind, conv, item, item_convs in rows)
+        out[rule] = SentenceSpec(rule, by_rule[rule], re.compile(rx), layout)
     return out
 
 
 # --------------------------------------------------------------------------- building objects
 
 def _sub_sentence_attrs(cls: type) -> dict[str, type]:
-    hints = typing.get_type_hints(cls)
+    hints = type_hints(cls)
     subs = {}
     for name, ann in hints.items():
         if typing.get_origin(ann) is typing.Union:
@@ -356,7 +214,7 @@ def _init_tables() -> None:
         subs = _sub_sentence_attrs(spec.cls)
         if subs:
             _SUBS[spec.cls] = subs
-        hints = typing.get_type_hints(spec.cls)
+        hints = type_hints(spec.cls)
         _REQUIRED[spec.cls] = tuple(
             (f.name, hints[f.name] is str)
             for f in fields(spec.cls)
@@ -385,13 +243,14 @@ def _items(f: FieldSpec, text: Optional[str]) -> tuple:
 
 
 def _builder_args(spec: SentenceSpec, index: dict, env: dict, tag: str) -> list[str]:
-    """Source of the field values of ``spec.cls``, in field order, from ``t`` (the groups of a
-    match whose group numbers are ``index``); embedded sentences are built from the same groups."""
+    """Source of the field values of ``spec.cls``, in field order, from ``g0``, ``g1``, … (the
+    groups of a match whose group numbers are ``index``); embedded sentences are built from the
+    same groups."""
     cls = spec.cls
     by_attr = {f.attr: f for f in spec.fields}
     required = dict(_REQUIRED.get(cls, ()))
     subs = _SUBS.get(cls, {})
-    hints = typing.get_type_hints(cls)
+    hints = type_hints(cls)
     args = []
     for i, fld in enumerate(fields(cls)):
         name, k = fld.name, f"{tag}_{i}"
@@ -400,7 +259,7 @@ def _builder_args(spec: SentenceSpec, index: dict, env: dict, tag: str) -> list[
             first = index[sub_spec.fields[0].rule] - 1
             env[f"cls{k}"] = sub_spec.cls
             sub_args = ", ".join(_builder_args(sub_spec, index, env, k))
-            args.append(f"(cls{k}({sub_args}) if t[{first}] is not None else None)")
+            args.append(f"(cls{k}({sub_args}) if g{first} is not None else None)")
             continue
         f = by_attr.get(name)
         if f is None:
@@ -408,7 +267,7 @@ def _builder_args(spec: SentenceSpec, index: dict, env: dict, tag: str) -> list[
             continue
         env[f"c{k}"] = f.convert
         conv = f"c{k}" if f.convert is not str else ""
-        g = f"t[{index[f.rule] - 1}]"
+        g = f"g{index[f.rule] - 1}"
         if f.kind == "flag":
             args.append(f"({g} is not None)")
         elif f.kind == "items":
@@ -439,7 +298,10 @@ def fast_builder(rule: str) -> Callable[[re.Match], S.Sentence]:
     args = _builder_args(spec, spec.regex.groupindex, env, "")
     # The object is filled through its slot descriptors, as the frozen dataclass __init__ would
     # do field by field, at half the cost (the classes have no __post_init__ to skip).
-    lines = ["def build(m):", "    t = m.groups()", "    o = _new(cls)"]
+    # The groups are unpacked into locals once: reading a local is cheaper than indexing a tuple.
+    n = spec.regex.groups
+    lines = ["def build(m):", *([f"    {''.join(f'g{i}, ' for i in range(n))}= m.groups()"] if n else []),
+             "    o = _new(cls)"]
     for i, (f, expr) in enumerate(zip(fields(cls), args)):
         env[f"set{i}"] = getattr(cls, f.name).__set__
         lines.append(f"    set{i}(o, {expr})")
