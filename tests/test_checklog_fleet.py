@@ -244,14 +244,28 @@ def test_cluster_nobody_listens_is_64(archive: Path, tmp_path: Path):
     assert done.returncode == 64 and "cannot connect to the scheduler" in one_line(done.stderr)
 
 
-def test_ctrl_c_keeps_finished_files_and_writes_a_partial_summary(tmp_path: Path):
+def _running(word: str) -> list[str]:
+    """Processes whose command line names ``word`` (a forked worker keeps its parent's)."""
+    found = []
+    for d in Path("/proc").iterdir():
+        try:
+            cmd = (d / "cmdline").read_bytes().replace(b"\0", b" ").decode(errors="replace")
+        except OSError:
+            continue
+        if d.name.isdigit() and word in cmd:
+            found.append(f"{d.name} {cmd}")
+    return found
+
+
+@pytest.mark.parametrize("jobs", ["1", "2"])
+def test_ctrl_c_keeps_finished_files_and_writes_a_partial_summary(tmp_path: Path, jobs: str):
     a = tmp_path / "archive"
     a.mkdir()
     for i in range(8):  # the longest fixture capture, eight times: long enough to interrupt
         shutil.copy(LOGS / "socat" / "backseat_vx.log", a / f"s{i}.log")
     out = tmp_path / "out"
     proc = subprocess.Popen([sys.executable, "-m", "helmcheck", "check-log", str(a), "--report-dir", str(out),
-                             "--jobs", "1", "--progress"], cwd=tmp_path, stdout=subprocess.PIPE,
+                             "--jobs", jobs, "--progress"], cwd=tmp_path, stdout=subprocess.PIPE,
                             stderr=subprocess.PIPE, text=True)
     first = proc.stderr.readline()  # one progress line per finished file (stderr is no terminal)
     assert first.startswith("files 1/8"), first
@@ -268,6 +282,7 @@ def test_ctrl_c_keeps_finished_files_and_writes_a_partial_summary(tmp_path: Path
         assert not (out / f["path"] / "check-key.json").exists()
     assert proc.returncode == doc["exit_code"] == 2, stdout + stderr
     assert "partial" in stdout.splitlines()[-1]
+    assert _running(str(a)) == []  # no worker left behind
     # the next run judges only what was left
     helmcheck("check-log", a, "--report-dir", out, "--jobs", "2", cwd=tmp_path)
     doc = summary(out)

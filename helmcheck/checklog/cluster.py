@@ -14,7 +14,10 @@ the one the local pool runs, with the same arguments, so the results are the sam
   another version answers ``error`` for each file instead of judging it).
 * Each task is submitted with ``pure=False`` (judging has the side effect of writing the results
   directory) and ``retries=0``; a task whose worker dies is reported ``error``.
-* An interruption cancels the tasks not yet finished and closes the connection.
+* An interruption cancels the tasks not yet finished and closes the connection. A task already
+  running on a worker finishes there (Dask does not stop a running task): it writes a complete
+  results directory, key last, which the summary of this run lists as not judged and the next
+  run finds cached.
 """
 
 from __future__ import annotations

@@ -84,6 +84,7 @@ def _run_pool(tasks: list[FileTask], opts: Options, jobs: int, done: OnDone) -> 
     pending = list(tasks)
     tries: dict[str, int] = {}
     while pending:
+        others = {p.pid for p in multiprocessing.active_children()}
         pool = ProcessPoolExecutor(max_workers=min(jobs, len(pending)), initializer=_quiet_worker,
                                    mp_context=multiprocessing.get_context("fork"))
         try:
@@ -106,14 +107,16 @@ def _run_pool(tasks: list[FileTask], opts: Options, jobs: int, done: OnDone) -> 
                     done(entry)
             pool.shutdown(wait=True)
         except BaseException:
-            _kill(pool)
+            _kill(pool, others)
             raise
 
 
-def _kill(pool: ProcessPoolExecutor) -> None:
-    """End the pool's workers now (a worker in the middle of a file is not waited for)."""
+def _kill(pool: ProcessPoolExecutor, others: set) -> None:
+    """End the pool's workers now (a worker in the middle of a file is not waited for); ``others``
+    are the child processes that were there before the pool, left alone."""
+    workers = [p for p in multiprocessing.active_children() if p.pid not in others]
     pool.shutdown(wait=False, cancel_futures=True)
-    for proc in multiprocessing.active_children():
+    for proc in workers:
         proc.kill()
-    for proc in multiprocessing.active_children():
+    for proc in workers:
         proc.join(timeout=5)
