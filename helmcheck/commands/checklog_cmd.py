@@ -38,7 +38,8 @@ whole archives (a DIR or a quoted GLOB; logs found by content, recursively):
   helmcheck check-log 'archive/2026-*/**/*.log' --jobs 4 --profile iver3.toml
   helmcheck check-log archive/ --report-dir out/            # again: only new or changed logs are judged
   helmcheck check-log archive/ --report-dir out/ --force    # judge every log again
-  dask scheduler --port 8786 &  dask worker tcp://HOST:8786 --nthreads 1 &   # on each machine
+  dask scheduler --port 8786                    # a cluster: the scheduler on one machine,
+  dask worker tcp://HOST:8786 --nthreads 1      # a worker on each machine (same helmcheck, shared paths)
   helmcheck check-log /shared/archive --report-dir /shared/out --cluster tcp://HOST:8786
 
 Each log gets its own results directory, mirroring the archive's tree, with check-key.json: a
