@@ -64,7 +64,8 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p.add_argument("--profile", metavar="FILE", help="TOML profile (default: rh5)")
     p.add_argument("--report-dir", metavar="DIR",
                    help="results directory (default reports/check-log-<stem>; with several files, "
-                        "DIR/<stem> each)")
+                        "DIR/<stem> each; for an archive, DIR/<path of each log below the archive> and "
+                        "DIR/summary.md, default reports/check-log-<archive directory's name>)")
     p.add_argument("--role", choices=("vehicle", "backseat", "both"), default="both",
                    help="whose behaviour to judge (default both)")
     p.add_argument("--missions", metavar="DIR",
