@@ -6,7 +6,9 @@ without ``--strict``), 1 a clause failed, 2 inconclusive (nothing failed, someth
 judged; or a report that could not be written), 64 usage (bad option, unreadable or
 unrecognised log file, bad profile, a report directory that holds an earlier check without
 ``--overwrite``) with a one-line error naming the file. With several files each is checked on
-its own; the exit status is the worst of them.
+its own; the exit status is the worst of them. A directory or a pattern among the arguments (or
+``--jobs``, ``--cluster``, ``--force``) is a whole archive: :mod:`.checklog_fleet_cmd` does it,
+with the exit status over all files that ``docs/contracts.md`` gives.
 """
 
 from __future__ import annotations
