@@ -17,6 +17,17 @@ Modules, one concern each:
   the same ones the certifiers use), bounded bookkeeping;
 * :mod:`.sidejob` — a second process for the backseat role of a long log;
 * :mod:`.report` — ``results.json``, the log copy, the rendered reports.
+
+Whole archives (``check-log DIR|GLOB…``):
+
+* :mod:`.archive` — finding the logs of directories and patterns (by content), what is skipped
+  and why, where each log's results go (mirroring the tree);
+* :mod:`.fleettask` — one log judged into its results directory, or found judged already (the
+  cache key ``check-key.json``): the task every engine runs;
+* :mod:`.fleet` — running the tasks in this process or in ``--jobs`` processes, and interruption;
+* :mod:`.cluster` — the same tasks on a Dask distributed scheduler (``--cluster``, the optional
+  extra ``cluster``);
+* :mod:`.summary` — ``summary.json``, ``summary.md``, the matrix view, the exit status over all.
 """
 
 from .checker import CheckOutcome, LogFormatError, check_log

@@ -2,7 +2,8 @@
 
 * :mod:`.certify_cmd` — ``certify vehicle|backseat``; :mod:`.certify_vehicle_cmd`,
   :mod:`.certify_backseat_cmd` — the two roles;
-* :mod:`.emulate_cmd` — ``emulate``; :mod:`.checklog_cmd` — ``check-log``; :mod:`.monitor_cmd` —
+* :mod:`.emulate_cmd` — ``emulate``; :mod:`.checklog_cmd` — ``check-log`` (a whole archive:
+  :mod:`.checklog_fleet_cmd`); :mod:`.monitor_cmd` —
   ``monitor``; :mod:`.verify_cmd` —
   ``verify``; :mod:`.report_cmd` — ``report``; :mod:`.matrix_cmd` — ``matrix``;
 * :mod:`.replay_cmd` — ``replay``; :mod:`.parse_cmd` — ``parse``; :mod:`.keygen_cmd` — ``keygen``;

@@ -6,7 +6,9 @@ without ``--strict``), 1 a clause failed, 2 inconclusive (nothing failed, someth
 judged; or a report that could not be written), 64 usage (bad option, unreadable or
 unrecognised log file, bad profile, a report directory that holds an earlier check without
 ``--overwrite``) with a one-line error naming the file. With several files each is checked on
-its own; the exit status is the worst of them.
+its own; the exit status is the worst of them. A directory or a pattern among the arguments (or
+``--jobs``, ``--cluster``, ``--force``) is a whole archive: :mod:`.checklog_fleet_cmd` does it,
+with the exit status over all files that ``docs/contracts.md`` gives.
 """
 
 from __future__ import annotations
@@ -32,6 +34,23 @@ examples:
 
 The report directory (default reports/check-log-<stem>) gets results.json (role "log"), a copy
 of the log, report.html, junit.xml and report.md. Each violation names its log line numbers.
+
+whole archives (a DIR or a quoted GLOB; logs found by content, recursively):
+  helmcheck check-log archive/ --report-dir out/            # out/<path of each log>/, out/summary.md
+  helmcheck check-log 'archive/2026-*/**/*.log' --jobs 4 --profile iver3.toml
+  helmcheck check-log archive/ --report-dir out/            # again: only new or changed logs are judged
+  helmcheck check-log archive/ --report-dir out/ --force    # judge every log again
+  dask scheduler --port 8786                    # a cluster: the scheduler on one machine,
+  dask worker tcp://HOST:8786 --nthreads 1      # a worker on each machine (same helmcheck, shared paths)
+  helmcheck check-log /shared/archive --report-dir /shared/out --cluster tcp://HOST:8786
+
+Each log gets its own results directory, mirroring the archive's tree, with check-key.json: a
+log whose key (helmcheck version, profile hash, log hash, role, time scale, missions, strict)
+is unchanged is not judged again. out/summary.json is the source of truth; out/summary.md has
+the per-file verdicts, clause x file counts and the matrix (also out/matrix.html). Exit status:
+the worst over the files (1 over 2 over 0); a file that cannot be read counts as 2, so the run
+cannot exit 0; Ctrl-C keeps the finished files and writes the summary marked partial (exit 2,
+or 1 if a file failed). --cluster needs: pip install 'helmcheck[cluster]'.
 """
 
 
@@ -41,11 +60,14 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
                                    "report per clause. Exit 0 conformant, 1 non-conformant, "
                                    "2 inconclusive, 64 usage.",
                        epilog=EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("files", nargs="+", metavar="FILE", help="log file(s) to check")
+    p.add_argument("files", nargs="+", metavar="FILE|DIR|GLOB",
+                   help="log file(s) to check; a directory or a quoted pattern ('archive/**/*.log') checks a "
+                        "whole archive (below)")
     p.add_argument("--profile", metavar="FILE", help="TOML profile (default: rh5)")
     p.add_argument("--report-dir", metavar="DIR",
                    help="results directory (default reports/check-log-<stem>; with several files, "
-                        "DIR/<stem> each)")
+                        "DIR/<stem> each; for an archive, DIR/<path of each log below the archive> and "
+                        "DIR/summary.md, default reports/check-log-<archive directory's name>)")
     p.add_argument("--role", choices=("vehicle", "backseat", "both"), default="both",
                    help="whose behaviour to judge (default both)")
     p.add_argument("--missions", metavar="DIR",
@@ -61,7 +83,16 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
                    help="replace an earlier check in the report directory (its results, log copy and "
                         "reports are removed first); without it such a directory is refused")
     p.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None,
-                   help="progress bar on stderr (default: for files over 4 MiB on a terminal)")
+                   help="progress on stderr (default: for files over 4 MiB on a terminal; for an archive, "
+                        "files done, lines/s and ETA whenever stderr is a terminal)")
+    a = p.add_argument_group("archives (a DIR or GLOB argument, or any of these options)")
+    a.add_argument("--jobs", type=int, metavar="N",
+                   help="judge N files at a time, each in its own process (default: the cores)")
+    a.add_argument("--cluster", metavar="tcp://HOST:PORT",
+                   help="judge the files on a Dask distributed scheduler instead "
+                        "(pip install 'helmcheck[cluster]'; a shared file system)")
+    a.add_argument("--force", action="store_true",
+                   help="judge every file again, also those whose results are current (cached)")
     p.set_defaults(func=run)
     return p
 
@@ -72,7 +103,19 @@ def _report_dir(f: Path, args: argparse.Namespace, several: bool) -> Path:
     return Path(args.report_dir) / f.stem if several else Path(args.report_dir)
 
 
+def _archive_mode(args: argparse.Namespace) -> bool:
+    """An archive check: a directory or a pattern among the arguments, or an archive option."""
+    from ..checklog.archive import is_pattern
+    return (args.jobs is not None or args.cluster is not None or args.force
+            or any(Path(f).is_dir() or is_pattern(f) for f in args.files))
+
+
 def run(args: argparse.Namespace) -> int:  # noqa: C901 - argument checks, then one loop
+    if args.time_scale is not None and not (math.isfinite(args.time_scale) and args.time_scale > 0):
+        raise UsageError(f"--time-scale must be positive (got {args.time_scale})")
+    if _archive_mode(args):
+        from .checklog_fleet_cmd import run_fleet
+        return run_fleet(args)
     from ..failures import OutputLost, PathError
     from ..outputs import prepare_report_dir
     from ..profile import load_profile
@@ -85,8 +128,6 @@ def run(args: argparse.Namespace) -> int:  # noqa: C901 - argument checks, then 
     if args.profile is None:
         # Without a declared profile, $OXFLT is taken as honoured, as helmcheck emulate does.
         profile = profile.replace(fault_injection="oxflt")
-    if args.time_scale is not None and not (math.isfinite(args.time_scale) and args.time_scale > 0):
-        raise UsageError(f"--time-scale must be positive (got {args.time_scale})")
     catalog = None
     if args.missions is not None:
         from ..emulator.missionfile import DirectoryCatalog
