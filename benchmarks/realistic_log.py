@@ -21,10 +21,13 @@ RH-BS-1 finding too), an ``$ACK`` is lost (RH-ACK-1, RH-ACK-2), and an out-of-ra
 (timeout 150 s: RH-BS-2) is acknowledged as accepted (RH-SRV-2, the range the vehicle should
 have refused it by).
 
-Two things the backseat never does, because ``check-log`` reads them wrongly today (a judge
-matter, not the log's): an ``$OPK`` over a mission park (the resumed park's countdown is
-expected to wait for the vehicle to be back on station, the reference model counts at once) and
-an ``$OMW`` waypoint with park time (the unseen on-station instant is bracketed too early). The
+Three things the backseat never does, because ``check-log`` reads them wrongly today (a judge
+matter, not the log's: a conforming vehicle's answers get a FAIL): an ``$OPK`` over a mission
+park (the resumed park's countdown is expected to wait for the vehicle to be back on station,
+the reference model counts at once), an ``$OMW`` waypoint with park time (the unseen on-station
+instant is bracketed too early), and an ``$OPOS`` that moves a submerged vehicle by metres
+(RH-POS-2 applies it; when that puts the vehicle on its next waypoint, the judge does not see
+how it got there): its ``$OPOS`` position is the vehicle's own last reported one. The
 emulator's own notes (plant and model events) are left out: a recording of a real vehicle's line
 has none.
 
@@ -214,7 +217,7 @@ class Backseat:
             return [f"OMSTART,0,0,0,0,{name}"]
         if now >= self.next_opos:
             self.next_opos = now + rng.uniform(20, 40)
-            out.append(f"OPOS,{self.lat + rng.gauss(0, 2e-5):.6f},{self.lon + rng.gauss(0, 2e-5):.6f},"
+            out.append(f"OPOS,{self.lat:.6f},{self.lon:.6f},"  # its navigation follows the vehicle's
                        f"{rng.uniform(1.5, 2.5):.1f},{rng.uniform(30, 36):.2f},{rng.uniform(8, 16):.1f}")
         if self.logging and now >= self.next_logd:
             self.next_logd = now + rng.uniform(8, 12)
