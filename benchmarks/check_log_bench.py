@@ -2,7 +2,7 @@
 the judge's cost against the parse of the same file.
 
 Run standalone: ``python benchmarks/check_log_bench.py [--lines N] [--seed S] [--best-case]
-[--one-process] [--keep FILE] [--tracemalloc] [--no-parse]``.
+[--one-process] [--keep FILE] [--tracemalloc] [--no-parse] [--log FILE]``.
 
 The input, by default, is realistic: a session of the reference vehicle driven by a scripted
 backseat (``realistic_log.py``: missions started and stopped, servo episodes, parks, on-the-fly
@@ -112,10 +112,14 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--tracemalloc", action="store_true", help="also measure the Python heap peak")
     ap.add_argument("--one-process", action="store_true", help="judge both roles in this process")
     ap.add_argument("--no-parse", action="store_true", help="skip the helmcheck parse comparison")
+    ap.add_argument("--log", metavar="FILE", type=Path, help="check this log instead (e.g. a session "
+                    "realistic_log.py wrote, to compare two versions of the code on the same bytes)")
     args = ap.parse_args(argv)
     tmpdir = None
     t0 = time.perf_counter()
-    if args.best_case:
+    if args.log is not None:
+        path, made, kind = args.log, "given", "given log"
+    elif args.best_case:
         if args.keep:
             path = Path(args.keep)
         else:

@@ -60,10 +60,12 @@ def checks(work: Path) -> list[tuple[str, Path, list[str]]]:
         name = str(p.relative_to(ROOT))
         out.append((name, p, []))
         if (p.parent / "profile.toml").exists():
-            out.append((name + " --profile", p, ["--profile", str(p.parent / "profile.toml")]))
+            # relative to the checkout (check-log runs there): results name the profile file
+            out.append((name + " --profile", p, ["--profile", str((p.parent / "profile.toml").relative_to(ROOT))]))
     for lines, seed, faults in REALISTIC:
-        path, _ = cached_session(lines, seed, faults)
         name = f"realistic-{lines}-{seed}-{'faults' if faults else 'clean'}"
+        path = work / f"{name}.log"  # under one name whatever the cache calls it (reports name the log)
+        shutil.copyfile(cached_session(lines, seed, faults)[0], path)
         out.append((name, path, []))
         if not faults:
             out.append((name + " --missions", path, ["--missions", str(MISSIONS)]))
