@@ -13,6 +13,10 @@ event to its wire log *and* feeds it to the judge with the time and line number 
 with (:class:`helmcheck.line.recorder.Recorder`); an offline check reads the same records
 back with the same module's reader. So one log gives one verdict, whoever reads it.
 
+The lines in those bytes are read by :class:`Decodings` (:func:`helmcheck.grammar.decode` with a
+bounded cache), one per session: observers of the same session share it, so a line is decoded
+once whichever roles judge it.
+
 Notes a judge acts on (anything else is kept as evidence only); the words are part of the
 wire-log format (``docs/contracts.md``):
 
