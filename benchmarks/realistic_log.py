@@ -19,7 +19,8 @@ safety lockout (an operator tripping the leak sensor, as on a bench) with ``$OSD
 the vehicle acknowledges a line with a wrong checksum (RH-FRM-4; the backseat's bad line is an
 RH-BS-1 finding too), an ``$ACK`` is lost (RH-ACK-1, RH-ACK-2), and an out-of-range ``$OMS``
 (timeout 150 s: RH-BS-2) is acknowledged as accepted (RH-SRV-2, the range the vehicle should
-have refused it by).
+have refused it by). They go in between 15 % and 90 % of the lines, each while a mission runs:
+a session of fewer than some thousands of lines may have room for none.
 
 Three things the backseat never does, because ``check-log`` reads them wrongly today (a judge
 matter, not the log's: a conforming vehicle's answers get a FAIL): an ``$OPK`` over a mission
