@@ -44,6 +44,7 @@ from ..judge.backseat import BS_CLAUSES, BackseatObserver
 from ..judge.ledger import Evidence as LedgerEvidence, Ledger
 from ..judge.runfacts import RunFacts
 from ..judge.vehicle import VehicleObserver
+from ..judge.wire import Decodings
 from ..model.missions import MissionCatalog
 from ..profile import DEFAULT, Profile
 from ..reports.segments import session_files
@@ -264,10 +265,10 @@ class _Backseat(_Side):
 
     unreadable_clause = "RH-BS-1"
 
-    def __init__(self, profile: Profile, scale: float, resolution: float, baud: int):
+    def __init__(self, profile: Profile, scale: float, resolution: float, baud: int, lines: Decodings):
         self.ledger = Ledger(BS_CLAUSES)
         self.observer = BackseatObserver(profile, self.ledger, time_scale=scale, baud=baud,
-                                         resolution=resolution)
+                                         resolution=resolution, decodings=lines)
 
     def close(self, t: float, backseat_traffic: bool) -> None:
         if not backseat_traffic:
@@ -282,10 +283,10 @@ class _Vehicle(_Side):
 
     unreadable_clause = "RH-FRM-1"
 
-    def __init__(self, profile: Profile, catalog, scale: float, resolution: float, baud: int):
+    def __init__(self, profile: Profile, catalog, scale: float, resolution: float, baud: int, lines: Decodings):
         self.ledger = Ledger(VEHICLE_CLAUSES)
         self.observer = VehicleObserver(profile, self.ledger, time_scale=scale, baud=baud,
-                                        resolution=resolution, catalog=catalog)
+                                        resolution=resolution, catalog=catalog, decodings=lines)
 
     def entries(self, to_vehicle: bool, from_vehicle: bool, facts: RunFacts) -> list:
         if not from_vehicle and not self.observer.aborted:
@@ -312,8 +313,10 @@ class SessionJudge:
                  judge_backseat: bool = True):
         self.profile = profile
         self.role = role
-        self.vehicle = _Vehicle(profile, catalog, scale, resolution, baud) if role in ("vehicle", "both") else None
-        self.backseat = (_Backseat(profile, scale, resolution, baud)
+        lines = Decodings(profile)  # each line read once, whichever roles read it
+        self.vehicle = (_Vehicle(profile, catalog, scale, resolution, baud, lines)
+                        if role in ("vehicle", "both") else None)
+        self.backseat = (_Backseat(profile, scale, resolution, baud, lines)
                          if role in ("backseat", "both") and judge_backseat else None)
         #: the backseat role's entries when a side job judged it (:func:`check_log`)
         self.backseat_entries: Optional[list] = None

@@ -123,14 +123,18 @@ _ESC = {0x0D: "\\r", 0x0A: "\\n", 0x5C: "\\\\"}
 _UNESC = {"r": "\r", "n": "\n", "t": "\t", "\\": "\\"}
 
 
+def _escaped(m: re.Match) -> bytes:
+    b = m.group(0)[0]
+    return _ESC.get(b, f"\\x{b:02x}").encode()
+
+
 def escape(raw: bytes) -> str:
     """A payload as written: bytes 0x20–0x7E stand for themselves except ``\\``; the others are
-    ``\\r``, ``\\n``, ``\\\\`` or ``\\xNN``."""
-    def sub(m: re.Match) -> bytes:
-        b = m.group(0)[0]
-        return _ESC.get(b, f"\\x{b:02x}").encode()
-
-    return _ESC_RE.sub(sub, raw).decode("ascii") if raw else ""
+    ``\\r``, ``\\n``, ``\\\\`` or ``\\xNN``. (A payload with nothing to escape, nearly every
+    one, is only searched.)"""
+    if _ESC_RE.search(raw) is None:
+        return raw.decode("ascii")
+    return _ESC_RE.sub(_escaped, raw).decode("ascii")
 
 
 def unescape(text: str) -> bytes:

@@ -13,6 +13,10 @@ event to its wire log *and* feeds it to the judge with the time and line number 
 with (:class:`helmcheck.line.recorder.Recorder`); an offline check reads the same records
 back with the same module's reader. So one log gives one verdict, whoever reads it.
 
+The lines in those bytes are read by :class:`Decodings` (:func:`helmcheck.grammar.decode` with a
+bounded cache), one per session: observers of the same session share it, so a line is decoded
+once whichever roles judge it.
+
 Notes a judge acts on (anything else is kept as evidence only); the words are part of the
 wire-log format (``docs/contracts.md``):
 
@@ -50,6 +54,7 @@ import re
 from dataclasses import dataclass
 from typing import Any, Optional
 
+from ..grammar import Decoded, decode
 from ..grammar.wirelog import FROM_VEHICLE, NOTE, TO_VEHICLE, WireEvent
 from ..profile import SAFETY_CODES
 
@@ -58,8 +63,30 @@ from ..profile import SAFETY_CODES
 #: enough that a session of hours, whose reports all differ, keeps its memory flat.
 LINE_CACHE = 512
 
-__all__ = ["LINE_CACHE", "WireEvent", "TO_VEHICLE", "FROM_VEHICLE", "NOTE", "Note", "parse_note", "case_note",
+__all__ = ["LINE_CACHE", "Decodings", "WireEvent", "TO_VEHICLE", "FROM_VEHICLE", "NOTE", "Note", "parse_note", "case_note",
            "case_end_note", "tester_note", "parse_plant"]
+
+
+class Decodings:
+    """Each line read once: :func:`~helmcheck.grammar.decode` against one profile, the latest
+    :data:`LINE_CACHE` lines kept (by their bytes). A line's reading depends on its bytes and the
+    profile alone, so the observers of one session share one: a line both roles read (every
+    ``$OSI``, every ``$ACK``, every command) is decoded once, not once per role."""
+
+    __slots__ = ("profile", "_cache")
+
+    def __init__(self, profile):
+        self.profile = profile
+        self._cache: dict[bytes, Decoded] = {}
+
+    def __call__(self, raw: bytes) -> Decoded:
+        hit = self._cache.get(raw)
+        if hit is None:
+            cache = self._cache
+            if len(cache) >= LINE_CACHE:
+                cache.clear()
+            hit = cache[raw] = decode(raw, self.profile)
+        return hit
 
 
 @dataclass(frozen=True, slots=True)

@@ -31,14 +31,14 @@ from __future__ import annotations
 from collections import deque
 from typing import Optional
 
-from ...grammar import Decoded, Discard, Framer, Line, decode
+from ...grammar import Discard, Framer, Line
 from ...grammar import sentences as s
 from ...grammar.wirelog import TO_VEHICLE_RUN, escape, is_line
 from ...profile import Profile
 from ..facts import LOCKOUT_REFUSED, NEEDS_MISSION, NEEDS_RUNNING, NEEDS_STOPPED
 from ..ledger import Evidence, Ledger
 from ..timing import ack_allowance, ack_give_up_after
-from ..wire import FROM_VEHICLE, LINE_CACHE, NOTE, TO_VEHICLE, WireEvent, parse_note
+from ..wire import FROM_VEHICLE, NOTE, TO_VEHICLE, Decodings, WireEvent, parse_note
 from .budget import LineBudget
 from .common import BS_CLAUSES, SentLine, Settings
 from .knowledge import Arrivals, Lockout, Pending, StateReports
@@ -49,6 +49,11 @@ from .reaction import Reaction
 from .servo import ServoRefresh
 
 __all__ = ["BackseatObserver", "BS_CLAUSES"]
+
+#: The vehicle's lines the backseat role reads (what the backseat could know: its state reports
+#: and acknowledgements); the first five bytes of each. Any other line (``$GPRMC``, ``$C``, the
+#: other data) is neither, however it reads, so it is not decoded at all.
+_READ = frozenset({b"$OSI,", b"$ACK,"})
 
 _NOT_TESTED = {
     "RH-BS-1": "the backseat sent no line",
@@ -68,7 +73,7 @@ class BackseatObserver:
     """Judges a backseat against RH-BS-1..8 from wire events (module docstring)."""
 
     def __init__(self, profile: Profile, ledger: Ledger, *, time_scale: float, baud: int,
-                 resolution: float = 1e-6):
+                 resolution: float = 1e-6, decodings: Optional[Decodings] = None):
         self.profile = profile
         self.ledger = ledger
         self.settings = st = Settings(profile, float(time_scale), int(baud), float(resolution),
@@ -80,7 +85,8 @@ class BackseatObserver:
         self._offset = 0  #: backseat framer offset of the next byte
         self._consumed = 0  #: backseat framer offset of the first byte not yet framed
         self._voffset = 0
-        self._cache: dict[bytes, Decoded] = {}
+        #: lines read (shared with the session's other observer when it is given one)
+        self._decode = decodings if decodings is not None and decodings.profile is profile else Decodings(profile)
         self.arrivals = Arrivals(st.baud)
         self.reports = StateReports()
         self.pending = Pending()
@@ -146,14 +152,6 @@ class BackseatObserver:
             self.ledger.not_tested(cid, why)
 
     # ================================================================ the backseat
-    def _decode(self, raw: bytes) -> Decoded:
-        d = self._cache.get(raw)
-        if d is None:
-            if len(self._cache) >= LINE_CACHE:
-                self._cache.clear()
-            d = self._cache[raw] = decode(raw, self.profile)
-        return d
-
     def _first_byte(self, offset: int) -> tuple[float, int]:
         t, lineno = self._records[0][1], self._records[0][2]
         for start, rt, rl in self._records:
@@ -236,6 +234,8 @@ class BackseatObserver:
                 self._report(e.raw, ev.t, self.arrivals.arrival(e.offset + len(e.raw) - base))
 
     def _report(self, raw: bytes, t: float, arrived: float) -> None:
+        if raw[:5] not in _READ:  # nothing else tells the backseat what it could know
+            return
         r = self._decode(raw).sentence
         if isinstance(r, s.OSI):
             self._osi(r, t, arrived)

@@ -33,14 +33,14 @@ from __future__ import annotations
 from collections import deque
 from typing import Optional
 
-from ...grammar import Discard, Framer, Line, decode
+from ...grammar import Discard, Framer, Line
 from ...grammar import sentences as s
 from ...grammar.wirelog import escape
 from ...model import plant as P
 from ...profile import Profile
 from ..ledger import Evidence, Ledger, Reason
 from ..timing import JITTER_S
-from ..wire import FROM_VEHICLE, LINE_CACHE, NOTE, TO_VEHICLE, WireEvent, parse_note
+from ..wire import FROM_VEHICLE, LINE_CACHE, NOTE, TO_VEHICLE, Decodings, WireEvent, parse_note
 from . import osichecks
 from .belief import Beliefs
 from .answers import Answers
@@ -63,7 +63,8 @@ class VehicleObserver(Answers, Deadlines):
     """See the module docstring."""
 
     def __init__(self, profile: Profile, ledger: Ledger, *, time_scale: float = 1.0,
-                 baud: Optional[int] = None, resolution: float = 1e-6, catalog=None):
+                 baud: Optional[int] = None, resolution: float = 1e-6, catalog=None,
+                 decodings: Optional[Decodings] = None):
         self.profile = profile
         self.ledger = ledger
         self.k = float(time_scale)
@@ -96,7 +97,8 @@ class VehicleObserver(Answers, Deadlines):
         self.timeline: list[tuple[float, str]] = []
         self.events: list[dict] = []
         self.checks = osichecks.OsiChecks(self)
-        self._decoded: dict = {}
+        #: lines read (shared with the session's other observer when it is given one)
+        self.decode = decodings if decodings is not None and decodings.profile is profile else Decodings(profile)
         self._escaped: dict = {}  #: a line's evidence text (sessions repeat their lines)
         self._kinds: dict = {}  #: a backseat line's :class:`~.lines.Kind`, by its bytes
         #: per direction, a record's bytes → the one line it is, or () when it needs the framer
@@ -183,15 +185,6 @@ class VehicleObserver(Answers, Deadlines):
             if whole:
                 return whole
         return fr.feed(data)
-
-    def decode(self, raw: bytes):
-        """:func:`~helmcheck.grammar.decode` with a bounded cache (sessions repeat their lines)."""
-        hit = self._decoded.get(raw)
-        if hit is None:
-            if len(self._decoded) >= LINE_CACHE:
-                self._decoded.clear()
-            hit = self._decoded[raw] = decode(raw, self.profile)
-        return hit
 
     def _evidence(self, ev: WireEvent, raw: bytes, direction: str) -> Evidence:
         text = self._escaped.get(raw)  # only whole CR LF lines are kept
