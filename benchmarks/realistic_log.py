@@ -27,8 +27,9 @@ matter, not the log's: a conforming vehicle's answers get a FAIL): an ``$OPK`` o
 park (the resumed park's countdown is expected to wait for the vehicle to be back on station,
 the reference model counts at once), an ``$OMW`` waypoint with park time (the unseen on-station
 instant is bracketed too early), and an ``$OPOS`` that moves a submerged vehicle by metres
-(RH-POS-2 applies it; when that puts the vehicle on its next waypoint, the judge does not see
-how it got there): its ``$OPOS`` position is the vehicle's own last reported one. The
+(RH-POS-2 applies it; when that put the vehicle on its next waypoint, the judge did not see how
+it got there — fixed since, ``tests/test_checklog_opos_arrival.py``; the sessions keep their
+bytes): its ``$OPOS`` position is the vehicle's own last reported one. The
 emulator's own notes (plant and model events) are left out: a recording of a real vehicle's line
 has none.
 

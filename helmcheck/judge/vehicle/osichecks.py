@@ -30,7 +30,9 @@ A report carries more, and these checks use it:
 * **at the surface** (field 15, depth): the at-surface action must be taken at the surface
   (RH-SAF-4: checked on the report that shows it), and a vehicle at the surface in the ascent for
   longer than the same allowance without taking it fails RH-SAF-4;
-* **``$OPOS``** (RH-POS-2): after an accepted ``$OPOS`` the next report's position is where the
+* **``$OPOS``** (RH-POS-2): a candidate that applied an accepted ``$OPOS`` position keeps it as
+  its latest position (``fix_seen``) and forgets the distance it last reported (``nav_seen``): it
+  moved there at once. After an accepted ``$OPOS`` the next report's position is where the
   mirror says (moved to the given position without a GPS fix, not moved with one) — judged only
   when the two readings are far enough apart to tell; every later ``$OCTD`` shows the
   conductivity and temperature it gave;
@@ -179,6 +181,16 @@ class OsiChecks:
         if item.conductivity not in (None, "") and item.temperature not in (None, ""):
             self.ct = (Decimal(str(item.conductivity)), Decimal(str(item.temperature)))
         o = self.o
+        # A candidate that applied the position (no GPS fix) is there at once: the way it made
+        # until now no longer bounds where it is, so an unseen waypoint reached is bounded from
+        # the fix on (:func:`.closure.reachable`), not from the reports before it.
+        v, late = o.v(p.t) - 2 * o.slack_v(), o.v(p.t_ack) + o.slack_v()
+        for c in o.beliefs.cands:
+            done = c.model.opos_records
+            if done and done[-1].position_applied:
+                speed = c.fix_seen[-1] if c.fix_seen is not None else 0.0
+                c.fix_seen = (v, late, float(item.lat), float(item.lon), speed)
+                c.nav_seen = None
         last = o.last_osi
         rec = o.beliefs.primary.model.opos_records
         if last is None or not rec:

@@ -1,0 +1,82 @@
+"""RH-POS-2 with RH-OUT-4: an ``$OPOS`` that moves a submerged vehicle onto its next waypoint.
+
+Without a GPS fix an accepted ``$OPOS`` position is applied (RH-POS-2): the vehicle is where the
+fix says at once, however far that is from where its reports put it. When that puts it on the
+mission waypoint it was heading for, its next report shows the waypoint reached (here a mission
+park) although no speed could have carried it there in the time. A conforming vehicle: the judge
+must not book RH-OUT-4 on it. The session is the reference emulator's core, driven in virtual
+time by a short script (poll, then the fix two metres from the park waypoint when the vehicle is
+about five metres out), recorded as a wire log without the emulator's own notes (as a real
+vehicle's line is recorded) and checked as ``check-log`` checks one.
+"""
+
+from __future__ import annotations
+
+import io
+from pathlib import Path
+
+from helmcheck.checklog.checker import check_log
+from helmcheck.emulator.core import EmulatorCore
+from helmcheck.emulator.missionfile import DirectoryCatalog, builtin_dir
+from helmcheck.grammar import checksum_hex
+from helmcheck.grammar.wirelog import WireLogWriter
+from helmcheck.profile import DEFAULT
+
+PARK_WP = (41.522698, -71.320000)  # conformance.mis waypoint 1 (a 300 s mission park)
+
+
+def frame(body: str) -> bytes:
+    return f"${body}*{checksum_hex(body)}\r\n".encode()
+
+
+def osi_fields(data: bytes):
+    for line in data.split(b"\r\n"):
+        if line.startswith(b"$OSI,"):
+            return line[1:line.index(b"*")].decode().split(",")
+    return None
+
+
+def session(path: Path, *, fix_metres: float) -> list:
+    """Drive the emulator to the park waypoint; ``$OPOS`` ``fix_metres`` south of it when the
+    vehicle reports 4.5–6 m to go. Returns the reports' (mode, waypoint, distance)."""
+    buf = io.StringIO()
+    log = WireLogWriter(buf, ("started 2026-11-25T08:00:00.000000Z  port virtual  baud 19200  time_scale 1",))
+    core = EmulatorCore(DEFAULT, DirectoryCatalog([builtin_dir()]), start=0.0, time_scale=1.0, baud=19200, log=log)
+    seen = []
+    now, sent_fix, after = 0.0, False, None
+
+    def send(body: str) -> bytes:
+        nonlocal now
+        out = core.feed(frame(body), now)
+        for _ in range(40):  # the answer's bytes at the line's pace
+            wake = core.next_wakeup()
+            if wake is None or wake > now + 0.2:
+                break
+            out += core.tick(wake)
+        return out
+
+    send("OMSTART,0,0,0,0,conformance.mis,")
+    while now < 600 and (after is None or now < after):
+        now += 0.5
+        f = osi_fields(send("OSD,G,C,S"))
+        if f is None:
+            continue
+        mode, wp, dist = f[2], int(f[3]), float(f[7])
+        seen.append((mode, wp, dist))
+        if not sent_fix and mode == "N" and wp == 1 and 4.5 <= dist <= 6.0:
+            now += 0.02
+            send(f"OPOS,{PARK_WP[0] - fix_metres / 111_320:.6f},{PARK_WP[1]:.6f},2.0,30.71,9.0")
+            sent_fix, after = True, now + 5.0
+    # a recording of a real vehicle's line has none of the emulator's own notes (plant, model)
+    path.write_text("".join(ln for ln in buf.getvalue().splitlines(keepends=True) if " ! " not in ln))
+    return seen
+
+
+def test_an_opos_that_puts_a_submerged_vehicle_on_its_waypoint_is_not_a_violation(tmp_path):
+    path = tmp_path / "wire.log"
+    seen = session(path, fix_metres=2.0)
+    assert ("P", 1) in [(m, w) for m, w, _ in seen], seen[-8:]  # the fix put it on station: the park began
+    out = check_log(path, profile=DEFAULT, role="vehicle")
+    verdicts = {c["id"]: (c["verdict"], c["reason"]) for c in out.clauses}
+    assert verdicts["RH-POS-2"][0] != "fail", verdicts["RH-POS-2"]
+    assert verdicts["RH-OUT-4"][0] != "fail", verdicts["RH-OUT-4"]
