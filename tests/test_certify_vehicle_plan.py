@@ -111,7 +111,8 @@ def test_plan_text_shows_every_case_the_exploration_budget_and_the_total(capsys)
     assert {"link", "explore", "restore", "total"} <= rows
     assert {c.id for c in select_cases(None, DEFAULT)} < rows
     explore = next(ln for ln in out.splitlines() if ln.startswith("explore"))
-    assert explore.split()[-3] == "600.0"  # the patient profile's wall budget, as its own line
+    # the patient profile's budget is 600 s of vehicle time (900 s wall): 30 s at x20, as its own line
+    assert explore.split()[-3] == "30.0", explore
     assert "V-57" in out and "not run" in out  # rh5 declares no $OXFLT: said, not timed
     assert "built-in" in out  # the missions it assumes
 

@@ -23,6 +23,8 @@ wire-log format (``docs/contracts.md``):
 ==========================================  ===================================================
 ``case V-22 RH-INT-2: <title>``             a clause case starts; findings inside it are booked
                                             on its clauses where they touch them
+``case explore: <title>``                   a case about no clause (the exploration): findings
+                                            are booked on what each observation speaks to
 ``case V-22 end``                           the case is over
 ``not tested RH-X,RH-Y: <reason>``          the tester could not exercise these clauses
 ``inconclusive RH-X,RH-Y: <reason>``        the tester exercised them but cannot judge them
@@ -103,7 +105,7 @@ class Note:
     value: Any = None  #: plant: (event class name, kwargs, v); link: baud
 
 
-_CASE = re.compile(r"^case (\S+) ((?:RH-[A-Z]+-\d+ ?)+): (.*)$")
+_CASE = re.compile(r"^case (\S+)(?: ((?:RH-[A-Z]+-\d+ ?)+))?: (.*)$")
 _CASE_END = re.compile(r"^case (\S+) end$")
 _TESTER = re.compile(r"^(not tested|inconclusive) ((?:RH-[A-Z]+-\d+,?)+): (.*)$")
 _LINK = re.compile(r"^link: (\d+) baud 8N1\b")
@@ -128,7 +130,7 @@ def parse_note(text: str) -> Optional[Note]:
     """The :class:`Note` a judge acts on, or ``None`` for a note that is evidence only."""
     m = _CASE.match(text)
     if m:
-        return Note("case", case=m.group(1), clauses=tuple(m.group(2).split()), text=m.group(3))
+        return Note("case", case=m.group(1), clauses=tuple((m.group(2) or "").split()), text=m.group(3))
     m = _CASE_END.match(text)
     if m:
         return Note("case-end", case=m.group(1))
@@ -182,7 +184,9 @@ def parse_note(text: str) -> Optional[Note]:
 
 
 def case_note(case_id: str, clauses: tuple[str, ...] | list[str], title: str) -> str:
-    return f"case {case_id} {' '.join(clauses)}: {title}"
+    """``case V-12 RH-ACK-3: title``; a case about no clause in particular (the exploration) is
+    ``case explore: title``, and its findings are booked on what each observation speaks to."""
+    return f"case {case_id} {' '.join(clauses)}: {title}" if clauses else f"case {case_id}: {title}"
 
 
 def case_end_note(case_id: str) -> str:

@@ -1,5 +1,6 @@
-"""The HTML report's model coverage (modes, transitions, interrupt pairs) and the event summary
-and event table that go with the mode timeline.
+"""The HTML report's model coverage (modes, transitions, interrupt pairs; the exploration's own
+coverage of the model's rows, interrupt pairs, timer boundaries and error codes, with what stayed
+uncovered) and the event summary and event table that go with the mode timeline.
 """
 
 from __future__ import annotations
@@ -41,7 +42,27 @@ def _coverage(run: Run) -> str:
         body.append(f"<tr><th>{_e(active)}</th>{''.join(cells)}</tr>")
     out.append(f'<table class="pairs"><thead><tr><th>active ↓ / interrupted by →</th>{head}</tr></thead>'
                f"<tbody>{''.join(body)}</tbody></table>")
+    out.append(_exploration_coverage(run))
     return "\n".join(out)
+
+
+def _exploration_coverage(run: Run) -> str:
+    """The exploration's model coverage (``stats.explore.model_coverage``), beside the clauses."""
+    mc = ((run.results.get("stats") or {}).get("explore") or {}).get("model_coverage")
+    if not isinstance(mc, dict) or not mc:
+        return ""
+    rows = []
+    for name, d in mc.items():
+        if not isinstance(d, dict):
+            continue
+        missing = d.get("uncovered") or []
+        more = (f"<details><summary>{len(missing)} uncovered</summary><ul>"
+                + "".join(f"<li><code>{_e(x)}</code></li>" for x in missing) + "</ul></details>") if missing else "—"
+        rows.append(f"<tr><td>{_e(name.replace('_', ' '))}</td><td>{_e(d.get('covered'))} of {_e(d.get('of'))}"
+                    f" ({_e(d.get('percent'))} %)</td><td>{more}</td></tr>")
+    return ('<h3 id="exploration-coverage">What the exploration reached of the model</h3>'
+            '<table class="exploration-coverage"><thead><tr><th>dimension</th><th>covered</th>'
+            f"<th>uncovered</th></tr></thead><tbody>{''.join(rows)}</tbody></table>")
 
 
 def _events_table(run: Run) -> str:

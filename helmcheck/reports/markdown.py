@@ -114,6 +114,12 @@ def render_markdown(run: Run, comparison_md: str | None = None) -> str:
     out.append("|" + "---:|" * (len(c) + 1))
     out.append("| " + " | ".join(str(n) for n in c.values()) + f" | {sum(c.values())} |")
     out.append("")
+    mc = ((r.get("stats") or {}).get("explore") or {}).get("model_coverage")
+    if isinstance(mc, dict) and mc:
+        out.append("Exploration's model coverage: " + "; ".join(
+            f"{md_escape(k.replace('_', ' '))} {d.get('covered')}/{d.get('of')}" for k, d in mc.items()
+            if isinstance(d, dict)) + ".")
+        out.append("")
 
     rows = non_pass_rows(r)
     if rows:

@@ -10,8 +10,9 @@ opened, nothing is written and no real time passes waiting. The lines follow the
 phases: the link check (with the settings survey of a vehicle found stopped), the cases, the
 exploration, the restore.
 
-What it cannot run in virtual time is the hypothesis exploration: it stops on a wall-clock
-budget, so the plan shows that budget as its own line (it ends sooner when its examples are done).
+What it cannot run in virtual time is the hypothesis exploration: it stops on its budget, in wall
+seconds and in vehicle seconds (whichever ends first: on a vehicle at ×1 the forced waits bind),
+so the plan shows that budget as its own line (it ends sooner when its examples are done).
 A profile whose safety violations an operator raises (``violation_trigger = "operator"``) is
 planned with someone at the terminal who trips the sensor :data:`OPERATOR_REACTION_S` after
 being told.
@@ -186,14 +187,15 @@ def estimate(profile: Profile, time_scale: float, *, select: Optional[list] = No
                 state, note = "stopped", f"{outcome} on the reference model: {reason}"
             plan.lines.append(PlanLine(case.id, "case", case.title, wall, round(wall * k, 3), wait,
                                        tuple(case.clauses), state, note))
-        n, _steps, budget = EXPLORE_PROFILES.get(hypothesis_profile, EXPLORE_PROFILES["fast"])
-        if examples is not None:
-            n = examples
+        budget = EXPLORE_PROFILES.get(hypothesis_profile, EXPLORE_PROFILES["fast"])
+        n = budget.examples if examples is None else examples
         if n > 0:
+            wall = min(budget.wall_s, budget.vehicle_s / k)  # whichever clock runs out first
             plan.lines.append(PlanLine("explore", "exploration",
                                        f"hypothesis exploration: {n} examples ({hypothesis_profile})",
-                                       float(budget), round(budget * k, 3), outcome="budget",
-                                       note=f"its wall budget ({hypothesis_profile} profile)"))
+                                       float(wall), round(wall * k, 3), outcome="budget",
+                                       note=f"its budget ({hypothesis_profile} profile): {budget.wall_s:g} s wall, "
+                                            f"{budget.vehicle_s:g} s vehicle time, whichever ends first"))
             custodian.touched = True  # it sends commands
         if custodian.needed:
             wall, wait = timed(lambda: custodian.restore(session))
@@ -249,7 +251,7 @@ def _operator(line: VirtualLine, core):
 
 
 def _assumptions(plan: Plan, profile: Profile, catalog: _PlanCatalog, missions_dir: Optional[Path],
-                 examples: int, budget: float, hp: str) -> list[str]:
+                 examples: int, budget, hp: str) -> list[str]:
     out = ["the vehicle behaves and answers like the reference model (the built-in emulator), which "
            "these times come from: the cases were run on it in virtual time; a vehicle slower to answer, "
            "with longer missions or slower to surface takes longer",
@@ -267,9 +269,10 @@ def _assumptions(plan: Plan, profile: Profile, catalog: _PlanCatalog, missions_d
         out.append(f"someone at the terminal trips a sensor {OPERATOR_REACTION_S:g} s after being told (the run "
                    f"waits up to {OPERATOR_WAIT_S:g} s for it)")
     if examples > 0:
-        out.append(f"the exploration is counted at its wall budget of {budget:g} s ({hp} profile, "
-                   f"{examples} examples): it ends sooner when its examples are done, and starts none "
-                   f"once the budget is spent (the one running then finishes); --examples 0 leaves it out")
+        out.append(f"the exploration is counted at its budget ({hp} profile, {examples} examples): "
+                   f"{budget.wall_s:g} s of wall time or {budget.vehicle_s:g} s of vehicle time, whichever "
+                   f"ends first; it ends sooner when its examples are done, and starts none once the budget "
+                   f"is spent (the one running then finishes); --examples 0 leaves it out")
     stopped = [x.id for x in plan.lines if x.outcome == "stopped"]
     if stopped:
         out.append(f"{', '.join(stopped)} stopped early on the reference model (see their notes): on a "

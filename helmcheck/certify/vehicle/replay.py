@@ -2,16 +2,28 @@
 
 A replay file is JSON::
 
-    {"format": "helmcheck-replay", "version": 1, "clause": "RH-SRV-4", "reason": "...",
-     "time_scale": 20.0, "profile": {...},
-     "steps": [{"send": "$OMS,90,2,20,0.5,5*hh\\r\\n"}, {"expect": "$ACK,9,0,0"},
-               {"wait": 6.0}, {"send": "$OSD,S*27\\r\\n"}, ...]}
+    {"format": "helmcheck-replay", "version": 2, "clause": "RH-SRV-4", "reason": "...",
+     "time_scale": 20.0, "profile": {...}, "start": "verified-reset", "lazy_silence": true,
+     "steps": [{"send": "$OMSTOP,0*hh\\r\\n", "t": 0.0}, {"expect": "$ACK,1,0,0"}, ...,
+               {"send": "$OMS,90,2,20,0.5,5*hh\\r\\n", "t": 0.412}, {"expect": "$ACK,9,0,0"},
+               {"wait": 6.0}, {"send": "$OSD,S*27\\r\\n", "t": 0.731}, ...]}
 
-``send`` is the exact bytes, escaped as in the wire log (``\\r``, ``\\n``, ``\\xNN``); ``wait``
-is vehicle seconds (divided by the time scale when re-driven, RH-TIM-2); ``expect`` says in
-words what the model expected then (for people; the re-drive asks the model afresh). Nothing in
-it depends on a hypothesis version. :func:`redrive` sends it again, judging every reply with
-the present model, and says whether it still fails.
+``send`` is the exact bytes, escaped as in the wire log (``\\r``, ``\\n``, ``\\xNN``), and ``t``
+when it was sent (wall seconds from the first step, at the recorded time scale); ``wait`` is
+vehicle seconds (divided by the time scale when re-driven, RH-TIM-2); ``expect`` says in words
+what the model expected then (for people, and to say where a re-drive went another way; the
+re-drive asks the model afresh). ``lazy_silence``: the sequence did not sit out the ACK window of
+a line the vehicle must discard (the exploration's pace); the re-drive keeps that pace and lets
+the observer settle every line before its verdict. Nothing in it depends on a hypothesis version.
+
+The steps are the *whole* sequence from the verified reset that began it (the exploration records
+from there, and ends every sequence with a verified reset of its own, so a lockout or a park a
+sequence set going is judged inside it): whatever state the failure needs, the steps build it.
+:func:`redrive` first brings the vehicle to that reset (``$OMSTOP,0`` until accepted, waiting out
+a lockout left by whatever ran before, then ``S`` seen), then sends the steps at their recorded
+pace (a step never earlier than its ``t`` scaled to the present time scale), judging every reply
+with the present model, and says whether it still fails — and at which step, or at which step the
+vehicle first went another way than when it was recorded.
 """
 
 from __future__ import annotations
@@ -33,11 +45,19 @@ class ReplayError(ValueError):
     """A replay file that cannot be used; names the file."""
 
 
-def save_replay(path: Path, clause: str, reason: str, steps: list, time_scale: float, profile: Profile) -> Path:
+def save_replay(path: Path, clause: str, reason: str, steps: list, time_scale: float, profile: Profile,
+                lazy_silence: bool = True) -> Path:
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    doc = {"format": FORMAT, "version": 1, "clause": clause, "reason": reason, "time_scale": time_scale,
-           "profile": profile.as_dict(), "steps": [dict(s) for s in steps]}
+    t0 = next((float(s["t"]) for s in steps if "t" in s), 0.0)
+    out = []
+    for s in steps:
+        s = dict(s)
+        if "t" in s:
+            s["t"] = round(float(s["t"]) - t0, 6)
+        out.append(s)
+    doc = {"format": FORMAT, "version": 2, "clause": clause, "reason": reason, "time_scale": time_scale,
+           "profile": profile.as_dict(), "start": "verified-reset", "lazy_silence": lazy_silence, "steps": out}
     write_text_atomic(path, json.dumps(doc, indent=1) + "\n")
     return path
 
@@ -57,25 +77,71 @@ def load_replay(path: Path) -> dict:
     return doc
 
 
-def redrive(doc: dict, session) -> tuple[str, str, Optional[str]]:
+def redrive(doc: dict, session, time_scale: Optional[float] = None) -> tuple[str, str, Optional[str]]:
     """Re-drive the steps on ``session``: (``fail``/``pass``/``inconclusive``, reason, clause).
 
-    The steps start with the verified reset the sequence began with; the session's observer
-    judges every reply, as in any run."""
+    First the verified reset the sequence began from (module docstring), then the steps at their
+    recorded pace; the session's observer judges every reply, as in any run. The reason names the
+    step a failure came at, and the first step whose answer the model expected otherwise than
+    when it was recorded (where the vehicle's state went another way)."""
+    from .flow import CaseStop
+
+    try:
+        stop, session.stop_on_fail = session.stop_on_fail, False
+        try:
+            session.reset(mission=False)
+        finally:
+            session.stop_on_fail = stop
+    except CaseStop as f:
+        return "inconclusive", f"the verified reset before the steps failed: {f.reason}", None
+    session.mark = session.ledger.mark()
+    # the line pace the sequence was recorded at: an exploration does not sit out the window of a
+    # line the vehicle must discard (the observer settles it later, :meth:`Session.finish`)
+    lazy, session.lazy_silence = session.lazy_silence, bool(doc.get("lazy_silence", False))
+    try:
+        return _steps(doc, session, time_scale)
+    finally:
+        session.lazy_silence = lazy
+
+
+def _steps(doc: dict, session, time_scale: Optional[float]) -> tuple[str, str, Optional[str]]:
     from .flow import CaseStop
     from .safety import BenchSafetyRefused
+    from .session import _brief
 
-    session.mark = session.ledger.mark()
+    steps = doc["steps"]
+    k_rec = float(doc.get("time_scale") or session.k)
+    pace = k_rec / float(time_scale or session.k)
+    where = {"i": -1, "send": ""}
+    diverged: list = []
+    start = session.now()
+    t_first = next((float(st["t"]) for st in steps if "t" in st), 0.0)
+    last = None
     try:
-        for st in doc["steps"]:
+        for i, st in enumerate(steps):
+            where["i"] = i
             if "send" in st:
+                where["send"] = st["send"]
+                if "t" in st:
+                    session.link.sleep(max(0.0, start + (float(st["t"]) - t_first) * pace - session.now()))
                 raw = unescape(st["send"])
                 try:
-                    session.exchange(raw)
+                    last = session.exchange(raw)
                 except BenchSafetyRefused as e:
-                    return "inconclusive", f"a step was not sent: {e}", None
+                    return "inconclusive", f"step {i + 1} was not sent: {e}", None
             elif "wait" in st:
                 session.wait(float(st["wait"]))
+            elif "expect" in st and last is not None and not diverged:
+                now = _brief(last.expected)
+                if now != st["expect"]:
+                    diverged.append(f"step {i} ({where['send'].strip()}) went another way: recorded "
+                                    f"{st['expect']}, now {now}")
+        where["send"] = ""
+        session.finish()  # a line the vehicle left unanswered is judged before the verdict
     except CaseStop as f:
-        return ("fail" if f.outcome == "fail" else "inconclusive"), f.reason, f.clause
-    return "pass", f"all {len(doc['steps'])} steps agreed with the model", None
+        at = f"step {where['i'] + 1} of {len(steps)} ({where['send'].strip() or 'a wait'})"
+        why = f"at {at}: {f.reason}" + (f"; first, {diverged[0]}" if diverged else "")
+        return ("fail" if f.outcome == "fail" else "inconclusive"), why, f.clause
+    if diverged:
+        return "pass", f"all {len(steps)} steps agreed with the model, but {diverged[0]}", None
+    return "pass", f"all {len(steps)} steps agreed with the model", None

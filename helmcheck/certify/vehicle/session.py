@@ -156,6 +156,20 @@ class Session:
         self.check()
         return sent
 
+    def finish(self) -> None:
+        """Let every line sent so far be settled by the observer — a line answered late or not at
+        all, which a ``lazy_silence`` exchange did not wait for, is judged now — then poll once (so
+        that an unanswered line is told from a dead link) and stop on a failure (:meth:`check`)."""
+        pending = [x for x in self.obs.sent if not x.done]
+        if pending:
+            size = max(len(x.raw) for x in pending)
+            allowance = ack_allowance(self.profile.ack_window_s, size, 0, self.profile.baud)
+            hard = max(x.t for x in pending) + ack_give_up_after(allowance) + 0.05
+            while any(not x.done for x in pending) and self.now() < hard:
+                self.link.next(hard)
+            self.poll()
+        self.check()
+
     def _probe(self, after: float) -> None:
         """A command got no ACK in time: does the vehicle still answer anything? (an ``$OSD,S``
         the observer judges like any other — its answer decides RH-ACK-1 against a link fault)."""

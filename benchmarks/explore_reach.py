@@ -1,0 +1,172 @@
+"""How many faulty vehicles the exploration alone finds, on their own clause.
+
+Every faulty vehicle of the suite — the emulator mutants (``tests/faulty_vehicles``) and, where
+``../shared/third-party/uvc_sim.py`` is beside the checkout, the single faults of that independent
+simulator (``tests/third_party_faults.py``) — is certified with one trivial clause selected
+(``--select RH-POS-1``: its hand-written case sends one ``$OPOS``), the exploration's ``fast``
+budget and a fixed seed, so that a finding on any other clause comes from the exploration. The
+conforming configurations (the emulator, its freedoms, the independent simulator) are certified
+the same way and must get no FAIL.
+
+    .venv/bin/python benchmarks/explore_reach.py [--jobs N] [--seed S] [--only NAME …] [--json OUT]
+
+Prints one line per vehicle (found on its clause / found elsewhere / missed) and the figures.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+import tempfile
+import time
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT))
+
+SELECT = "RH-POS-1"
+
+
+def _replay(path: Path, port: str) -> int:
+    """``helmcheck replay`` of one saved replay on a fresh vehicle: its exit status (1: fails again)."""
+    import contextlib
+    import io
+
+    from helmcheck.cli import main as cli_main
+    with contextlib.redirect_stdout(io.StringIO()):
+        return cli_main(["replay", str(path), "--port", port])
+
+
+def _emulator_case(name: str, seed: int, k: float, budget: float | None) -> dict:
+    from helmcheck.certify.vehicle.runner import Options, certify
+    from tests.faulty_vehicles import EMU_PROFILE, MUTANTS, make_core, serve
+
+    mutant = next((m for m in MUTANTS if m.name == name), None) if name != "conforming" else None
+    with tempfile.TemporaryDirectory() as tmp:
+        with serve(lambda start: make_core(mutant, k, start)) as port:
+            opts = Options(port=port, profile=EMU_PROFILE.replace(time_scale=k), time_scale=k,
+                           report_dir=Path(tmp) / "r", select=[SELECT], progress=False, render=False, seed=seed,
+                           explore_budget_s=budget)
+            out = certify(opts)
+        r = _summary(name, mutant.clause if mutant else "", out.results, "emulator")
+        codes = []
+        for rel in r["replays"]:  # each on a fresh instance of the same vehicle
+            with serve(lambda start: make_core(mutant, k, start)) as port:
+                codes.append(_replay(Path(tmp) / "r" / rel, port))
+        r["replayed"] = codes
+        return r
+
+
+def _third_party_case(fault: str, seed: int, k: float, budget: float | None) -> dict:
+    import subprocess
+
+    from tests.test_third_party_vehicle import BASE, OXFLT, uvc_sim
+    with tempfile.TemporaryDirectory() as tmp:
+        t = Path(tmp)
+        with uvc_sim(t, k, fault="" if fault == "conforming" else fault) as port:
+            prof = t / "profile.toml"
+            prof.write_text(BASE + OXFLT + "baud = 115200\n" + f"time_scale = {k:g}\n")
+            extra = ["--explore-budget", f"{budget:g}"] if budget else []
+            subprocess.run([sys.executable, "-m", "helmcheck", "certify", "vehicle", "--port", port,
+                            "--time-scale", f"{k:g}", "--profile", str(prof), "--report-dir", str(t / "run"),
+                            "--seed", str(seed), "--no-progress", "--select", SELECT, *extra],
+                           capture_output=True, text=True, timeout=900)
+            results = json.loads((t / "run" / "results.json").read_text())
+        codes = []
+        for r in results.get("replays", []):
+            with uvc_sim(t, k, fault="" if fault == "conforming" else fault) as port:
+                codes.append(subprocess.run([sys.executable, "-m", "helmcheck", "replay", str(t / "run" / r["file"]),
+                                             "--port", port], capture_output=True, timeout=600).returncode)
+    from tests.test_third_party_vehicle import CAUGHT_ON
+    c = CAUGHT_ON.get(fault, "")
+    clause = c[0] if isinstance(c, tuple) else c
+    out = _summary(fault, clause, results, "third-party")
+    out["replayed"] = codes
+    return out
+
+
+def _summary(name: str, clause: str, results: dict, family: str) -> dict:
+    failed = sorted(c["id"] for c in results["clauses"] if c["verdict"] == "fail")
+    ex = (results.get("stats") or {}).get("explore") or {}
+    if not clause:
+        outcome = "false-fail" if failed else "clean"
+    elif clause in failed:
+        outcome = "own"
+    elif failed:
+        outcome = "elsewhere"
+    else:
+        outcome = "missed"
+    return {"family": family, "name": name, "clause": clause, "outcome": outcome, "failed": failed,
+            "ran": ex.get("ran"), "wall_s": ex.get("wall_s"), "found": ex.get("found", ""),
+            "replays": [r.get("file") for r in results.get("replays", [])],
+            "model_coverage": {k: f"{v['covered']}/{v['of']}" for k, v in (ex.get("model_coverage") or {}).items()}}
+
+
+def cases(only: list[str]) -> list[tuple]:
+    from tests.faulty_vehicles import MUTANTS
+    out = [("emulator", "conforming")] + [("emulator", m.name) for m in MUTANTS]
+    try:
+        from tests.test_third_party_vehicle import CAUGHT_ON, SIM
+        if SIM.is_file():
+            out += [("third-party", "conforming")] + [("third-party", f) for f in CAUGHT_ON]
+    except ImportError:
+        pass
+    if only:
+        out = [c for c in out if any(o in c[1] for o in only) or c[0] in only]
+    return out
+
+
+def run_one(family: str, name: str, seed: int, budget: float | None) -> dict:
+    t0 = time.monotonic()
+    try:
+        if family == "emulator":
+            r = _emulator_case(name, seed, 25.0, budget)
+        else:
+            r = _third_party_case(name, seed, 20.0, budget)
+    except Exception as e:  # noqa: BLE001 - reported per case
+        r = {"family": family, "name": name, "clause": "", "outcome": "error", "failed": [],
+             "error": f"{type(e).__name__}: {e}"}
+    r["case_wall_s"] = round(time.monotonic() - t0, 1)
+    return r
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--jobs", type=int, default=4)
+    ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("--budget", type=float, default=None, help="wall seconds (default: the fast profile's)")
+    ap.add_argument("--only", nargs="*", default=[])
+    ap.add_argument("--json", type=Path)
+    a = ap.parse_args(argv)
+    todo = cases(a.only)
+    rows = []
+    t0 = time.monotonic()
+    with ProcessPoolExecutor(a.jobs) as pool:
+        futs = [pool.submit(run_one, f, n, a.seed, a.budget) for f, n in todo]
+        for fut in as_completed(futs):
+            r = fut.result()
+            rows.append(r)
+            print(f"{r['family']:11} {r['name']:34} {r['clause']:10} {r['outcome']:10} "
+                  f"{','.join(r['failed'])[:60]} replays {r.get('replayed')} {r.get('error', '')}", flush=True)
+    for fam in ("emulator", "third-party"):
+        faulty = [r for r in rows if r["family"] == fam and r["clause"]]
+        if not faulty:
+            continue
+        own = sum(r["outcome"] == "own" for r in faulty)
+        anyf = sum(r["outcome"] in ("own", "elsewhere") for r in faulty)
+        bad = [r["name"] + ":" + ",".join(r["failed"]) for r in rows if r["family"] == fam and r["outcome"] == "false-fail"]
+        replays = [c for r in rows if r["family"] == fam for c in r.get("replayed") or []]
+        print(f"{fam}: {own}/{len(faulty)} on their own clause ({100 * own / len(faulty):.0f} %), "
+              f"{anyf}/{len(faulty)} found at all; conforming false FAILs: {bad or 'none'}; "
+              f"replays failing again on a fresh instance: {replays.count(1)}/{len(replays)}")
+    print(f"wall {time.monotonic() - t0:.0f} s")
+    if a.json:
+        a.json.write_text(json.dumps(sorted(rows, key=lambda r: (r["family"], r["name"])), indent=1))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

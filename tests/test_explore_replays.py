@@ -1,0 +1,63 @@
+"""Replays that reproduce: a failure the exploration alone finds is saved with everything from the
+verified reset that led to it, and re-driven on a *fresh* instance of the same faulty vehicle it
+fails again, at the step named (``helmcheck/certify/vehicle/replay.py``); on the conforming
+vehicle the same file passes.
+
+The two faults are the deep kinds a replay used to lose: a lockout that ends early (RH-SAF-1: the
+failure comes 10 s after the ``$OXFLT`` that set it going, and a replay without that ``$OXFLT``
+passes) and a ``$OPK`` park that an interrupting control hands back to (RH-INT-3: park, interrupt,
+release). Each is certified with one trivial clause selected (RH-POS-1), so that only the
+exploration can find it, at a fixed seed.
+"""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from helmcheck.cli import main as cli_main
+from helmcheck.certify.vehicle.runner import Options, certify
+from tests.faulty_vehicles import EMU_PROFILE, MUTANTS, make_core, serve
+
+K = 25.0
+FAULTS = {"lockout-10s": "RH-SAF-1", "opk-kept-after-interrupt": "RH-INT-3"}
+#: What the fault may be booked on: its clause, or the report that first shows its effect when no
+#: command probed it (a lockout over early shows as the mode after it, RH-OUT-4)
+OWN_OR_EFFECT = {"lockout-10s": ("RH-SAF-1", "RH-OUT-4", "RH-TIM-1"), "opk-kept-after-interrupt": ("RH-INT-3", "RH-OUT-4")}
+
+
+def _mutant(name):
+    return next(m for m in MUTANTS if m.name == name)
+
+
+@pytest.mark.parametrize("name", sorted(FAULTS))
+def test_an_exploration_finding_replays_on_a_fresh_vehicle(name, tmp_path, capsys):
+    mutant = _mutant(name)
+    with serve(lambda start: make_core(mutant, K, start)) as port:
+        out = certify(Options(port=port, profile=EMU_PROFILE.replace(time_scale=K), time_scale=K,
+                              report_dir=tmp_path / "r", select=["RH-POS-1"], progress=False, render=False,
+                              seed=2, explore_budget_s=45.0))
+    failed = {c["id"] for c in out.results["clauses"] if c["verdict"] == "fail"}
+    assert failed, out.results["stats"]["explore"]
+    assert failed <= set(OWN_OR_EFFECT[name]), (failed, out.results["stats"]["explore"])
+    replays = out.results["replays"]
+    assert replays and replays[0]["clause"] in failed, replays
+    clause = replays[0]["clause"]
+    path = tmp_path / "r" / replays[0]["file"]
+    doc = json.loads(path.read_text())
+    assert doc["version"] == 2 and doc["start"] == "verified-reset"
+    sent = [st["send"] for st in doc["steps"] if "send" in st]
+    assert sent[0].startswith("$OMSTOP,0*"), sent[:3]  # from the verified reset on
+    if name == "lockout-10s":
+        assert any(x.startswith("$OXFLT,") for x in sent), sent  # the violation that set it going
+    capsys.readouterr()
+    with serve(lambda start: make_core(mutant, K, start)) as port:  # a fresh instance
+        code = cli_main(["replay", str(path), "--port", port])
+    text = capsys.readouterr().out
+    assert code == 1 and text.startswith("STILL FAILS: at step "), text
+    assert clause in text, text
+    with serve(lambda start: make_core(None, K, start)) as port:  # the conforming vehicle
+        code = cli_main(["replay", str(path), "--port", port])
+    text = capsys.readouterr().out
+    assert code == 0 and text.startswith("PASSES NOW"), text
