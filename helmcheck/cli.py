@@ -38,6 +38,7 @@ SUBCOMMANDS = {
     "emulate": ("helmcheck.commands.emulate_cmd", "run the reference vehicle emulator on a serial port"),
     "certify": ("helmcheck.commands.certify_cmd", "certify a vehicle or a backseat over a serial port"),
     "replay": ("helmcheck.commands.replay_cmd", "re-drive a saved failing sequence against a vehicle"),
+    "diff": ("helmcheck.commands.diff_cmd", "drive two vehicles with the same sequences; report their first divergence"),
     "check-log": ("helmcheck.commands.checklog_cmd", "check a recorded serial log against the model"),
     "monitor": ("helmcheck.commands.monitor_cmd", "judge a live backseat-vehicle session (tap or in line)"),
     "report": ("helmcheck.commands.report_cmd", "render a results directory as HTML, JUnit, Markdown"),
@@ -58,6 +59,7 @@ Typical use:
   helmcheck emulate --port pty                     # a reference vehicle on a pseudo-terminal
   helmcheck certify vehicle --port /dev/pts/5      # certify whatever answers on that port
   helmcheck certify backseat --port pty            # play the vehicle, judge a backseat
+  helmcheck diff --port /dev/pts/5 --port /dev/pts/7  # two vehicles, same sequences: first divergence
   helmcheck report reports/demo                    # render results.json to HTML/JUnit/Markdown
   helmcheck matrix out/a out/b --out out/          # several runs side by side, clause by clause
   helmcheck verify reports/demo                    # re-judge the wire log; check the signature

@@ -71,6 +71,7 @@ USAGE = {
     "certify vehicle": ["certify", "vehicle"],
     "certify backseat": ["certify", "backseat", "--duration", "0"],
     "replay": ["replay"],
+    "diff": ["diff", "--port", "/dev/null"],
     "check-log": ["check-log"],
     "monitor": ["monitor", "--tap", "pty"],
     "report": ["report", "--format", "pdf", "x"],
@@ -126,6 +127,7 @@ PORT_COMMANDS = {
     "certify vehicle": lambda port, tmp: ["certify", "vehicle", "--port", port, "--report-dir", tmp / "r"],
     "certify backseat": lambda port, tmp: ["certify", "backseat", "--port", port, "--report-dir", tmp / "r"],
     "replay": lambda port, tmp: ["replay", replay_file(tmp), "--port", port],
+    "diff": lambda port, tmp: ["diff", "--port", port, "--port", port, "--report-dir", tmp / "r"],
     "monitor": lambda port, tmp: ["monitor", "--between", "pty", port, "--report-dir", tmp / "r"],
 }
 

@@ -5,6 +5,9 @@
 * :mod:`.backseat` — ``certify backseat``: helmcheck plays the vehicle (the reference emulator's
   core, in-process) and judges a backseat (§9); library entry
   :func:`helmcheck.certify.backseat.certifier.certify`;
+* :mod:`.diff` — ``diff``: two vehicles driven with the same sequences side by side, each judged
+  by the vehicle observer, their first divergence shrunk; library entry
+  :func:`helmcheck.certify.diff.driver.diff`;
 * :mod:`.outcome` — :class:`~.outcome.Outcome`, what both return.
 
 Both judge through the observers of :mod:`helmcheck.judge`, fed by the recorder of

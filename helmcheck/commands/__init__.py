@@ -6,7 +6,7 @@
   :mod:`.checklog_fleet_cmd`); :mod:`.monitor_cmd` —
   ``monitor``; :mod:`.verify_cmd` —
   ``verify``; :mod:`.report_cmd` — ``report``; :mod:`.matrix_cmd` — ``matrix``;
-* :mod:`.replay_cmd` — ``replay``; :mod:`.parse_cmd` — ``parse``; :mod:`.keygen_cmd` — ``keygen``;
+* :mod:`.replay_cmd` — ``replay``; :mod:`.diff_cmd` — ``diff``; :mod:`.parse_cmd` — ``parse``; :mod:`.keygen_cmd` — ``keygen``;
   :mod:`.profile_cmd` — ``profile init``; :mod:`.docs_cmd` — ``docs``.
 
 ``certify`` dispatches again, by role, to :mod:`.certify_vehicle_cmd` and

@@ -101,6 +101,8 @@ class Options:
     #: continue the interrupted run in ``report_dir`` (:mod:`.resume`): its record is replayed
     #: into the observer, its wire log appended to, its completed cases not run again
     resume: bool = False
+    #: what the wire log's header names the run (``helmcheck diff`` drives a Run for its machinery)
+    title: str = "certify vehicle"
 
 
 def selected_ids(select: Optional[list]) -> list[str]:
@@ -168,7 +170,7 @@ class Run(ExecChild):
             raise
         meta = [f"started {time.strftime('%Y-%m-%dT%H:%M:%SZ', time.gmtime())}  port "
                 f"{getattr(raw, 'name', None) or self.o.port}  baud {self.p.baud}  time_scale {self.k:g}",
-                f"helmcheck {__version__} certify vehicle; profile {self.p.name}"]
+                f"helmcheck {__version__} {self.o.title}; profile {self.p.name}"]
         if self.resumed is not None:  # the record goes on after a gap of a second
             lines, last_t = self.resumed.lines, self.resumed.last_t
             self.recorder = Recorder(wire, observers=[self.observer, self.facts], after=(lines, last_t))
