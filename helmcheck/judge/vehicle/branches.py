@@ -4,8 +4,9 @@ Besides the nominal state at the ACK's vehicle time (RH-RD-15): when the command
 RH-TIM-1 tolerance of a model timer, both sides of the race (also of a timer the model already
 ran: from its checkpoint, the state before it); an accepted ``$OPK`` also with its countdown
 waiting for on station (RH-PK-2: where the vehicle is at the ACK, no report settles); before a
-command that freezes the mission (RH-INT-1), a candidate in ``N`` also with the next waypoint
-reached unseen just before it, where it can have got there (:func:`~.closure.reachable`).
+command that freezes the mission (RH-INT-1) — or a violation raised with ``$OXFLT``, which freezes
+it too (RH-RD-11) — a candidate in ``N`` also with the next waypoint reached unseen just before it,
+where it can have got there (:func:`~.closure.reachable`).
 """
 
 from __future__ import annotations
@@ -67,7 +68,7 @@ def branches(c: Candidate, item, v: float, slack_v: float, catalog) -> list:
             w.model.await_on_station()
             out.append((w, replies, row, before))
     if (isinstance(item, s.Command) and m.mode == "N" and m.phase == "none" and m.mission is not None
-            and VehicleModel.event_of(item) in _WP_ALT_EVENTS
+            and (VehicleModel.event_of(item) in _WP_ALT_EVENTS or isinstance(item, s.OXFLT))
             and reachable(c, m.mission_wp, v, catalog)):  # only where it can have got there
         tp = min(max(c.seen_v if c.seen_v is not None else v, m.now or 0.0), v)
         t = c.clone()
