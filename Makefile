@@ -4,7 +4,7 @@ VENV   := .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 
-.PHONY: demo test fuzz bench docs clean
+.PHONY: demo test fuzz bench docs clean explore-reach
 
 #: The property tests, for `make fuzz`.
 FUZZ_TESTS := tests/test_grammar_fastpath.py tests/test_grammar_framer.py tests/test_grammar_roundtrip.py \
@@ -30,6 +30,11 @@ test: $(STAMP)
 # (tests/conftest.py, profile "fuzz"). A failure prints the blob that reproduces it.
 fuzz: $(STAMP)
 	HYPOTHESIS_PROFILE=fuzz $(PY) -m pytest $(FUZZ_TESTS)
+
+# Not run by CI (about 25 minutes): the exploration alone against every faulty vehicle of the
+# suite (tests/test_explore_reach.py, benchmarks/explore_reach.py).
+explore-reach: $(STAMP)
+	HELMCHECK_REACH=1 $(PY) -m pytest -q tests/test_explore_reach.py
 
 bench: $(STAMP)
 	$(PY) benchmarks/run_all.py

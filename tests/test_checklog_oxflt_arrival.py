@@ -38,12 +38,21 @@ def osi_fields(data: bytes):
     return None
 
 
+def _core(buf, profile=PROFILE):
+    log = WireLogWriter(buf, ("started 2026-11-26T08:00:00.000000Z  port virtual  baud 19200  time_scale 1",))
+    return EmulatorCore(profile, DirectoryCatalog([builtin_dir()]), start=0.0, time_scale=1.0, baud=19200, log=log)
+
+
+def _write(path: Path, buf) -> None:
+    """The recording as a real vehicle's line is recorded: without the emulator's own notes."""
+    path.write_text("".join(ln for ln in buf.getvalue().splitlines(keepends=True) if " ! " not in ln))
+
+
 def session(path: Path, delay: float) -> list:
     """``$OMSTART``; reports every 0.5 s until the first waypoint is 3.0–3.6 m off (on station at
     3 m: reached within a second), ``$OXFLT`` ``delay`` s after that report, then reports for 40 s."""
     buf = io.StringIO()
-    log = WireLogWriter(buf, ("started 2026-11-26T08:00:00.000000Z  port virtual  baud 19200  time_scale 1",))
-    core = EmulatorCore(PROFILE, DirectoryCatalog([builtin_dir()]), start=0.0, time_scale=1.0, baud=19200, log=log)
+    core = _core(buf)
     now = 0.0
     seen = []
 
@@ -72,7 +81,7 @@ def session(path: Path, delay: float) -> list:
         f = osi_fields(send("OSD,S"))
         if f is not None:
             seen.append((f[2], int(f[3]), float(f[7])))
-    path.write_text("".join(ln for ln in buf.getvalue().splitlines(keepends=True) if " ! " not in ln))
+    _write(path, buf)
     return seen
 
 

@@ -1,8 +1,8 @@
 """The generated sequences: a hypothesis state machine whose every step acts on both vehicles.
 
 :func:`machine` builds a ``RuleBasedStateMachine`` like the exploration's
-(:mod:`helmcheck.certify.vehicle.explore`, whose strategies it imports): each sequence starts
-with the verified reset on both sides (``$OMSTOP,0`` until ``S``, then ``$OLOGL`` and
+(:mod:`helmcheck.certify.vehicle.explore`; the strategies are :mod:`~helmcheck.certify.vehicle.generate`'s):
+each sequence starts with the verified reset on both sides (``$OMSTOP,0`` until ``S``, then ``$OLOGL`` and
 ``$OMLOAD``, and the test mission started or not), then each rule sends the same line to A and
 B (a valid command, a remote-control command, one mutation of a valid line, ``$OXFLT``) or lets
 the same vehicle time pass, polls both, and compares what the profile pins (:mod:`.view`).
@@ -36,7 +36,7 @@ from typing import Callable, Optional
 from hypothesis import strategies as st
 from hypothesis.stateful import RuleBasedStateMachine, initialize, precondition, rule
 
-from ..vehicle.explore import control_commands, invalid_lines, valid_commands
+from ..vehicle.generate import control_commands, invalid_lines, valid_commands
 from ..vehicle.flow import LinkLost
 from ..vehicle.interpreter import context, fill, raw_line
 from ..vehicle.session import frame

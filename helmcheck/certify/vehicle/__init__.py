@@ -13,8 +13,13 @@ entry point is :func:`.runner.certify`. Modules, one concern each:
   steps); :mod:`.steps` — their step vocabulary; :mod:`.interpreter` — runs a case's steps.
 * :mod:`.session` — runs steps against a vehicle: verified reset, send, poll, timed waits.
 * :mod:`.flow` — how a case stops early (flow control, never a verdict).
-* :mod:`.explore` — hypothesis sequences of valid and invalid commands, shrunk on failure.
-* :mod:`.replay` — version-independent replay files: write, read, re-drive.
+* :mod:`.explore` — hypothesis sequences aimed at the model (:mod:`.machine`: the rules and
+  episodes), shrunk on failure, within a budget
+  in wall and vehicle seconds; :mod:`.generate` — what they draw (every claimed command at its
+  range edges and error codes, every mutation of a line); :mod:`.modelcover` — what of the
+  model they reached (rows, interrupt pairs, timer boundaries, error codes).
+* :mod:`.replay` — version-independent replay files: write, read, re-drive from the verified
+  reset, naming the step that failed or went another way.
 * :mod:`.clockrate` — the vehicle's clock rate from ``$GPRMC`` readings, and whether it is the
   declared time scale (sans-IO); :mod:`.clockprobe` reads the clock at start.
 * :mod:`.restore` — leaving the vehicle as it was found: its settings and its mode.

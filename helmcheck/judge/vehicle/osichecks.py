@@ -397,7 +397,9 @@ class OsiChecks:
         # does not sit at that distance long enough to be watched)
         near = d <= prof.on_station_m
         depth = osi_depth_m(osi, prof.depth_unit)
-        if m.phase == "ascent" and depth is not None and depth <= prof.gps_fix_depth_m:
+        if m.phase == "ascent" and m.mode != "M" and depth is not None and depth <= prof.gps_fix_depth_m:
+            # (an $OMP accepted in the ascent holds the vehicle: the surface is reached, and acted
+            # on, when the primitive ends — the model defers it; nothing is watched in M)
             key = ("surface", osi.mode)
             clause, what = ("RH-SAF-4",), f"at the surface ({depth:g} m) without its SafetyAction"
         elif m.phase != "none" or not near:
