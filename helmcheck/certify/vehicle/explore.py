@@ -76,8 +76,10 @@ class Budget(NamedTuple):
     vehicle_s: float
 
 
-#: Examples asked of hypothesis at a time (:func:`explore`).
+#: Examples asked of hypothesis at a time (:func:`explore`), and the share of the time given to
+#: the batches whose sequences wait for nothing (:func:`.machine.machine`, ``deep=False``).
 BATCH = 8
+SHALLOW_SHARE = 0.4
 
 #: name -> :class:`Budget`
 PROFILES = {"fast": Budget(400, 40, 30.0, 1500.0), "patient": Budget(8, 10, 900.0, 600.0)}
@@ -169,7 +171,8 @@ def explore(run) -> None:
     state = _State(run, budget)
     state.examples = examples
     state.progress = run.progress
-    factory0 = machine(state, p, timeouts(run.session.k, p.timeout_range))
+    tos = timeouts(run.session.k, p.timeout_range)
+    kinds = (machine(state, p, tos, deep=False), machine(state, p, tos, deep=True))
     db = DirectoryBasedExampleDatabase(str(run.dir / ".hypothesis"))
     session = run.session
     session.note(f"exploration: {examples} examples of up to {steps} steps, budget {budget.wall_s:g} s wall "
@@ -183,12 +186,19 @@ def explore(run) -> None:
                                                          on_poll and on_poll())
     try:
         # in batches: hypothesis runs its examples to the end even when the budget is spent (each
-        # still drawing its steps), so the exploration asks for BATCH at a time until it is spent
+        # still drawing its steps), so the exploration asks for BATCH at a time until it is spent;
+        # the batches take turns by time: sequences that wait for nothing (many lines each, the
+        # one-step paths) get SHALLOW_SHARE of it, those with the episodes that wait out timers,
+        # parks and the lockout the rest
         done = 0
         batch = 0
+        spent_by = [0.0, 0.0]  # wall seconds spent on the shallow and the deep batches
         while done < examples and not state.spent and outcome == "pass":
             n = min(BATCH, examples - done)
-            factory = factory0 if o.seed is None else seed(o.seed * 1000 + batch)(factory0)
+            deep = spent_by[1] * (1 - SHALLOW_SHARE) <= spent_by[0] * SHALLOW_SHARE  # the kind behind its share
+            kind = kinds[deep]
+            factory = kind if o.seed is None else seed(o.seed * 1000 + batch)(kind)
+            b0 = time.monotonic()
             cfg = settings(max_examples=n, stateful_step_count=steps, deadline=None, database=db,
                            suppress_health_check=list(HealthCheck), report_multiple_bugs=False, print_blob=False,
                            phases=(Phase.explicit, Phase.reuse, Phase.generate, Phase.shrink))
@@ -199,6 +209,7 @@ def explore(run) -> None:
                     outcome = type(e).__name__
                 else:
                     state.tester_error(e)
+            spent_by[deep] += time.monotonic() - b0
             done += n
             batch += 1
         if outcome == "pass" and state.failures:  # found, and the budget ran out while shrinking

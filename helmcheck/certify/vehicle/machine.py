@@ -41,7 +41,7 @@ class VehicleFailure(AssertionError):
 
 #: Vehicle seconds ahead within which a timer's deadline is waited for (:meth:`boundary`), and
 #: the longest a sequence waits for the mission to reach its park.
-HORIZON_V = 40.0
+HORIZON_V = 25.0
 PARK_WITHIN_V = 120.0
 
 
@@ -61,9 +61,12 @@ def _reach_park(session, ctx: dict) -> None:
     _here(session, ctx)
 
 
-def machine(state, p, tos):
+def machine(state, p, tos, deep: bool = True):
     """The ``RuleBasedStateMachine`` class of one exploration: ``state`` is shared by its
-    instances (the exploration's budget, counts, coverage and smallest failure)."""
+    instances (the exploration's budget, counts, coverage and smallest failure). ``deep=False``:
+    the rules that wait for protocol time (timers, parks, the lockout) are off and the mission
+    park is no start — cheap sequences, many lines each, for the one-step paths of the model
+    (every command and error code in ``S`` and ``N``, every mutation of a line)."""
     session = state.run.session
     cov = state.coverage
     obs = session.obs
@@ -136,6 +139,8 @@ def machine(state, p, tos):
         @initialize(start=st.sampled_from(["S", "S", "S", "N", "N", "N", "N", "P"]))
         def start(self, start):
             """From a verified reset, traced: the replay of a failure begins here (:mod:`.replay`)."""
+            if start == "P" and not deep:
+                start = "N"
             self.mission = start != "S"
             self.timed = start == "P"
             if not self.active:
@@ -225,6 +230,7 @@ def machine(state, p, tos):
                     cov.command(met, sent.expected)
             self._guard(go)
 
+        @precondition(lambda self: deep)
         @rule(v=st.sampled_from([0.5, 1.0, 2.0, 5.0]))
         def wait_a_while(self, v):
             def go():
@@ -236,7 +242,7 @@ def machine(state, p, tos):
         def poll(self):
             self._guard(lambda: (session.poll(), _here(session, self.ctx)))
 
-        @precondition(lambda self: self.timed)
+        @precondition(lambda self: deep and self.timed)
         @rule(side=st.sampled_from(["before", "after", "after"]))
         def boundary(self, side):
             """Land a report just before the next model timer's deadline, or poll across it until the
@@ -281,7 +287,7 @@ def machine(state, p, tos):
                 cov.boundary(got[2], "after")
                 _here(session, self.ctx)
 
-        @precondition(lambda self: self.mission)
+        @precondition(lambda self: deep and self.mission)
         @rule(first=control_commands(speed, motor, short), then=st.one_of(control_commands(speed, motor, short),
                                                                        st.sampled_from(["OJW,{wp_other}",
                                                                                         "OMW,Clr", "OMSTOP,0"])),
@@ -301,7 +307,7 @@ def machine(state, p, tos):
                     self._settle_next("remote")
             self._guard(go)
 
-        @precondition(lambda self: self.mission)
+        @precondition(lambda self: deep and self.mission)
         @rule(then=st.one_of(control_commands(speed, motor, short), st.sampled_from(["OJW,{wp_other}", "OMW,Clr"])))
         def interrupt_park(self, then):
             """The mission park interrupted, the interruption let run out (RH-INT-2, RH-PK-3)."""
@@ -317,7 +323,7 @@ def machine(state, p, tos):
                 self._settle_next()
             self._guard(go)
 
-        @precondition(lambda self: self.mission)
+        @precondition(lambda self: deep and self.mission)
         @rule(body=control_commands(speed, motor, short), refresh=st.booleans())
         def timed_control(self, body, refresh):
             """A control bracketed at its timeout; ``refresh``: the same control sent again halfway,
@@ -333,7 +339,7 @@ def machine(state, p, tos):
                 self._settle_next()
             self._guard(go)
 
-        @precondition(lambda self: oxflt and self.faults == 0)
+        @precondition(lambda self: deep and oxflt and self.faults == 0)
         @rule(code=st.sampled_from(["Sle", "Sop", "Sed"]), inside=commands(p, tos, "motion"),
               after=st.one_of(control_commands(speed, motor, tos), commands(p, tos, "navigation")),
               dive=st.booleans())
@@ -367,7 +373,7 @@ def machine(state, p, tos):
                 _here(session, self.ctx)
             self._guard(go)
 
-        @precondition(lambda self: self.mission)
+        @precondition(lambda self: deep and self.mission)
         @rule()
         def mission_park(self):
             """Get the running mission to its park (then the other rules interrupt it)."""
@@ -385,7 +391,7 @@ def machine(state, p, tos):
             from .interpreter import run_step
             self._guard(lambda: run_step(session, SetRoundTrip(setting), self.ctx) if mode() == "S" else None)
 
-        @precondition(lambda self: oxflt and self.faults == 0)
+        @precondition(lambda self: deep and oxflt and self.faults == 0)
         @rule(code=st.sampled_from(["Sle", "Sop", "Sed"]))
         def fault(self, code):
             """A safety violation (RH-SAF-5): one per sequence; the lockout and the ascent follow."""
