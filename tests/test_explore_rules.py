@@ -31,6 +31,7 @@ from hypothesis.errors import FlakyFailure, FlakyStrategyDefinition
 from helmcheck.cli import main as cli_main
 from helmcheck.emulator.core import EmulatorCore
 from helmcheck.certify.vehicle import explore as explore_mod
+from helmcheck.certify.vehicle import machine as machine_mod
 from helmcheck.certify.vehicle import replay as replay_mod
 from helmcheck.certify.vehicle.runner import Options, certify
 from helmcheck.grammar import sentences as s
@@ -186,7 +187,7 @@ def _boom(*_a, **_k):
 
 def test_a_tester_error_inside_the_exploration_ends_the_run_2_with_its_traceback(tmp_path, capsys,
                                                                                  monkeypatch):
-    monkeypatch.setattr(explore_mod, "context", _boom)  # every example's start calls it
+    monkeypatch.setattr(machine_mod, "context", _boom)  # every example's start calls it
     rdir = tmp_path / "r"
     with serve(lambda start: make_core(None, K, start)) as port:
         code = cli_main(["certify", "vehicle", "--port", port, "--time-scale", str(K), "--report-dir", str(rdir),
@@ -200,7 +201,7 @@ def test_a_tester_error_inside_the_exploration_ends_the_run_2_with_its_traceback
     assert m, lines[0]
     assert Path(m.group(1)) == rdir / "tester-error.txt"
     text = (rdir / "tester-error.txt").read_text()
-    assert "Traceback" in text and "_boom" in text and "explore.py" in text, text
+    assert "Traceback" in text and "_boom" in text and "machine.py" in text, text
     r = load_results(rdir)
     assert r["partial"] and r["verdict"] == "inconclusive", (r["verdict"], r["verdict_reason"])
     assert "tester error" in r["verdict_reason"].lower() and "tester-error.txt" in r["verdict_reason"], \

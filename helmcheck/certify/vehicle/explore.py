@@ -195,7 +195,7 @@ def explore(run) -> None:
         spent_by = [0.0, 0.0]  # wall seconds spent on the shallow and the deep batches
         while done < examples and not state.spent and outcome == "pass":
             n = min(BATCH, examples - done)
-            deep = spent_by[1] * (1 - SHALLOW_SHARE) <= spent_by[0] * SHALLOW_SHARE  # the kind behind its share
+            deep = spent_by[1] * SHALLOW_SHARE < spent_by[0] * (1 - SHALLOW_SHARE)  # behind its share; shallow first
             kind = kinds[deep]
             factory = kind if o.seed is None else seed(o.seed * 1000 + batch)(kind)
             b0 = time.monotonic()

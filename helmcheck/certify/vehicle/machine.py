@@ -47,12 +47,18 @@ PARK_WITHIN_V = 120.0
 
 def _reach_park(session, ctx: dict) -> None:
     """From ``N``: jump to the test mission's park waypoint (once it is known) and poll until ``P``,
-    at most :data:`PARK_WITHIN_V`; a vehicle that is not there by then is left where it is (the
-    observer judges every report on the way; no tester note: the exploration needs no state)."""
+    when the vehicle can get there within :data:`PARK_WITHIN_V` at the speed it reports (at least
+    half a knot); else, or when it is not there by then, it is left where it is (the observer
+    judges every report on the way; no tester note: the exploration needs no state)."""
     entry = session.obs.missions.entry(session.profile.mission)
     wp = entry.park_waypoint if entry is not None else None
     if wp is not None and session.obs.state().mission_wp != wp:
         session.exchange(frame(f"OJW,{wp + session.profile.waypoint_base}"))
+    osi = session.poll()
+    mps = max(0.5, float(osi.speed or 0)) * 0.514444
+    if osi.mode != "N" or float(osi.distance or 0) / mps > PARK_WITHIN_V:
+        _here(session, ctx)
+        return
     end = session.now() + PARK_WITHIN_V / session.k
     while session.now() < end:
         if session.poll().mode != "N":
