@@ -239,7 +239,7 @@ def test_exploration_counts_only_the_sequences_that_ran(tmp_path):
     assert ex["budget_spent"] is True, ex
     assert 0 < ex["ran"] < 500, ex
     notes = [r.note for r in read_records(open(tmp_path / "r" / "wire.log", "rb")) if r.dir == "!"]
-    assert any(f"exploration: {ex['ran']} sequence(s) ran; the 1 s budget was spent" in n for n in notes), notes
+    assert any(f"exploration: {ex['ran']} sequence(s) ran; the 1 s wall budget was spent" in n for n in notes), notes
     stops = sum(1 for raw in _sent_lines(tmp_path / "r" / "wire.log") if raw.startswith(b"$OMSTOP,0*"))
     assert stops >= ex["ran"], (stops, ex)  # every counted sequence began with its reset
 

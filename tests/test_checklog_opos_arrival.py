@@ -15,6 +15,8 @@ from __future__ import annotations
 import io
 from pathlib import Path
 
+import pytest
+
 from helmcheck.checklog.checker import check_log
 from helmcheck.emulator.core import EmulatorCore
 from helmcheck.emulator.missionfile import DirectoryCatalog, builtin_dir
@@ -80,3 +82,56 @@ def test_an_opos_that_puts_a_submerged_vehicle_on_its_waypoint_is_not_a_violatio
     verdicts = {c["id"]: (c["verdict"], c["reason"]) for c in out.clauses}
     assert verdicts["RH-POS-2"][0] != "fail", verdicts["RH-POS-2"]
     assert verdicts["RH-OUT-4"][0] != "fail", verdicts["RH-OUT-4"]
+
+
+def surfacing_session(path: Path, delay: float) -> list:
+    """The mission dives, ``$OMSTOP``: the vehicle floats up; a report every 0.2 s until it is
+    just under the GPS-fix depth, then ``$OPOS`` 110 m away ``delay`` s later — when it may have
+    reached the surface (a fix: not applied) or not (applied) — then reports for 10 s."""
+    buf = io.StringIO()
+    log = WireLogWriter(buf, ("started 2026-11-26T08:00:00.000000Z  port virtual  baud 19200  time_scale 1",))
+    core = EmulatorCore(DEFAULT, DirectoryCatalog([builtin_dir()]), start=0.0, time_scale=1.0, baud=19200, log=log)
+    now = 0.0
+    seen = []
+
+    def send(body: str) -> bytes:
+        out = core.feed(frame(body), now)
+        for _ in range(40):
+            wake = core.next_wakeup()
+            if wake is None or wake > now + 0.2:
+                break
+            out += core.tick(wake)
+        return out
+
+    send("OMSTART,0,0,0,0,conformance.mis,")
+    while now < 300 and float(osi_fields(send("OSD,S"))[15]) < 1.0:
+        now += 0.5
+    send("OMSTOP,0")
+    fix = DEFAULT.gps_fix_depth_m
+    while now < 400:
+        now += 0.2
+        f = osi_fields(send("OSD,S"))
+        seen.append((round(now, 1), float(f[15])))
+        if fix < float(f[15]) <= fix + 0.1:
+            break
+    now += delay
+    send(f"OPOS,{float(f[4]) + 0.001:.6f},{float(f[5]):.6f},0,,")
+    seen.append(("OPOS", delay))
+    end = now + 10.0
+    while now < end:
+        now += 0.5
+        f = osi_fields(send("OSD,S"))
+        seen.append((round(now, 1), float(f[15])))
+    path.write_text("".join(ln for ln in buf.getvalue().splitlines(keepends=True) if " ! " not in ln))
+    return seen
+
+
+@pytest.mark.parametrize("delay", [0.2, 0.6, 1.0, 1.5])
+def test_an_opos_while_the_vehicle_crosses_the_gps_fix_depth_is_not_a_violation(tmp_path, delay):
+    """RH-POS-2 with RH-RD-10: the last report before the ``$OPOS`` shows the vehicle just under
+    the GPS-fix depth and rising; by the ``$OPOS`` it may have a fix (and leave the position) or
+    not yet (and apply it): a conforming vehicle either way."""
+    seen = surfacing_session(tmp_path / "wire.log", delay)
+    out = check_log(tmp_path / "wire.log", profile=DEFAULT, role="vehicle")
+    bad = {c["id"]: c["reason"] for c in out.clauses if c["verdict"] == "fail"}
+    assert not bad, (bad, seen[-12:])

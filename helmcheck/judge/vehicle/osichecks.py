@@ -60,6 +60,8 @@ __all__ = ["OsiChecks"]
 
 _KN = 1852.0 / 3600.0
 #: Metres below which an ``$OPOS`` position cannot be told from where the vehicle already was.
+#: The fastest a vehicle rises or sinks (m/s), for the GPS-fix depth a report does not settle (RH-RD-10).
+_VERTICAL_MPS = 1.0
 _POS_DECIDABLE_M = 30.0
 #: Reports away from the park position kept per ``$OPK`` (the latest; enough to time a count).
 _AWAY_KEPT = 32
@@ -196,7 +198,8 @@ class OsiChecks:
         if last is None or not rec:
             return
         self.pos = {"applied": rec[-1].position_applied, "lat": float(item.lat), "lon": float(item.lon),
-                    "prev": (float(last.lat), float(last.lon)), "prev_t": o.last_osi_t, "t": p.t_ack}
+                    "prev": (float(last.lat), float(last.lon)), "prev_t": o.last_osi_t, "t": p.t_ack,
+                    "depth": osi_depth_m(last, o.profile.depth_unit)}
 
     def _octd(self, p, ev: list) -> None:
         if self.ct is None:
@@ -280,6 +283,14 @@ class OsiChecks:
         apart = distance_m(*prev, *target)
         if apart < max(_POS_DECIDABLE_M, 3 * allow):
             return  # the two readings cannot be told apart
+        fix, d0, d1 = o.profile.gps_fix_depth_m, pos["depth"], osi_depth_m(osi, o.profile.depth_unit)
+        if d0 is not None and d1 is not None:
+            # RH-RD-10: whether the vehicle had a fix when the $OPOS came is known from the reports
+            # on either side of it; one that crossed the GPS-fix depth between them, or was within
+            # the way it can rise or sink in that time of it, may have had either
+            margin = _VERTICAL_MPS * dt_v
+            if (d0 <= fix) != (d1 <= fix) or min(abs(d0 - fix), abs(d1 - fix)) <= margin:
+                return
         near_target = distance_m(*here, *target) <= allow
         near_prev = distance_m(*here, *prev) <= allow
         if pos["applied"]:
