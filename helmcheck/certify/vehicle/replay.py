@@ -39,6 +39,9 @@ from ...reports.atomic import write_text_atomic
 __all__ = ["save_replay", "load_replay", "redrive", "ReplayError", "FORMAT"]
 
 FORMAT = "helmcheck-replay"
+#: Vehicle seconds a re-drive goes on polling after its last step (plus twice the observer's own
+#: slack): the RH-TIM-1 tolerance of a 30 s timer, and then some.
+LINGER_V = 3.0
 
 
 class ReplayError(ValueError):
@@ -137,7 +140,9 @@ def _steps(doc: dict, session, time_scale: Optional[float]) -> tuple[str, str, O
                     diverged.append(f"step {i} ({where['send'].strip()}) went another way: recorded "
                                     f"{st['expect']}, now {now}")
         where["send"] = ""
-        session.finish()  # a line the vehicle left unanswered is judged before the verdict
+        # a line the vehicle left unanswered, and a transition that comes late by more than its
+        # tolerance, are judged before the verdict
+        session.finish(LINGER_V + 2 * session.obs.slack_v())
     except CaseStop as f:
         at = f"step {where['i'] + 1} of {len(steps)} ({where['send'].strip() or 'a wait'})"
         why = f"at {at}: {f.reason}" + (f"; first, {diverged[0]}" if diverged else "")

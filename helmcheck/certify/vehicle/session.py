@@ -156,10 +156,12 @@ class Session:
         self.check()
         return sent
 
-    def finish(self) -> None:
+    def finish(self, linger_v: float = 0.0) -> None:
         """Let every line sent so far be settled by the observer — a line answered late or not at
         all, which a ``lazy_silence`` exchange did not wait for, is judged now — then poll once (so
-        that an unanswered line is told from a dead link) and stop on a failure (:meth:`check`)."""
+        that an unanswered line is told from a dead link), go on polling for ``linger_v`` vehicle
+        seconds (a report late by more than a timer's tolerance shows only after it), and stop on a
+        failure (:meth:`check`)."""
         pending = [x for x in self.obs.sent if not x.done]
         if pending:
             size = max(len(x.raw) for x in pending)
@@ -169,6 +171,9 @@ class Session:
                 self.link.next(hard)
             self.poll()
         self.check()
+        if linger_v > 0:
+            self.wait(linger_v)
+            self.check()
 
     def _probe(self, after: float) -> None:
         """A command got no ACK in time: does the vehicle still answer anything? (an ``$OSD,S``
