@@ -35,7 +35,7 @@ from ...judge.timing import JITTER_S
 from ...profile import Profile
 from .steps import RAW_KINDS
 
-__all__ = ["commands", "FAMILIES", "control_commands", "invalid_lines", "timeouts", "valid_commands", "osd_requests",
+__all__ = ["commands", "FAMILIES", "EXPLORE_WRITES", "control_commands", "invalid_lines", "timeouts", "valid_commands", "osd_requests",
            "TIMEOUT_CHOICES", "bench_speed", "bench_motor"]
 
 #: Remote-control timeouts the exploration draws from (seconds), before :func:`timeouts` keeps those
@@ -96,7 +96,8 @@ def _omp(p: Profile, motor: int, tos):
     good = st.builds(lambda a, b, m, t: f"OMP,{a}{a}{b}{b}{m},00,{t}", hexb, hexb, mot, tos)
     bad = st.builds(lambda form, t: form.format(t=t),
                     st.sampled_from(["OMP,808080808,00,{t}", "OMP,80808080800,00,{t}", "OMP,8080G08080,00,{t}",
-                                     "OMP,8080808080,01,{t}", "OMP,8080808080,00", "OMP,8080,00,{t}"]),
+                                     "OMP,8080808080,01,{t}", "OMP,8080808080,10,{t}", "OMP,8080808080,00",
+                                     "OMP,8080,00,{t}"]),
                     _timeouts_edges(p, tos))
     return st.one_of(good, bad)
 
@@ -124,8 +125,10 @@ def _omw(p: Profile, spd):
 
 
 def _mission_names():
+    """The test mission, and names a vehicle must refuse: not there, an absolute path, a drive
+    letter, a ``..`` component (RH-MSN-1, RH-RD-6), empty."""
     return st.sampled_from(["{mission}", "{mission}", "helmcheck-missing.mis", "../{mission}", "/{mission}",
-                            "C:{mission}", ""])
+                            "C:{mission}", "sub/../../{mission}", "..\\{mission}", ""])
 
 
 def osd_requests(p: Profile):
@@ -144,9 +147,19 @@ def _log():
     return st.one_of(ologl, ologd)
 
 
+#: The settings the exploration writes (``$ORWSET``): the run reads them first and writes back what
+#: it found (:mod:`.restore`).
+EXPLORE_WRITES = ("Sle", "Sop", "Sed")
+
+
 def _orwset():
-    return st.sampled_from(["ORWSET,Sle,R", "ORWSET,Sop,R", "ORWSET,Sed,R", "ORWSET,SafetyAction,R",
-                            "ORWSET,Bogus,R", "ORWSET,Sle,W,2,5", "ORWSET,SafetyAction,W,1,dive", "ORWSET"])
+    """Reads of the settings, writes of a state and a value then read back by a later draw (RH-SET-2;
+    the run writes back what it found, :mod:`.restore`), and lines a vehicle must refuse."""
+    write = st.builds(lambda name, state, value: f"ORWSET,{name},W,{state},{value}",
+                      st.sampled_from(EXPLORE_WRITES), st.sampled_from(["0", "1"]), st.integers(1, 9))
+    return st.one_of(write, st.sampled_from([
+        "ORWSET,Sle,R", "ORWSET,Sop,R", "ORWSET,Sed,R", "ORWSET,SafetyAction,R", "ORWSET,Bogus,R",
+        "ORWSET,Sle,W,2,5", "ORWSET,SafetyAction,W,1,dive", "ORWSET", "ORWSET,Sle,R,1"]))
 
 
 def _opos(spd):

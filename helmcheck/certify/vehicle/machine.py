@@ -21,7 +21,7 @@ from hypothesis.stateful import RuleBasedStateMachine, initialize, precondition,
 
 from ...model.timers import tolerance
 from .flow import CaseStop, LinkLost
-from .generate import bench_motor, bench_speed, commands, control_commands, invalid_lines
+from .generate import EXPLORE_WRITES, bench_motor, bench_speed, commands, control_commands, invalid_lines
 from .interpreter import _here, context, fill, raw_line
 from .safety import BenchSafetyRefused
 from .session import frame
@@ -116,7 +116,7 @@ def machine(state, p, tos, deep: bool = True):
                 state.skipped += 1
 
         def _guard(self, fn):
-            if not self.active:
+            if not self.active or state.which_spent is not None:  # the budget ends the sequence here too
                 return
             try:
                 fn()
@@ -391,7 +391,7 @@ def machine(state, p, tos, deep: bool = True):
             self._guard(go)
 
         @precondition(lambda self: not self.mission and "ORWSET" in claimed)
-        @rule(setting=st.sampled_from(["Sle", "Sop", "Sed"]))
+        @rule(setting=st.sampled_from(EXPLORE_WRITES))
         def write_then_read(self, setting):
             """RH-SET-2: write a changed state and value, read it back; the original written back."""
             from .interpreter import run_step

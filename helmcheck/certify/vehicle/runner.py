@@ -60,6 +60,7 @@ from .flow import LinkLost, LinkSilent
 from .interpreter import run_case
 from .link import TesterLink
 from .progress import Progress
+from .generate import EXPLORE_WRITES
 from .restore import Custodian, written_settings
 from .resume import Resumed, resume_into
 from .safety import BenchSafetyRefused
@@ -138,7 +139,10 @@ class Run(ExecChild):
         self.session: Optional[Session] = None
         self.stats: dict = {}
         self.child = None  #: the vehicle under test, when helmcheck started it (a Launcher)
-        self.custodian = Custodian(written_settings(select_cases(opts.select, self.p)))
+        writes = written_settings(select_cases(opts.select, self.p))
+        if opts.explore and opts.examples != 0 and "ORWSET" in self.p.commands:
+            writes += [x for x in EXPLORE_WRITES if x not in writes]  # read first, written back at the end
+        self.custodian = Custodian(writes)
         self.resumed: Optional[Resumed] = None
         if opts.resume:
             self.resumed = resume_into(self)
