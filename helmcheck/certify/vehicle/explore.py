@@ -18,9 +18,10 @@ rules. What the sequences reached of the model is counted (:mod:`.modelcover`) a
 
 Each example starts from a verified reset (with ``$OLOGL`` and ``$OMLOAD`` in ``S`` so that the
 observer knows the log labels and the loaded mission), then starts the test mission or reaches
-its park if drawn — all of it recorded — and ends with a verified reset of its own, inside the
-example: a lockout or a park it set going is judged within it, never in the next one, so the
-replay of a failure holds everything from the reset that led to it.
+its park if drawn — all of it recorded from the reset on (the reset itself is not: a replay
+begins with one of its own) — and ends with a verified reset of its own, inside the example: a
+lockout or a park it set going is judged within it, never in the next one, so the replay of a
+failure holds everything from the reset that led to it.
 
 Shrinking re-runs candidates against the live vehicle. The run keeps the smallest failing
 sequence it saw and saves that as a version-independent replay file (:mod:`.replay`), whatever
@@ -112,7 +113,6 @@ class _State:
         self.failures = 0
         self.lost: Optional[str] = None
         self.error: Optional[Exception] = None  #: the first tester error (module docstring)
-        self.dirty = False  #: the last example ended on a failure, before its closing reset
         self.coverage = ModelCoverage(run.p)
 
     @property

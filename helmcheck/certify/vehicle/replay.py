@@ -89,6 +89,7 @@ def redrive(doc: dict, session, time_scale: Optional[float] = None) -> tuple[str
     when it was recorded (where the vehicle's state went another way)."""
     from .flow import CaseStop
 
+    session.mark = session.ledger.mark()
     try:
         stop, session.stop_on_fail = session.stop_on_fail, False
         try:
@@ -96,7 +97,11 @@ def redrive(doc: dict, session, time_scale: Optional[float] = None) -> tuple[str
         finally:
             session.stop_on_fail = stop
     except CaseStop as f:
-        return "inconclusive", f"the verified reset before the steps failed: {f.reason}", None
+        if f.outcome != "fail" and not session.failures():
+            return "inconclusive", f"the verified reset before the steps failed: {f.reason}", None
+    got = session.failures()
+    if got:  # a vehicle that breaks the profile in every reply already does in the reset
+        return "fail", f"already in the verified reset before the steps: {got[0][0]}: {got[0][1]}", got[0][0]
     session.mark = session.ledger.mark()
     # the line pace the sequence was recorded at: an exploration does not sit out the window of a
     # line the vehicle must discard (the observer settles it later, :meth:`Session.finish`)

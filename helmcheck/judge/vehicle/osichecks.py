@@ -231,6 +231,12 @@ class OsiChecks:
             self.oxflt = None
             if judged and osi.error_state == code:
                 o.ledger.passed("RH-SAF-5", f"$OXFLT,{code} raised the violation at once, with no ACK", ev, p.case)
+            elif not judged and osi.error_state in ("N", ""):
+                # no state a conforming vehicle may be in explains a report with no code after it:
+                # the violation was not raised (what else the report shows is booked by the mirror)
+                o.book("fail", ("RH-SAF-5",), f"the first report after $OXFLT,{code} shows no safety code "
+                                              f"(field 8 {osi.error_state or 'empty'}): the violation was not raised",
+                       ev, at=p)
         elif judged and shown_before == "N" and osi.error_state not in ("N", ""):
             # raised by the vehicle itself (its own rule, a sensor): judged like any other (RH-SAF-5)
             o.ledger.passed("RH-SAF-5", f"the vehicle raised {osi.error_state} by itself (no $OXFLT) and "
