@@ -27,7 +27,7 @@ from .safety import BenchSafetyRefused
 from .session import frame
 from .steps import SetRoundTrip
 
-__all__ = ["machine", "VehicleFailure", "HORIZON_V", "PARK_WITHIN_V"]
+__all__ = ["machine", "VehicleFailure", "HORIZON_V", "PARK_WITHIN_V", "QUEUE_WITHIN_V"]
 
 
 def _raw(kind: str, body: str, profile) -> bytes:
@@ -43,6 +43,8 @@ class VehicleFailure(AssertionError):
 #: the longest a sequence waits for the mission to reach its park.
 HORIZON_V = 25.0
 PARK_WITHIN_V = 120.0
+#: The longest a sequence follows its queue of waypoints (:meth:`queue`).
+QUEUE_WITHIN_V = 120.0
 
 
 def _reach_park(session, ctx: dict) -> None:
@@ -329,7 +331,7 @@ def machine(state, p, tos, deep: bool = True):
                 self._settle_next()
             self._guard(go)
 
-        @precondition(lambda self: deep and self.mission)
+        @precondition(lambda self: deep)
         @rule(body=control_commands(speed, motor, short), refresh=st.booleans())
         def timed_control(self, body, refresh):
             """A control bracketed at its timeout; ``refresh``: the same control sent again halfway,
@@ -343,6 +345,30 @@ def machine(state, p, tos, deep: bool = True):
                     session.wait(max(0.0, (got[0] / session.k - session.now()) * session.k / 2))
                     send(frame(fill(body, self.ctx)))
                 self._settle_next()
+            self._guard(go)
+
+        @precondition(lambda self: deep and self.mission and "OMW" in claimed)
+        @rule(parks=st.lists(st.sampled_from(["0", "0", "5"]), min_size=1, max_size=3),
+              then=st.sampled_from(["", "", "OMW,Clr", "OMS", "OJW,{wp_other}"]))
+        def queue(self, parks, then):
+            """A queue of waypoints 15 m apart (RH-OMW-2): followed to its end (RH-OMW-4, a park on a
+            waypoint when drawn), or interrupted and released on the way (RH-OMW-5)."""
+            self.timed = True
+
+            def go():
+                for i, park in enumerate(parks):
+                    lat = float(self.ctx["lat"]) + 15.0 * (i + 1) / 111320.0
+                    send(frame(fill(f"OMW,{lat:.6f},{{lon}},2,,15,{speed:g},{park},", self.ctx)))
+                session.poll()
+                if then:
+                    body = fill("OMS,90,2,20,0,{t}" if then == "OMS" else then, {**self.ctx, "t": "5"})
+                    send(frame(body))
+                    self._settle_next()
+                end = session.now() + QUEUE_WITHIN_V / session.k
+                while session.now() < end and mode() == "W":
+                    session.poll()
+                    session.link.sleep(max(session.poll_gap, 0.05))
+                _here(session, self.ctx)
             self._guard(go)
 
         @precondition(lambda self: deep and oxflt and self.faults == 0)
