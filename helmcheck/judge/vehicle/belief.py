@@ -104,6 +104,10 @@ class Beliefs:
         """Feed an answered command (module docstring); ``observed`` is the vehicle's replies."""
         desync = self.desync
         self.arm_v = max(self.arm_v, slack_v)
+        if type(item) is s.OSD:
+            result = self._poll(item, v, slack_v, observed, desync)
+            if result is not None:
+                return result
         options = []
         for c in self.cands:
             options += branches(c, item, v, slack_v, self.catalog)
@@ -141,6 +145,50 @@ class Beliefs:
                     if not self.desync:
                         self.desync = (f"the vehicle answered {brief(observed)} where a conforming "
                                        f"vehicle answers {brief(nominal[1])}")
+        self._after_command(item, observed, v, slack_v, result)
+        return result
+
+    def _poll(self, item: s.OSD, v: float, slack_v: float, observed: list, desync: str
+              ) -> Optional[CommandResult]:
+        """:meth:`command` for an ``$OSD`` that every candidate can only have met in one state:
+        no timer of its model runs by ``v`` or races it (RH-TIM-1), none it already ran does
+        (:func:`~.branches.branches` offers no other side), and an ``$OSD`` changes no state (a
+        row that stays, no phase change; its data are answered by class name). Each candidate
+        then answers it in place — what :func:`~.branches.branches` does on a copy of it, the
+        same state, without copying every candidate at every poll. ``None`` (every candidate
+        as it was) when that does not hold or no answer is the vehicle's: the general path."""
+        cands = self.cands
+        for c in cands:
+            m = c.model
+            due = m.timers.due
+            if due is not None and (due <= v or abs(due - v) <= tolerance(m.timer()[1], slack_v + c.extra_v)):
+                return None
+            if m.checkpoint is not None and c.timed:
+                fired = c.timed[-1]
+                if 0.0 <= v - fired.deadline <= tolerance(fired.duration, slack_v + c.extra_v):
+                    return None
+        got = reply_keys(observed)
+        saved, options, match = [], [], []
+        for c in cands:
+            m = c.model
+            saved.append((m.now, m._pending, m.last_row, len(m.trace)))
+            m.advance(v)
+            before = (m.mode, m.phase)
+            row = m.row_for(item)
+            replies = m.receive(item, v)
+            options.append((c, replies, row, before))
+            if reply_keys(replies) == got:
+                match.append(options[-1])
+        if not match:
+            for c, (now, pending, last_row, n) in zip(cands, saved):
+                m = c.model
+                m.now, m._pending, m.last_row = now, pending, last_row
+                del m.trace[n:]
+            return None
+        base = len(cands[0].story)
+        self._keep([o[0] for o in match])
+        chosen = match[0]
+        result = CommandResult(chosen[1], True, chosen[2], chosen[3], chosen[0].story[base:], False, desync)
         self._after_command(item, observed, v, slack_v, result)
         return result
 
