@@ -111,16 +111,13 @@ class SentenceSpec:
     fields: tuple[FieldSpec, ...]
 
 
-def _decimal(text: str) -> Decimal:
-    return Decimal(text)
-
-
 def _park(text: str) -> int:
     return int(text[1:])
 
 
-#: The converters a field row names (:mod:`.derived`): the text of one terminal -> its value.
-CONVERTERS: dict[str, Callable[[str], Any]] = {"decimal": _decimal, "park": _park, "int": int, "str": str,
+#: The converters a field row names (:mod:`.derived`): the text of one terminal -> its value
+#: (the types themselves where they convert: a builder calls one per field of every line).
+CONVERTERS: dict[str, Callable[[str], Any]] = {"decimal": Decimal, "park": _park, "int": int, "str": str,
                                                 "bool": bool}
 
 
