@@ -44,7 +44,7 @@ from ..facts import ASCENT_REFUSED, LOCKOUT_REFUSED
 from .brackets import bracket, pre_shown, retime
 from .branches import branches
 from .candidate import Candidate
-from .closure import explain_osi, explain_reply, osi_depth_m, reply_keys
+from .closure import explain_osi, explain_reply, osi_depth_m, osi_numbers, reply_keys
 from .sent import brief
 
 __all__ = ["Beliefs", "CommandResult", "OsiResult", "CAP"]
@@ -167,7 +167,7 @@ class Beliefs:
                 fired = c.timed[-1]
                 if 0.0 <= v - fired.deadline <= tolerance(fired.duration, slack_v + c.extra_v):
                     return None
-        got = reply_keys(observed)
+        got = None
         saved, options, match = [], [], []
         for c in cands:
             m = c.model
@@ -177,7 +177,9 @@ class Beliefs:
             row = m.row_for(item)
             replies = m.receive(item, v)
             options.append((c, replies, row, before))
-            if reply_keys(replies) == got:
+            # equal replies have equal keys; only unequal ones need their keys compared
+            if replies == observed or reply_keys(replies) == (got if got is not None else
+                                                              (got := reply_keys(observed))):
                 match.append(options[-1])
         if not match:
             for c, (now, pending, last_row, n) in zip(cands, saved):
@@ -422,7 +424,7 @@ class Beliefs:
     def _plant(self, c: Candidate, osi: s.OSI) -> None:
         """The ``$OSI``'s measured values become the candidate's plant snapshot."""
         m = c.model
-        lat, lon, speed = float(osi.lat), float(osi.lon), float(osi.speed)
+        lat, lon, speed = osi_numbers(osi)[:3]
         depth = osi_depth_m(osi, self.profile.depth_unit)
         if depth is not None and m.phase == "ascent":
             depth = None
