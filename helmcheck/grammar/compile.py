@@ -224,11 +224,15 @@ _init_tables()
 
 # --------------------------------------------------------------------------- fast builders
 
+_TEXT_ITEMS = (str,)  #: the converters of items kept as their text
+
 def _items(f: FieldSpec, text: Optional[str]) -> tuple:
     if not text:
         return ()
-    out = []
     convs = f.item_converts
+    if convs == _TEXT_ITEMS and f.item_regex.groups == 1:
+        return tuple(f.item_regex.findall(text))  # its "" is an absent group's "" below too
+    out = []
     single = len(convs) == 1
     for m in f.item_regex.finditer(text):
         if single:
