@@ -11,7 +11,9 @@ what was adopted to explain the wire), most plausible first (fewest unseen event
   also with its countdown waiting for on station (RH-PK-2: where the vehicle is at the ACK, no
   report settles); before a command that freezes the mission (RH-INT-1) a candidate in ``N`` also
   offers the state where the next waypoint was reached unseen just before it, where it can have
-  got there (:func:`~.closure.reachable`). The candidates whose answer is the vehicle's survive.
+  got there (:func:`~.closure.reachable`); an ``$OSD`` that every candidate can only have met
+  in one state is answered in place, not on copies (it changes no state; ``_poll``). The
+  candidates whose answer is the vehicle's survive.
   When none does, unseen events that change the answer are tried (:func:`~.closure.explain_reply`);
   when that fails too, the answer is a finding, and the observer follows the nominal state marked
   *desynchronised* until a state that is known again (an accepted ``$OMSTOP`` or ``$OMSTART``).
