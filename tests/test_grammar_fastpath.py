@@ -1,15 +1,19 @@
-"""Differential tests: the fast path (regexes compiled from the grammar) and Lark agree."""
+"""Differential tests: the fast path (regexes compiled from the grammar) and Lark agree; the
+``$OSI`` range shortcut and its rule agree."""
 
 from __future__ import annotations
+
+from decimal import Decimal
 
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from hypothesis.extra.lark import from_lark
 
 from helmcheck.grammar import checksum_hex, decode, format
+from helmcheck.grammar import sentences as S
 from helmcheck.grammar.compile import lark_parser
 
-from .strategies import any_sentence
+from .strategies import REPLIES, any_sentence
 
 FIELD_ALPHABET = "0123456789.-,ABCDEFGHIJKLMNOPQRSTUVWXYZabcxyz PCRTD:/\\_"
 
@@ -103,3 +107,26 @@ def test_fast_path_regexes_match_only_clean_bodies():
                 assert _chars_outside(sre_parse.parse(f.item_regex.pattern), allowed) == [], (rule, f.rule)
     assert _chars_outside(sre_parse.parse(r"A[^,a]\s.[^,]"), allowed) == ["NEGATE", "CATEGORY", "ANY", "NOT_LITERAL"]
     assert _chars_outside(sre_parse.parse(r"(?:x|\$)"), allowed) == ["$"]
+
+
+@given(REPLIES[S.OSI], st.data())
+@settings(max_examples=300)
+def test_osi_ranges_shortcut_agrees_with_the_rule(osi, data):
+    # _osi_fine answers True only when the rule finds nothing; check_ranges gives the rule's word
+    from dataclasses import replace
+
+    from helmcheck.grammar.ranges import _RULES, check_ranges
+    from helmcheck.profile import DEFAULT
+
+    field = data.draw(st.sampled_from(["lat", "lon", "speed", "distance", "true_heading", "battery", "mode",
+                                       "actuators", None]))
+    if field is not None:
+        bad = {"lat": Decimal("90.5"), "lon": Decimal("-180.5"), "speed": Decimal("-1"),
+               "distance": Decimal("-0.01"), "true_heading": Decimal("360"), "battery": "x1",
+               "mode": "Mp", "actuators": "b0b0a0a0b8"}[field]
+        osi = replace(osi, **{field: bad})
+    rule = next(iter(_RULES[S.OSI](osi, DEFAULT)), None)
+    got = check_ranges(osi, DEFAULT)
+    assert (got is None) == (rule is None)
+    if rule is not None:
+        assert (got.clause, got.field) == (rule[0], rule[1])

@@ -93,3 +93,29 @@ def test_RH_TIM_1_vehicle_off_by_less_than_tolerance_passes(delay):
         shadow.checkpoints = False
         shadow.advance(t_obs)
         assert expectation(m, t_obs).check(shadow.osi(t_obs)) == [], t_obs
+
+
+@settings(max_examples=150, deadline=None)
+@given(t_obs=st.floats(0.0, 120.0), slack=st.floats(0.0, 3.0), waypoint=st.integers(0, 3),
+       park=st.integers(0, 90), mode=st.sampled_from(["S", "N", "P", "mP", "A", "W"]), shift=st.floats(-5.0, 5.0))
+def test_RH_OUT_4_quick_check_is_the_expectations_check(t_obs, slack, waypoint, park, mode, shift):
+    from helmcheck.model.observe import quick_check, quick_expectation
+    m = servo_model()
+    m.receive(opk(minutes=1), 13.0)
+    m.plant(OnStation(), 15.0)
+    nominal = m.clone()
+    nominal.advance(t_obs + shift)
+    right = nominal.osi(t_obs + shift)
+    for osi in (right, dataclasses.replace(right, mode=mode), dataclasses.replace(right, next_waypoint=waypoint),
+                dataclasses.replace(right, park_time=park)):
+        assert quick_check(m, osi, t_obs, slack) == quick_expectation(m, t_obs, slack).check(osi)
+
+
+def test_plant_snapshot_with_is_dataclasses_replace():
+    from helmcheck.model.plant import PlantSnapshot
+    snap = PlantSnapshot(lat=1.5, battery_pct=50.0)
+    changes = {"lat": 2.0, "lon": -3.0, "speed_kn": 1.25, "depth_m": 4.0}
+    assert snap.with_(**changes) == dataclasses.replace(snap, **changes)
+    assert snap.with_() == snap and snap.with_(lat=9.0).battery_pct == 50.0
+    with pytest.raises(TypeError):
+        snap.with_(no_such_field=1)

@@ -111,16 +111,13 @@ class SentenceSpec:
     fields: tuple[FieldSpec, ...]
 
 
-def _decimal(text: str) -> Decimal:
-    return Decimal(text)
-
-
 def _park(text: str) -> int:
     return int(text[1:])
 
 
-#: The converters a field row names (:mod:`.derived`): the text of one terminal -> its value.
-CONVERTERS: dict[str, Callable[[str], Any]] = {"decimal": _decimal, "park": _park, "int": int, "str": str,
+#: The converters a field row names (:mod:`.derived`): the text of one terminal -> its value
+#: (the types themselves where they convert: a builder calls one per field of every line).
+CONVERTERS: dict[str, Callable[[str], Any]] = {"decimal": Decimal, "park": _park, "int": int, "str": str,
                                                 "bool": bool}
 
 
@@ -227,11 +224,15 @@ _init_tables()
 
 # --------------------------------------------------------------------------- fast builders
 
+_TEXT_ITEMS = (str,)  #: the converters of items kept as their text
+
 def _items(f: FieldSpec, text: Optional[str]) -> tuple:
     if not text:
         return ()
-    out = []
     convs = f.item_converts
+    if convs == _TEXT_ITEMS and f.item_regex.groups == 1:
+        return tuple(f.item_regex.findall(text))  # its "" is an absent group's "" below too
+    out = []
     single = len(convs) == 1
     for m in f.item_regex.finditer(text):
         if single:

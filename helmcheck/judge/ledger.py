@@ -122,6 +122,11 @@ class Ledger:
         lv.count += 1
         if lv.full and (not case or case in e.cases):
             return  # everything kept is full: only the count changes (the common, repeated finding)
+        if (not evidence and type(evidence) in (tuple, list) and (lv.reason or not reason)
+                and (not case or case in e.cases)):
+            # nothing to keep (no evidence, the reason kept, the case known): a count, as below
+            lv.full = bool(lv.evidence and lv.reason and len(lv.lines) >= MAX_LINES)
+            return
         if not lv.reason and reason:
             lv.reason = reason() if callable(reason) else reason
         ev = list(evidence)

@@ -35,7 +35,8 @@ reads it, ``drop_checkpoint()`` forgets it). Shadows start from it.
 Steady state: :func:`steady_expectation` answers without shadows when no checkpoint is held
 and no timer can expire by ``now`` even at its earliest (RH-TIM-1): the one present state, with
 its park time widened by ``slack``. :func:`quick_expectation` tries it first and falls back to
-:func:`expectation` (for observers that ask for every ``$OSI`` of a long log).
+:func:`expectation` (for observers that ask for every ``$OSI`` of a long log); :func:`quick_check`
+is its ``check``, which makes no expectation for a report the steady state explains.
 
 Limits (documented, deliberate): a command that arrives within the tolerance of a timer is
 applied to the nominal state only (the model cannot know which side of the race the vehicle
@@ -52,7 +53,8 @@ from typing import Optional
 from ..grammar import sentences as s
 from .timers import tolerance
 
-__all__ = ["Acceptable", "Expectation", "expectation", "steady_expectation", "quick_expectation"]
+__all__ = ["Acceptable", "Expectation", "expectation", "steady_expectation", "quick_expectation",
+           "quick_check"]
 
 
 @dataclass(frozen=True, slots=True)
@@ -67,10 +69,15 @@ class Acceptable:
     park_hi: int
 
     def matches(self, osi: s.OSI) -> bool:
-        return (osi.mode == self.mode and osi.next_waypoint == self.waypoint
-                and osi.error_state == self.error_state
-                and self.park_lo <= osi.park_time <= self.park_hi
-                and (osi.srp_active is None or osi.srp_active == ("True" if self.srp_active else "False")))
+        return _fits(osi, self.mode, self.waypoint, self.error_state, self.srp_active, self.park_lo, self.park_hi)
+
+
+def _fits(osi: s.OSI, mode: str, waypoint: int, error_state: str, srp_active: bool, park_lo: int,
+          park_hi: int) -> bool:
+    """:meth:`Acceptable.matches` of the state with these fields."""
+    return (osi.mode == mode and osi.next_waypoint == waypoint and osi.error_state == error_state
+            and park_lo <= osi.park_time <= park_hi
+            and (osi.srp_active is None or osi.srp_active == ("True" if srp_active else "False")))
 
 
 @dataclass(frozen=True, slots=True)
@@ -203,6 +210,12 @@ def _timer_near(model, now: float, slack: float) -> bool:
 def steady_expectation(model, now: float, slack: float = 0.0) -> Optional[Expectation]:
     """The :class:`Expectation` at ``now`` when nothing can change before it (module
     docstring), else ``None``."""
+    got = _steady(model, now, slack)
+    return None if got is None else Expectation(now, slack, (Acceptable(*got),))
+
+
+def _steady(model, now: float, slack: float) -> Optional[tuple]:
+    """The fields of the one :class:`Acceptable` of :func:`steady_expectation`, or ``None``."""
     if model.checkpoint is not None or _timer_near(model, now, slack):
         return None
     base = model.now if model.now is not None and model.now > now else now
@@ -214,10 +227,21 @@ def steady_expectation(model, now: float, slack: float = 0.0) -> Optional[Expect
         lo, hi = max(0, math.floor(max(0.0, p - slack))), math.ceil(p + slack)
         lo = min(lo, park)
         hi = max(hi, park)
-    return Expectation(now, slack, (Acceptable(mode, wp, err, srp, lo, hi),))
+    return mode, wp, err, srp, lo, hi
 
 
 def quick_expectation(model, now: float, slack: float = 0.0) -> Expectation:
     """:func:`steady_expectation` when it answers, else :func:`expectation`."""
     exp = steady_expectation(model, now, slack)
     return exp if exp is not None else expectation(model, now, slack)
+
+
+def quick_check(model, osi: s.OSI, now: float, slack: float = 0.0) -> list[tuple[str, str]]:
+    """``quick_expectation(model, now, slack).check(osi)``; a report the one steady state
+    explains (nearly every report of a session) is answered without making the expectation."""
+    got = _steady(model, now, slack)
+    if got is None:
+        return expectation(model, now, slack).check(osi)
+    if _fits(osi, *got):
+        return []
+    return Expectation(now, slack, (Acceptable(*got),)).check(osi)

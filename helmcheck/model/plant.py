@@ -28,7 +28,8 @@ frozen mission (RH-RD-5).
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, fields, replace
+from operator import attrgetter
 from typing import Optional
 
 __all__ = [
@@ -75,7 +76,25 @@ class PlantSnapshot:
     remaining_mission_h: float = 0.0
 
     def with_(self, **changes) -> "PlantSnapshot":
-        return replace(self, **changes)
+        """A copy with ``changes`` (``dataclasses.replace``, without its per-call field walk and
+        the frozen ``__init__``: an observer replaces the snapshot at nearly every report)."""
+        setters = _SNAP_SETTERS
+        if not changes.keys() <= setters.keys():
+            return replace(self, **changes)  # an unknown field: replace's own TypeError
+        new = _new(PlantSnapshot)
+        for put, value in zip(_SNAP_PUTS, _snap_values(self)):
+            put(new, value)
+        for name, value in changes.items():
+            setters[name](new, value)
+        return new
+
+
+_new = object.__new__
+_SNAP_NAMES = tuple(f.name for f in fields(PlantSnapshot))
+_snap_values = attrgetter(*_SNAP_NAMES)
+#: each field's slot setter (the frozen class's own ``__setattr__`` refuses)
+_SNAP_PUTS = tuple(getattr(PlantSnapshot, name).__set__ for name in _SNAP_NAMES)
+_SNAP_SETTERS = dict(zip(_SNAP_NAMES, _SNAP_PUTS))
 
 
 class PlantEvent:

@@ -11,7 +11,9 @@ what was adopted to explain the wire), most plausible first (fewest unseen event
   also with its countdown waiting for on station (RH-PK-2: where the vehicle is at the ACK, no
   report settles); before a command that freezes the mission (RH-INT-1) a candidate in ``N`` also
   offers the state where the next waypoint was reached unseen just before it, where it can have
-  got there (:func:`~.closure.reachable`). The candidates whose answer is the vehicle's survive.
+  got there (:func:`~.closure.reachable`); an ``$OSD`` that every candidate can only have met
+  in one state is answered in place, not on copies (it changes no state; ``_poll``). The
+  candidates whose answer is the vehicle's survive.
   When none does, unseen events that change the answer are tried (:func:`~.closure.explain_reply`);
   when that fails too, the answer is a finding, and the observer follows the nominal state marked
   *desynchronised* until a state that is known again (an accepted ``$OMSTOP`` or ``$OMSTART``).
@@ -44,7 +46,7 @@ from ..facts import ASCENT_REFUSED, LOCKOUT_REFUSED
 from .brackets import bracket, pre_shown, retime
 from .branches import branches
 from .candidate import Candidate
-from .closure import explain_osi, explain_reply, osi_depth_m, reply_keys
+from .closure import explain_osi, explain_reply, osi_depth_m, osi_numbers, reply_keys
 from .sent import brief
 
 __all__ = ["Beliefs", "CommandResult", "OsiResult", "CAP"]
@@ -104,6 +106,10 @@ class Beliefs:
         """Feed an answered command (module docstring); ``observed`` is the vehicle's replies."""
         desync = self.desync
         self.arm_v = max(self.arm_v, slack_v)
+        if type(item) is s.OSD:
+            result = self._poll(item, v, slack_v, observed, desync)
+            if result is not None:
+                return result
         options = []
         for c in self.cands:
             options += branches(c, item, v, slack_v, self.catalog)
@@ -141,6 +147,52 @@ class Beliefs:
                     if not self.desync:
                         self.desync = (f"the vehicle answered {brief(observed)} where a conforming "
                                        f"vehicle answers {brief(nominal[1])}")
+        self._after_command(item, observed, v, slack_v, result)
+        return result
+
+    def _poll(self, item: s.OSD, v: float, slack_v: float, observed: list, desync: str
+              ) -> Optional[CommandResult]:
+        """:meth:`command` for an ``$OSD`` that every candidate can only have met in one state:
+        no timer of its model runs by ``v`` or races it (RH-TIM-1), none it already ran does
+        (:func:`~.branches.branches` offers no other side), and an ``$OSD`` changes no state (a
+        row that stays, no phase change; its data are answered by class name). Each candidate
+        then answers it in place — what :func:`~.branches.branches` does on a copy of it, the
+        same state, without copying every candidate at every poll. ``None`` (every candidate
+        as it was) when that does not hold or no answer is the vehicle's: the general path."""
+        cands = self.cands
+        for c in cands:
+            m = c.model
+            due = m.timers.due
+            if due is not None and (due <= v or abs(due - v) <= tolerance(m.timer()[1], slack_v + c.extra_v)):
+                return None
+            if m.checkpoint is not None and c.timed:
+                fired = c.timed[-1]
+                if 0.0 <= v - fired.deadline <= tolerance(fired.duration, slack_v + c.extra_v):
+                    return None
+        got = None
+        saved, options, match = [], [], []
+        for c in cands:
+            m = c.model
+            saved.append((m.now, m._pending, m.last_row, len(m.trace)))
+            m.advance(v)
+            before = (m.mode, m.phase)
+            row = m.row_for(item)
+            replies = m.receive(item, v)
+            options.append((c, replies, row, before))
+            # equal replies have equal keys; only unequal ones need their keys compared
+            if replies == observed or reply_keys(replies) == (got if got is not None else
+                                                              (got := reply_keys(observed))):
+                match.append(options[-1])
+        if not match:
+            for c, (now, pending, last_row, n) in zip(cands, saved):
+                m = c.model
+                m.now, m._pending, m.last_row = now, pending, last_row
+                del m.trace[n:]
+            return None
+        base = len(cands[0].story)
+        self._keep([o[0] for o in match])
+        chosen = match[0]
+        result = CommandResult(chosen[1], True, chosen[2], chosen[3], chosen[0].story[base:], False, desync)
         self._after_command(item, observed, v, slack_v, result)
         return result
 
@@ -374,7 +426,7 @@ class Beliefs:
     def _plant(self, c: Candidate, osi: s.OSI) -> None:
         """The ``$OSI``'s measured values become the candidate's plant snapshot."""
         m = c.model
-        lat, lon, speed = float(osi.lat), float(osi.lon), float(osi.speed)
+        lat, lon, speed = osi_numbers(osi)[:3]
         depth = osi_depth_m(osi, self.profile.depth_unit)
         if depth is not None and m.phase == "ascent":
             depth = None

@@ -40,7 +40,7 @@ import math
 from dataclasses import dataclass
 from typing import Optional
 
-from ...model.observe import quick_expectation
+from ...model.observe import quick_check
 from ...model.transitions import STAY, Row
 from ...model.vehicle import VehicleModel
 
@@ -194,7 +194,7 @@ class Candidate:
     # ------------------------------------------------------------------ questions
     def check(self, osi, v: float, slack_v: float) -> list[tuple[str, str]]:
         """``[]`` when this candidate explains ``osi`` at ``v`` (RH-OUT-4, RH-TIM-1)."""
-        return quick_expectation(self.model, v, slack_v + self.extra_v).check(osi)
+        return quick_check(self.model, osi, v, slack_v + self.extra_v)
 
     def saw(self, v: float, mode: str) -> None:
         """A confirmed ``$OSI`` showed ``mode``, sent at vehicle time ``v``."""

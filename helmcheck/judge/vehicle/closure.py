@@ -32,6 +32,9 @@ that change an answer: a violation (an unexpected err 26; its code is learnt fro
 ``$OSI``), the mission's end (a command refused for want of a running mission), the surface (a
 command the ascent refuses accepted). Mission names the observer knows nothing about are learnt
 from the vehicle's answer; the answer is then adopted but not judged (``mission_dependent``).
+
+A report's numbers, which these and the report checks (:mod:`.osichecks`) read, are worked out
+here once per report (:func:`osi_numbers`, :func:`osi_depth_m`).
 """
 
 from __future__ import annotations
@@ -46,7 +49,7 @@ from .candidate import Candidate
 from .catalog import UnknownMission, _LearntOpen
 
 __all__ = ["explain_osi", "explain_reply", "same_replies", "reply_keys", "MAX_WAYPOINTS", "osi_depth_m",
-           "reachable"]
+           "osi_numbers", "reachable"]
 
 #: The most mission (or queue) waypoints the observer assumes passed between two reports.
 MAX_WAYPOINTS = 8
@@ -73,10 +76,25 @@ def same_replies(want: list, got: list) -> bool:
 
 
 def osi_depth_m(osi: s.OSI, depth_unit: str) -> Optional[float]:
-    if osi.depth is None:
+    d = osi_numbers(osi)[4]
+    if d is None:
         return None
-    d = float(osi.depth)
     return d * _FT if depth_unit == "ft" else d
+
+
+def osi_numbers(osi: s.OSI) -> tuple:
+    """``(lat, lon, speed, field 7, depth or None)`` of a report as floats, worked out once per
+    report however many checks read them (``float`` of a ``Decimal`` formats and parses it)."""
+    hit = _NUMBERS[0]
+    if hit[0] is osi:
+        return hit[1]
+    got = (float(osi.lat), float(osi.lon), float(osi.speed), float(osi.distance),
+           None if osi.depth is None else float(osi.depth))
+    _NUMBERS[0] = (osi, got)  # one item, replaced whole: the latest report
+    return got
+
+
+_NUMBERS: list = [(None, ())]
 
 
 # =============================================================================== $OSI

@@ -94,6 +94,27 @@ def classify(d: Optional[Decoded], raw: bytes, profile: Profile, discard_clause:
     return Kind("discard", clause=_DISCARD_CLAUSE.get(clause, clause), would_be=_id_type(raw))
 
 
+#: The passes of a valid vehicle sentence, by (class, no findings, $OSI field count): they
+#: depend on nothing else, and a session's lines differ only in their values.
+_PASSES: dict = {}
+
+
+def _passes(sent: s.Sentence, d: Decoded) -> tuple:
+    passes = [("RH-FRM-1", "vehicle sentences are $ID,fields*hh CR LF"),
+              ("RH-FRM-2", "vehicle checksums are right")]
+    if not d.findings:
+        passes.append(("RH-FRM-3", "vehicle checksums are upper-case hex"))
+    if not isinstance(sent, s.ACK):
+        passes.append(("RH-OUT-3", "numeric fields within their physical ranges"))
+        if isinstance(sent, s.OSI):
+            passes.append(("RH-OUT-1", f"$OSI with {sent.field_count} fields"))
+        else:
+            passes.append(("RH-OUT-2", f"${sent.ID} in its format"))
+            if isinstance(sent, s.Compass):
+                passes.append(("RH-FRM-8", "$C has no commas"))
+    return tuple(passes)
+
+
 class OutputJudge:
     """Per-line judgement of the vehicle's output (module docstring)."""
 
@@ -147,23 +168,16 @@ class OutputJudge:
         if isinstance(sent, s.Command):
             led.failed("RH-FRM-1", f"the vehicle sent a command sentence ${sent.ID}", [ev], case)
             return None
-        passes = [("RH-FRM-1", "vehicle sentences are $ID,fields*hh CR LF"),
-                  ("RH-FRM-2", "vehicle checksums are right")]
-        if not d.findings:
-            passes.append(("RH-FRM-3", "vehicle checksums are upper-case hex"))
-        if not isinstance(sent, s.ACK):
-            passes.append(("RH-OUT-3", "numeric fields within their physical ranges"))
-            if isinstance(sent, s.OSI):
-                passes.append(("RH-OUT-1", f"$OSI with {sent.field_count} fields"))
-            else:
-                passes.append(("RH-OUT-2", f"${sent.ID} in its format"))
-                if isinstance(sent, s.Compass):
-                    passes.append(("RH-FRM-8", "$C has no commas"))
+        cls = type(sent)
+        key = (cls, not d.findings, sent.field_count if cls is s.OSI else 0)
+        passes = _PASSES.get(key)
+        if passes is None:
+            passes = _PASSES[key] = _passes(sent, d)
         led.passed_all(passes, [ev], case)
         if d.terminator == "\r\n" and not d.findings and d.raw.isascii():  # judged by its bytes alone
             if len(self._clean) >= LINE_CACHE:
                 self._clean.clear()
-            self._clean[d.raw] = (sent, tuple(passes))
+            self._clean[d.raw] = (sent, passes)
         return sent
 
     def _parity(self, d: Decoded, ev: Evidence, case: str) -> bool:

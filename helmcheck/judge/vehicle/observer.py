@@ -55,6 +55,7 @@ __all__ = ["VehicleObserver", "Sent"]
 _PLANT = {"WaypointReached": P.WaypointReached, "OnStation": P.OnStation,
           "QueueWaypointReached": P.QueueWaypointReached, "AtSurface": P.AtSurface,
           "Submerged": P.Submerged, "SafetyViolation": P.SafetyViolation}
+_new_tuple = tuple.__new__
 _DATA_OF = {"G": "GPRMC", "C": "Compass", "S": "OSI", "P": "OPI", "D": "DVL", "Y": "OYSI", "T": "OCTD",
             "I": "OINS"}
 
@@ -187,14 +188,16 @@ class VehicleObserver(Answers, Deadlines):
         return fr.feed(data)
 
     def _evidence(self, ev: WireEvent, raw: bytes, direction: str) -> Evidence:
+        """The line's :class:`~helmcheck.judge.ledger.Evidence` (made by ``tuple.__new__``, as the
+        wire-log reader makes its records: the named tuple's own ``__new__`` is Python code)."""
         text = self._escaped.get(raw)  # only whole CR LF lines are kept
         if text is not None:
-            return Evidence(ev.t, direction, text, ev.lineno)
-        if raw.endswith(b"\r\n") and b"\n" not in raw[:-1]:
+            return _new_tuple(Evidence, (ev.t, direction, text, ev.lineno))
+        if raw.endswith(b"\r\n") and raw.find(b"\n") == len(raw) - 1:
             if len(self._escaped) >= LINE_CACHE:
                 self._escaped.clear()
             text = self._escaped[raw] = escape(raw[:-2])
-            return Evidence(ev.t, direction, text, ev.lineno)
+            return _new_tuple(Evidence, (ev.t, direction, text, ev.lineno))
         return Evidence(ev.t, direction + "~", escape(raw[:200]), ev.lineno)
 
     def _note(self, ev: WireEvent) -> None:

@@ -53,7 +53,7 @@ from ...model.geo import distance_m
 from ...model.plant import NEUTRAL
 from ...model.timers import tolerance
 from ..timing import JITTER_S, PLANT_REACT_S
-from .closure import osi_depth_m
+from .closure import osi_depth_m, osi_numbers
 from .queuetarget import QueueTarget
 
 __all__ = ["OsiChecks"]
@@ -333,13 +333,13 @@ class OsiChecks:
         # when the report can have been made — the earliest less the observer's slack once more,
         # for the report judged against it (its own time is known only to within that)
         v, late = o.v(p.t) - 2 * o.slack_v(), o.v(t) + o.slack_v()
-        lat, lon, speed = float(osi.lat), float(osi.lon), float(osi.speed)
+        lat, lon, speed, distance, _ = osi_numbers(osi)
         nav = osi.mode in ("N", "P")
         for c in o.beliefs.cands:
             c.fix_seen = (v, late, lat, lon, speed)
             m = c.model
             if nav and m.mission is not None and m.mode == osi.mode and m.mission_wp == osi.next_waypoint:
-                c.nav_seen = (m.mission.name, m.mission_wp, float(osi.distance), v, lat, lon, speed)
+                c.nav_seen = (m.mission.name, m.mission_wp, distance, v, lat, lon, speed)
 
     def _opk_park(self, osi: s.OSI, p, t: float, ev: list) -> None:
         """RH-PK-2 from an ``mP`` report after an accepted ``$OPK`` (module docstring)."""
@@ -408,7 +408,7 @@ class OsiChecks:
         o = self.o
         prof = o.profile
         key = None
-        d = float(osi.distance)
+        d = osi_numbers(osi)[3]
         # RH-RD-5: on station means within on_station_m, inclusive, judged on field 7 as reported (a
         # vehicle that stopped 2.996 m away reports 3.00 and is on station; one still approaching
         # does not sit at that distance long enough to be watched)

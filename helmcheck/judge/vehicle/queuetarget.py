@@ -28,6 +28,7 @@ from typing import Optional
 
 from ...grammar import sentences as s
 from ...model.geo import distance_m
+from .closure import osi_numbers
 
 __all__ = ["QueueTarget", "allowance"]
 
@@ -62,13 +63,14 @@ class QueueTarget:
     def report(self, osi: s.OSI, model, v_early: float, v_late: float, ev: list, case: str, book) -> None:
         """One judged ``$OSI``, made between vehicle times ``v_early`` and ``v_late``, with the
         mirror's most plausible ``model``; ``book(verdict, clauses, reason)`` books a finding."""
-        before, self.last = self.last, (v_early, float(osi.lat), float(osi.lon))
+        lat, lon = osi_numbers(osi)[:2]
+        before, self.last = self.last, (v_early, lat, lon)
         if osi.mode != "W" or model.mode != "W" or model.phase != "none" or not model.queue or model.queue_parking:
             self.key = None
             return
         queue = model.queue
         key = (model.control_generation, queue[0])
-        here = (float(osi.lat), float(osi.lon))
+        here = (lat, lon)
         if key != self.key:  # a new queue: it set out from where the last report saw it
             self.key, self.index, self.seen = key, 0, before
         mps = max(self.max_speed_kn, float(osi.speed)) * _KN
