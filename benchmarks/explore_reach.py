@@ -30,6 +30,24 @@ sys.path.insert(0, str(ROOT))
 SELECT = "RH-POS-1"
 
 
+def _other_choices():
+    from helmcheck.emulator.freedoms import EmulatorSettings
+    return EmulatorSettings(reply_delay_s=(0.0, 0.15), seed=3, control_tick_s=0.2, timer_factor=1.02,
+                            speed_factor=1.25, turn_rate_dps=25.0, ascent_mps=0.6,
+                            decimals=(("lat", 7), ("lon", 7), ("speed", 1), ("distance", 0)), idle_distance="last",
+                            osi_reserved=("x", "y", "z"), start_battery_pct=80.0)
+
+
+def _slow_choices():
+    from helmcheck.emulator.freedoms import EmulatorSettings
+    return EmulatorSettings(reply_delay_s=(0.1, 0.5), seed=5, timer_factor=0.98, speed_factor=0.8,
+                            turn_rate_dps=8.0, ascent_mps=0.15, buoyancy_rise_mps=0.05, start_heading=350.0)
+
+
+#: Conforming emulators with other freedoms than the reference one's: they must get no FAIL.
+FREEDOMS = {"conforming-freedoms": _other_choices, "conforming-slow": _slow_choices}
+
+
 def _replay(path: Path, port: str) -> int:
     """``helmcheck replay`` of one saved replay on a fresh vehicle: its exit status (1: fails again)."""
     import contextlib
@@ -44,9 +62,18 @@ def _emulator_case(name: str, seed: int, k: float, budget: float | None) -> dict
     from helmcheck.certify.vehicle.runner import Options, certify
     from tests.faulty_vehicles import EMU_PROFILE, MUTANTS, make_core, serve
 
-    mutant = next((m for m in MUTANTS if m.name == name), None) if name != "conforming" else None
+    mutant = next((m for m in MUTANTS if m.name == name), None)
+
+    def core(start):
+        if name in FREEDOMS:  # a conforming vehicle that takes other freedoms (docs/freedoms.md)
+            from helmcheck.emulator.core import EmulatorCore
+            from helmcheck.emulator.missionfile import DirectoryCatalog, builtin_dir
+            return EmulatorCore(EMU_PROFILE.replace(time_scale=k), DirectoryCatalog([builtin_dir()]), start=start,
+                                time_scale=k, baud=115200, settings=FREEDOMS[name]())
+        return make_core(mutant, k, start)
+
     with tempfile.TemporaryDirectory() as tmp:
-        with serve(lambda start: make_core(mutant, k, start)) as port:
+        with serve(core) as port:
             opts = Options(port=port, profile=EMU_PROFILE.replace(time_scale=k), time_scale=k,
                            report_dir=Path(tmp) / "r", select=[SELECT], progress=False, render=False, seed=seed,
                            explore_budget_s=budget)
@@ -54,7 +81,7 @@ def _emulator_case(name: str, seed: int, k: float, budget: float | None) -> dict
         r = _summary(name, mutant.clause if mutant else "", out.results, "emulator")
         codes = []
         for rel in r["replays"]:  # each on a fresh instance of the same vehicle
-            with serve(lambda start: make_core(mutant, k, start)) as port:
+            with serve(core) as port:
                 codes.append(_replay(Path(tmp) / "r" / rel, port))
         r["replayed"] = codes
         return r
@@ -92,7 +119,7 @@ def _summary(name: str, clause: str, results: dict, family: str) -> dict:
     failed = sorted(c["id"] for c in results["clauses"] if c["verdict"] == "fail")
     ex = (results.get("stats") or {}).get("explore") or {}
     if not clause:
-        outcome = "false-fail" if failed else "clean"
+        outcome = "false-fail" if failed else "clean"  # a conforming configuration
     elif clause in failed:
         outcome = "own"
     elif failed:
@@ -107,7 +134,8 @@ def _summary(name: str, clause: str, results: dict, family: str) -> dict:
 
 def cases(only: list[str]) -> list[tuple]:
     from tests.faulty_vehicles import MUTANTS
-    out = [("emulator", "conforming")] + [("emulator", m.name) for m in MUTANTS]
+    out = ([("emulator", "conforming")] + [("emulator", n) for n in FREEDOMS]
+           + [("emulator", m.name) for m in MUTANTS])
     try:
         from tests.test_third_party_vehicle import CAUGHT_ON, SIM
         if SIM.is_file():

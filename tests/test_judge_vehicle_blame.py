@@ -261,3 +261,22 @@ def test_RH_INT_2_driven_near_the_waypoint_under_remote_control_and_reaching_it_
     v = judge(tmp_path, rec)
     assert failed(v) == set(), {c: v[c]["reason"] for c in failed(v)}
     assert verdict(v, "RH-INT-2") == "pass"
+
+
+# ============================================================ RH-INT-1: one remote control takes over from another
+
+def test_RH_INT_1_an_OMP_refused_under_servo_control_is_booked_on_RH_INT_1(tmp_path):
+    """Under ``$OMS`` control (A) a conforming vehicle accepts ``$OMP`` (any remote command
+    interrupts any other, RH-INT-1); refusing it breaks RH-INT-1 first, not RH-PRM-1 (which says
+    only that ``$OMP`` is accepted from ``S`` too)."""
+    rec = start() + send(1.0, "OMS,90,2,20,1,30", "ACK,9,0,0") + poll(1.5, mode="A", dist=148.0, speed=2.0)
+    rec += send(2.0, "OMP,8080808080,00,10", "ACK,10,1,21") + poll(2.5, mode="A", dist=147.0, speed=2.0)
+    v = judge(tmp_path, rec)
+    assert verdict(v, "RH-INT-1") == "fail", v["RH-INT-1"]
+
+
+def test_RH_PRM_1_an_OMP_refused_in_S_stays_RH_PRM_1(tmp_path):
+    rec = poll(0.0, mode="S") + send(1.0, "OMP,8080808080,00,10", "ACK,10,1,21") + poll(1.5, mode="S")
+    v = judge(tmp_path, rec)
+    assert verdict(v, "RH-PRM-1") == "fail", v["RH-PRM-1"]
+    assert verdict(v, "RH-INT-1") != "fail"

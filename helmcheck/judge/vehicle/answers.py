@@ -170,7 +170,7 @@ class Answers:
             self.event(p.t, "command", text_of(p)[:60])
             if res.before[0] in ("A", "M", "mP", "W") and res.row is not None and res.row.target != "=":
                 self.interrupt_pairs.add((res.before[0], p.kind.item.ID))
-        cands = command_clauses(p.kind.item, want, res.row)
+        cands = command_clauses(p.kind.item, want, res.row, res.before[0])
         if p.kind.variant and a.status == 1 and (want is None or want.status == 0):
             # refused where a conforming vehicle accepts: the form it must still read (RH-FRM-2/3/6/7)
             # first; a wrong answer to a line it did read is about the command, not the form

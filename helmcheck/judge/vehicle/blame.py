@@ -5,7 +5,7 @@ Every finding names an ordered tuple of *candidate* clauses, the most specific f
 * an answered command — :func:`command_clauses`: a malformed command's field clause and RH-ACK-3
   (``$OSD`` letters: RH-OSD-2); a command the table refuses: the refusing row's clauses (the
   precondition and RH-ACK-4, or the lockout's RH-SAF-1/RH-SAF-3); an accepted one: its row's
-  clauses. A value out of range is booked on the clause that sets the range, whether the
+  clauses (RH-INT-1 first when it takes over from another remote control). A value out of range is booked on the clause that sets the range, whether the
   grammar (a field's form: ``$OMP`` field 1 not ten hex digits, a timeout that is not an integer)
   or the range check (``$OMP`` field 2 not ``00``, a timeout of 0) finds it: :data:`FIELD_CLAUSE`
   names that clause for each field whose form or range a vehicle clause sets; a field count, or
@@ -116,8 +116,11 @@ def _dedupe(xs: tuple[str, ...]) -> tuple[str, ...]:
     return tuple(dict.fromkeys(x for x in xs if vehicle_clause(x)))
 
 
-def command_clauses(item, expected_ack: Optional[s.ACK], row) -> tuple[str, ...]:
-    """The clauses an answered command speaks to, most specific first (module docstring)."""
+def command_clauses(item, expected_ack: Optional[s.ACK], row, before_mode: str = "") -> tuple[str, ...]:
+    """The clauses an answered command speaks to, most specific first (module docstring).
+    ``before_mode``: the mode the command met; a command a conforming vehicle accepts there that
+    takes over from another remote control speaks first to RH-INT-1 (any remote command interrupts
+    any other), whatever else its row names."""
     if isinstance(item, SentenceError):
         if expected_ack is not None and expected_ack.err == 26:
             return ("RH-SAF-1",) if row is None else _dedupe(row.clauses)
@@ -128,6 +131,9 @@ def command_clauses(item, expected_ack: Optional[s.ACK], row) -> tuple[str, ...]
     if row is None:
         return ("RH-ACK-1",)
     out = _dedupe(row.clauses)
+    if (before_mode in _REMOTE and "RH-INT-1" in out and row.error is None and row.target != before_mode
+            and (expected_ack is None or expected_ack.status == 0)):
+        out = ("RH-INT-1",) + tuple(c for c in out if c != "RH-INT-1")
     if expected_ack is not None and expected_ack.status == 1 and row.error is None:
         # accepted by the table, refused by a data check (index, count, file, distance): the
         # row's own clause (RH-JW-1, RH-LOG-2, RH-MSN-1/2, RH-PK-1) says what was checked
@@ -135,6 +141,8 @@ def command_clauses(item, expected_ack: Optional[s.ACK], row) -> tuple[str, ...]
     return out or ("RH-ACK-1",)
 
 
+#: The remote-control modes (RH-INT-1).
+_REMOTE = frozenset({"mP", "A", "M", "W"})
 #: Clauses that say only "the report must be consistent": outside a case, a finding on one of
 #: them is booked on its first specific cause too (what the vehicle did wrong to get there).
 GENERIC = frozenset({"RH-OUT-4"})
