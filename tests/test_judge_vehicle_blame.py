@@ -280,3 +280,22 @@ def test_RH_PRM_1_an_OMP_refused_in_S_stays_RH_PRM_1(tmp_path):
     v = judge(tmp_path, rec)
     assert verdict(v, "RH-PRM-1") == "fail", v["RH-PRM-1"]
     assert verdict(v, "RH-INT-1") != "fail"
+
+
+# ============================================================ RH-SAF-1: field 8 in the lockout and after it
+
+def test_RH_SAF_1_a_safety_code_cleared_while_every_explanation_keeps_it_is_booked_on_RH_SAF_1(tmp_path):
+    """After ``$OXFLT`` field 8 shows the code in the lockout (RH-SAF-1) and keeps it after
+    (RH-RD-13, a reading booked on RH-SAF-1); a report with ``N`` there, a few seconds in, breaks
+    RH-SAF-1, not only RH-OUT-4 (the conforming counterpart keeps it and passes)."""
+    from helmcheck.profile import emulator_profile
+
+    def run(err_later: str) -> dict:
+        rec = start() + [(1.0, ">", "OXFLT,Sle")] + poll(1.5, mode="N", dist=149.0, err="Sle", speed=2.0)
+        rec += poll(5.0, mode="N", dist=149.0, err=err_later, speed=2.0)
+        out = check_log(write(tmp_path, rec), profile=emulator_profile(), role="vehicle")
+        return {c["id"]: c for c in out.clauses}
+
+    v = run("N")
+    assert verdict(v, "RH-SAF-1") == "fail", v["RH-SAF-1"]
+    assert verdict(run("Sle"), "RH-SAF-1") != "fail"

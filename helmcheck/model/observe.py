@@ -111,8 +111,10 @@ class Expectation:
         err = [a for a in wp if a.error_state == osi.error_state]
         if not err:
             want = sorted({a.error_state for a in wp})
-            out.append(("RH-OUT-4", f"error state {osi.error_state!r} {at}; expected "
-                                    f"{' or '.join(want)}"))
+            # a safety code every explanation shows, missing or another: field 8 in the lockout and
+            # after it (RH-SAF-1, RH-RD-13)
+            clause = "RH-SAF-1" if "N" not in want else "RH-OUT-4"
+            out.append((clause, f"error state {osi.error_state!r} {at}; expected {' or '.join(want)}"))
             err = wp
         park = [a for a in err if a.park_lo <= osi.park_time <= a.park_hi]
         if not park:

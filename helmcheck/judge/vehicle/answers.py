@@ -286,7 +286,9 @@ class Answers:
         t_from = max(p.t, t - transmit_time(len(evd.text) + 2, self.baud))
         res = self.beliefs.osi(osi, self.v(t_from), self.v(t), self.slack_v())
         if res.findings:
-            cands = ("RH-OUT-4",) + tuple(c for c in res.causes if c != "RH-OUT-4") + self.checks.recent()
+            named = tuple(dict.fromkeys(c for c, _ in res.findings if c != "RH-OUT-4"))  # a field's own clause
+            cands = (("RH-OUT-4",) + named + tuple(c for c in res.causes if c != "RH-OUT-4" and c not in named)
+                     + self.checks.recent())
             msg = res.findings[0][1]
             if res.desync:
                 self.book("inconclusive", cands, f"{msg} — not judged: the observer lost track of the "
