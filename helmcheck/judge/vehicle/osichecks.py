@@ -292,10 +292,11 @@ class OsiChecks:
         fix, d0, d1 = o.profile.gps_fix_depth_m, pos["depth"], osi_depth_m(osi, o.profile.depth_unit)
         if d0 is not None and d1 is not None:
             # RH-RD-10: whether the vehicle had a fix when the $OPOS came is known from the reports
-            # on either side of it; one that crossed the GPS-fix depth between them, or was within
-            # the way it can rise or sink in that time of it, may have had either
+            # on either side of it; one that crossed the GPS-fix depth between them, or was rising
+            # or sinking within the way it can make in that time of it, may have had either
             margin = _VERTICAL_MPS * dt_v
-            if (d0 <= fix) != (d1 <= fix) or min(abs(d0 - fix), abs(d1 - fix)) <= margin:
+            moving = abs(d1 - d0) > 0.02  # a vehicle holding its depth stays on its side of it
+            if (d0 <= fix) != (d1 <= fix) or (moving and min(abs(d0 - fix), abs(d1 - fix)) <= margin):
                 return
         near_target = distance_m(*here, *target) <= allow
         near_prev = distance_m(*here, *prev) <= allow
