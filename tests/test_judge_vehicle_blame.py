@@ -299,3 +299,20 @@ def test_RH_SAF_1_a_safety_code_cleared_while_every_explanation_keeps_it_is_book
     v = run("N")
     assert verdict(v, "RH-SAF-1") == "fail", v["RH-SAF-1"]
     assert verdict(run("Sle"), "RH-SAF-1") != "fail"
+
+
+def test_RH_SAF_4_a_violation_in_S_needs_no_visible_action_at_the_surface(tmp_path):
+    """A violation raised in ``S`` under water: the lockout, the ascent, the surface — and ``S``
+    all along, which is what a conforming vehicle shows (RH-SAF-4's action changes nothing a
+    report shows there): no RH-SAF-4 finding however long it stays."""
+    from helmcheck.profile import emulator_profile
+    rec = poll(0.0, mode="S", depth=0.9) + [(0.5, ">", "OXFLT,Sop")]
+    t = 1.0
+    while t < 40.0:
+        depth = 0.8 if t < 21.0 else max(0.0, 0.8 - (t - 21.0) * 0.3)
+        rec += poll(t, mode="S", err="Sop", depth=depth)
+        t += 0.5
+    out = check_log(write(tmp_path, rec), profile=emulator_profile(), role="vehicle")
+    v = {c["id"]: c for c in out.clauses}
+    assert verdict(v, "RH-SAF-4") != "fail", v["RH-SAF-4"]
+    assert not failed(v), {c: v[c]["reason"] for c in failed(v)}

@@ -415,9 +415,10 @@ class OsiChecks:
         # does not sit at that distance long enough to be watched)
         near = d <= prof.on_station_m
         depth = osi_depth_m(osi, prof.depth_unit)
-        if m.phase == "ascent" and m.mode != "M" and depth is not None and depth <= prof.gps_fix_depth_m:
-            # (an $OMP accepted in the ascent holds the vehicle: the surface is reached, and acted
-            # on, when the primitive ends — the model defers it; nothing is watched in M)
+        if m.phase == "ascent" and m.mode in ("N", "P") and depth is not None and depth <= prof.gps_fix_depth_m:
+            # (the action shows only where a mission was frozen: in S it changes nothing a report
+            # shows, and an $OMP accepted in the ascent holds the vehicle: the model defers the
+            # surface until the primitive ends; neither is watched)
             key = ("surface", osi.mode)
             clause, what = ("RH-SAF-4",), f"at the surface ({depth:g} m) without its SafetyAction"
         elif m.phase != "none" or not near:
