@@ -231,6 +231,17 @@ def machine(state: DiffState, nwp: int, speed: float, motor: int, oxflt: bool, t
             self._do(f"{kind} ${body}",
                      lambda name, ses: ses.exchange(_raw(kind, fill(body, self.ctx[name]), ses.profile)))
 
+        @rule(body=control_commands(speed, motor, tos), then=st.sampled_from(["", "", "OJW,{wp_other}", "OMW,Clr"]))
+        def control_released(self, body, then):
+            """A remote control (then, when drawn, another command), let run out: what each side
+            does at the release is compared (RH-SRV-4, RH-PRM-4, RH-INT-2)."""
+            self._send(f"${body}", body)
+            if then:
+                self._send(f"${then}", then)
+            timeout = float(body.rsplit(",", 1)[-1]) if body.startswith(("OMS", "OMP")) else 5.0
+            v = timeout + 2.0
+            self._do(f"wait {v:g} s", lambda name, ses: ses.wait(v))
+
         @rule(v=st.sampled_from([1.0, 2.0, 5.0, 12.0]))
         def wait_a_while(self, v):
             self._do(f"wait {v:g} s", lambda name, ses: ses.wait(v))
