@@ -106,12 +106,15 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="where results.json, wire.log and the reports go (default: reports/vehicle)")
     p.add_argument("--select", action="append", metavar="IDS",
                    help="clause IDs or globs to certify (RH-SRV-*, RH-ACK-2); comma-separated or repeated")
-    p.add_argument("--examples", type=int, metavar="N", help="hypothesis examples (0: no exploration)")
+    p.add_argument("--examples", type=int, metavar="N",
+                   help="at most N generated sequences, within the budget (0: no exploration; default: the "
+                        "--hypothesis-profile's, fast 400, patient 8)")
     p.add_argument("--seed", type=int, metavar="N", help="hypothesis seed (reproducible sequences)")
     p.add_argument("--strict", action="store_true", help="a SHOULD not met fails the run")
     p.add_argument("--wire-log", metavar="FILE", help="also copy the wire log to FILE")
     p.add_argument("--hypothesis-profile", choices=("fast", "patient"), default=None,
-                   help="fast for emulators (default when K > 1), patient for hardware")
+                   help="the exploration's budget: fast for emulators (30 s wall or 1500 s of vehicle time; "
+                        "default when K > 1), patient for hardware (600 s of vehicle time or 900 s wall)")
     p.add_argument("--no-progress", action="store_true", help="no progress display")
     p.add_argument("--exec", dest="exec_cmd", metavar="CMD",
                    help="start the vehicle under test on the port: CMD is split like a shell line, run "
