@@ -105,6 +105,7 @@ def machine(state, p, tos, deep: bool = True):
             self.mission = False
             self.timed = False
             self.faults = 0
+            self.wrote: set = set()  #: settings written (put back at the end: :meth:`_put_back`)
             if self.active:
                 state.executions += 1
                 if state.progress is not None:
@@ -159,6 +160,10 @@ def machine(state, p, tos, deep: bool = True):
             stop, session.stop_on_fail = session.stop_on_fail, False
             try:
                 session.reset(mission=False)
+                cust = session.custodian  # the settings as the run found them (a failed sequence left its own)
+                for rec in (cust.records.values() if cust is not None else ()):
+                    if rec.written and rec.before is not None:
+                        session.exchange(frame(f"ORWSET,{rec.name},W,{','.join(rec.before)}"))
             except CaseStop:
                 pass
             except LinkLost as e:
@@ -185,6 +190,8 @@ def machine(state, p, tos, deep: bool = True):
             self._guard(go)
 
         def _sent(self, body: str) -> None:
+            if body.startswith("ORWSET,") and ",W," in body:
+                self.wrote.add(body.split(",")[1])
             self.mission = self.mission or body.startswith("OMSTART")
             self.timed = self.timed or body.startswith(("OMS,", "OMP,", "OPK,", "OMW,", "ODVL,"))
 
@@ -421,6 +428,7 @@ def machine(state, p, tos, deep: bool = True):
         def write_then_read(self, setting):
             """RH-SET-2: write a changed state and value, read it back; the original written back."""
             from .interpreter import run_step
+            self.wrote.add(setting)
             self._guard(lambda: run_step(session, SetRoundTrip(setting), self.ctx) if mode() == "S" else None)
 
         @precondition(lambda self: deep and oxflt and self.faults == 0)
@@ -431,12 +439,23 @@ def machine(state, p, tos, deep: bool = True):
             self.timed = True
             self._guard(lambda: session.exchange(frame(f"OXFLT,{code}")) if obs.state().phase == "none" else None)
 
+        def _put_back(self) -> None:
+            """The settings this sequence wrote, written back as the run found them: a setting outlives
+            the verified reset, and the next sequence (and a replay, on a fresh vehicle) must not
+            depend on this one."""
+            cust = session.custodian
+            if cust is None:
+                return
+            for rec in cust.records.values():
+                if rec.name in self.wrote and rec.before is not None:
+                    send(frame(f"ORWSET,{rec.name},W,{','.join(rec.before)}"))
+
         def teardown(self):
             """Back to a verified reset inside the example, so that whatever the example set going (a
-            lockout, a park, a timer) is judged within it and its replay holds all of it."""
+            lockout, a park, a timer, a setting) is judged within it and its replay holds all of it."""
             try:
                 if self.active and not self.failed and not state.spent:
-                    self._guard(lambda: (session.finish(), session.reset(mission=False)))
+                    self._guard(lambda: (session.finish(), session.reset(mission=False), self._put_back()))
             finally:
                 session.trace = None
 
