@@ -164,6 +164,13 @@ def machine(state, p, tos, deep: bool = True):
                 for rec in (cust.records.values() if cust is not None else ()):
                     if rec.written and rec.before is not None:
                         session.exchange(frame(f"ORWSET,{rec.name},W,{','.join(rec.before)}"))
+                # a lockout the mirror still counts (the vehicle's ended sooner: a finding of the
+                # sequence that raised it) is waited out, so this one starts from the same state
+                # on any vehicle
+                end = session.now() + (p.lockout_s * 1.5 + 30.0) / session.k
+                while obs.state().phase == "lockout" and session.now() < end:
+                    session.poll()
+                    session.link.sleep(max(session.poll_gap, 0.05))
             except CaseStop:
                 pass
             except LinkLost as e:

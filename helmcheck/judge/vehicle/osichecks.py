@@ -227,13 +227,14 @@ class OsiChecks:
         self._way_made(osi, p, t)
         self._opk_park(osi, p, t, ev)
         if self.oxflt is not None:
-            code, _ = self.oxflt
+            code, t_ox = self.oxflt
             self.oxflt = None
             if judged and osi.error_state == code:
                 o.ledger.passed("RH-SAF-5", f"$OXFLT,{code} raised the violation at once, with no ACK", ev, p.case)
-            elif not judged and osi.error_state in ("N", ""):
-                # no state a conforming vehicle may be in explains a report with no code after it:
-                # the violation was not raised (what else the report shows is booked by the mirror)
+            elif not judged and osi.error_state in ("N", "") and o.v(t) - o.v(t_ox) < o.profile.lockout_s:
+                # no state a conforming vehicle may be in explains a report with no code after it,
+                # within the lockout it would have started: the violation was not raised (what else
+                # the report shows is booked by the mirror)
                 o.book("fail", ("RH-SAF-5",), f"the first report after $OXFLT,{code} shows no safety code "
                                               f"(field 8 {osi.error_state or 'empty'}): the violation was not raised",
                        ev, at=p)
