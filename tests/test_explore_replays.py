@@ -44,7 +44,7 @@ def test_an_exploration_finding_replays_on_a_fresh_vehicle(name, tmp_path, capsy
     doc = json.loads(path.read_text())
     assert doc["version"] == 2 and doc["start"] == "verified-reset"
     sent = [st["send"] for st in doc["steps"] if "send" in st]
-    assert sent[0].startswith("$OMSTOP,0*"), sent[:3]  # from the verified reset on
+    assert sent[0].startswith("$OLOGL,"), sent[:3]  # what the sequence sent after its verified reset
     if name == "lockout-10s":
         assert any(x.startswith("$OXFLT,") for x in sent), sent  # the violation that set it going
     capsys.readouterr()
