@@ -12,65 +12,38 @@ vehicle's line is recorded) and checked as ``check-log`` checks one.
 
 from __future__ import annotations
 
-import io
 from pathlib import Path
 
 import pytest
 
 from helmcheck.checklog.checker import check_log
-from helmcheck.emulator.core import EmulatorCore
-from helmcheck.emulator.missionfile import DirectoryCatalog, builtin_dir
-from helmcheck.grammar import checksum_hex
-from helmcheck.grammar.wirelog import WireLogWriter
 from helmcheck.profile import DEFAULT
+from tests.virtual_vehicle import VirtualVehicle, osi_fields
 
 PARK_WP = (41.522698, -71.320000)  # conformance.mis waypoint 1 (a 300 s mission park)
-
-
-def frame(body: str) -> bytes:
-    return f"${body}*{checksum_hex(body)}\r\n".encode()
-
-
-def osi_fields(data: bytes):
-    for line in data.split(b"\r\n"):
-        if line.startswith(b"$OSI,"):
-            return line[1:line.index(b"*")].decode().split(",")
-    return None
 
 
 def session(path: Path, *, fix_metres: float) -> list:
     """Drive the emulator to the park waypoint; ``$OPOS`` ``fix_metres`` south of it when the
     vehicle reports 4.5–6 m to go. Returns the reports' (mode, waypoint, distance)."""
-    buf = io.StringIO()
-    log = WireLogWriter(buf, ("started 2026-11-25T08:00:00.000000Z  port virtual  baud 19200  time_scale 1",))
-    core = EmulatorCore(DEFAULT, DirectoryCatalog([builtin_dir()]), start=0.0, time_scale=1.0, baud=19200, log=log)
+    vv = VirtualVehicle(DEFAULT)
+    send = vv.send
     seen = []
-    now, sent_fix, after = 0.0, False, None
-
-    def send(body: str) -> bytes:
-        nonlocal now
-        out = core.feed(frame(body), now)
-        for _ in range(40):  # the answer's bytes at the line's pace
-            wake = core.next_wakeup()
-            if wake is None or wake > now + 0.2:
-                break
-            out += core.tick(wake)
-        return out
+    sent_fix, after = False, None
 
     send("OMSTART,0,0,0,0,conformance.mis,")
-    while now < 600 and (after is None or now < after):
-        now += 0.5
+    while vv.now < 600 and (after is None or vv.now < after):
+        vv.now += 0.5
         f = osi_fields(send("OSD,G,C,S"))
         if f is None:
             continue
         mode, wp, dist = f[2], int(f[3]), float(f[7])
         seen.append((mode, wp, dist))
         if not sent_fix and mode == "N" and wp == 1 and 4.5 <= dist <= 6.0:
-            now += 0.02
+            vv.now += 0.02
             send(f"OPOS,{PARK_WP[0] - fix_metres / 111_320:.6f},{PARK_WP[1]:.6f},2.0,30.71,9.0")
-            sent_fix, after = True, now + 5.0
-    # a recording of a real vehicle's line has none of the emulator's own notes (plant, model)
-    path.write_text("".join(ln for ln in buf.getvalue().splitlines(keepends=True) if " ! " not in ln))
+            sent_fix, after = True, vv.now + 5.0
+    vv.write(path)  # without the emulator's own notes, as a real vehicle's line is recorded
     return seen
 
 
@@ -88,41 +61,30 @@ def surfacing_session(path: Path, delay: float) -> list:
     """The mission dives, ``$OMSTOP``: the vehicle floats up; a report every 0.2 s until it is
     just under the GPS-fix depth, then ``$OPOS`` 110 m away ``delay`` s later — when it may have
     reached the surface (a fix: not applied) or not (applied) — then reports for 10 s."""
-    buf = io.StringIO()
-    log = WireLogWriter(buf, ("started 2026-11-26T08:00:00.000000Z  port virtual  baud 19200  time_scale 1",))
-    core = EmulatorCore(DEFAULT, DirectoryCatalog([builtin_dir()]), start=0.0, time_scale=1.0, baud=19200, log=log)
-    now = 0.0
+    vv = VirtualVehicle(DEFAULT)
+    send = vv.send
     seen = []
 
-    def send(body: str) -> bytes:
-        out = core.feed(frame(body), now)
-        for _ in range(40):
-            wake = core.next_wakeup()
-            if wake is None or wake > now + 0.2:
-                break
-            out += core.tick(wake)
-        return out
-
     send("OMSTART,0,0,0,0,conformance.mis,")
-    while now < 300 and float(osi_fields(send("OSD,S"))[15]) < 1.0:
-        now += 0.5
+    while vv.now < 300 and float(osi_fields(send("OSD,S"))[15]) < 1.0:
+        vv.now += 0.5
     send("OMSTOP,0")
     fix = DEFAULT.gps_fix_depth_m
-    while now < 400:
-        now += 0.2
+    while vv.now < 400:
+        vv.now += 0.2
         f = osi_fields(send("OSD,S"))
-        seen.append((round(now, 1), float(f[15])))
+        seen.append((round(vv.now, 1), float(f[15])))
         if fix < float(f[15]) <= fix + 0.1:
             break
-    now += delay
+    vv.now += delay
     send(f"OPOS,{float(f[4]) + 0.001:.6f},{float(f[5]):.6f},0,,")
     seen.append(("OPOS", delay))
-    end = now + 10.0
-    while now < end:
-        now += 0.5
+    end = vv.now + 10.0
+    while vv.now < end:
+        vv.now += 0.5
         f = osi_fields(send("OSD,S"))
-        seen.append((round(now, 1), float(f[15])))
-    path.write_text("".join(ln for ln in buf.getvalue().splitlines(keepends=True) if " ! " not in ln))
+        seen.append((round(vv.now, 1), float(f[15])))
+    vv.write(path)  # without the emulator's own notes, as a real vehicle's line is recorded
     return seen
 
 

@@ -12,76 +12,41 @@ and checked as ``check-log`` checks one.
 
 from __future__ import annotations
 
-import io
 from pathlib import Path
 
 import pytest
 
 from helmcheck.checklog.checker import check_log
-from helmcheck.emulator.core import EmulatorCore
-from helmcheck.emulator.missionfile import DirectoryCatalog, builtin_dir
-from helmcheck.grammar import checksum_hex
-from helmcheck.grammar.wirelog import WireLogWriter
 from helmcheck.profile import emulator_profile
+from tests.virtual_vehicle import VirtualVehicle, osi_fields
 
 PROFILE = emulator_profile()
-
-
-def frame(body: str) -> bytes:
-    return f"${body}*{checksum_hex(body)}\r\n".encode()
-
-
-def osi_fields(data: bytes):
-    for line in data.split(b"\r\n"):
-        if line.startswith(b"$OSI,"):
-            return line[1:line.index(b"*")].decode().split(",")
-    return None
-
-
-def _core(buf, profile=PROFILE):
-    log = WireLogWriter(buf, ("started 2026-11-26T08:00:00.000000Z  port virtual  baud 19200  time_scale 1",))
-    return EmulatorCore(profile, DirectoryCatalog([builtin_dir()]), start=0.0, time_scale=1.0, baud=19200, log=log)
-
-
-def _write(path: Path, buf) -> None:
-    """The recording as a real vehicle's line is recorded: without the emulator's own notes."""
-    path.write_text("".join(ln for ln in buf.getvalue().splitlines(keepends=True) if " ! " not in ln))
 
 
 def session(path: Path, delay: float) -> list:
     """``$OMSTART``; reports every 0.5 s until the first waypoint is 3.0–3.6 m off (on station at
     3 m: reached within a second), ``$OXFLT`` ``delay`` s after that report, then reports for 40 s."""
-    buf = io.StringIO()
-    core = _core(buf)
-    now = 0.0
+    vv = VirtualVehicle(PROFILE)
+    send = vv.send
     seen = []
 
-    def send(body: str) -> bytes:
-        out = core.feed(frame(body), now)
-        for _ in range(40):
-            wake = core.next_wakeup()
-            if wake is None or wake > now + 0.2:
-                break
-            out += core.tick(wake)
-        return out
-
     send("OMSTART,0,0,0,0,conformance.mis,")
-    while now < 600:
-        now += 0.5
+    while vv.now < 600:
+        vv.now += 0.5
         f = osi_fields(send("OSD,S"))
         seen.append((f[2], int(f[3]), float(f[7])))
         if f[2] == "N" and int(f[3]) == 0 and 3.0 < float(f[7]) <= 3.6:
             break
-    now += delay
+    vv.now += delay
     send("OXFLT,Sle")
     seen.append(("OXFLT", delay, 0.0))
-    end = now + 40.0
-    while now < end:
-        now += 0.5
+    end = vv.now + 40.0
+    while vv.now < end:
+        vv.now += 0.5
         f = osi_fields(send("OSD,S"))
         if f is not None:
             seen.append((f[2], int(f[3]), float(f[7])))
-    _write(path, buf)
+    vv.write(path)
     return seen
 
 

@@ -226,17 +226,19 @@ def machine(state, p, tos, deep: bool = True):
         def control(self, body):
             self._command(body)
 
+        def _line(self, line) -> None:
+            kind, body = line
+            self._guard(lambda: send(_raw(kind, fill(body, self.ctx), p)))
+
         @rule(line=invalid_lines("framing"))
         def framing(self, line):
             """A line the vehicle must read as written or discard (§1: RH-FRM-2..7)."""
-            kind, body = line
-            self._guard(lambda: send(_raw(kind, fill(body, self.ctx), p)))
+            self._line(line)
 
         @rule(line=invalid_lines("refused"))
         def refused(self, line):
             """A well-framed line the vehicle must refuse, or discard for its ID (RH-ACK-3, RH-FRM-5)."""
-            kind, body = line
-            self._guard(lambda: send(_raw(kind, fill(body, self.ctx), p)))
+            self._line(line)
 
         @rule(bodies=st.lists(st.one_of(commands(p, tos), control_commands(speed, motor, tos)), min_size=2,
                               max_size=3))

@@ -1,0 +1,58 @@
+"""The reference emulator's core driven in virtual time, recorded as a real vehicle's line is.
+
+For tests that need a conforming vehicle in a precise situation (a fix just as it reaches a
+waypoint, a violation just after an unseen arrival): :class:`VirtualVehicle` feeds the core a
+framed command at the present virtual time ``now`` and ticks it until the answer's bytes are out;
+:meth:`VirtualVehicle.write` keeps the wire log without the emulator's own notes (``plant:``,
+model notes), so ``check-log`` has to judge it from the wire alone.
+"""
+
+from __future__ import annotations
+
+import io
+from pathlib import Path
+from typing import Optional
+
+from helmcheck.emulator.core import EmulatorCore
+from helmcheck.emulator.missionfile import DirectoryCatalog, builtin_dir
+from helmcheck.grammar import checksum_hex
+from helmcheck.grammar.wirelog import WireLogWriter
+from helmcheck.profile import Profile
+
+
+def frame(body: str) -> bytes:
+    return f"${body}*{checksum_hex(body)}\r\n".encode()
+
+
+def osi_fields(data: bytes) -> Optional[list]:
+    """The fields of the first ``$OSI`` in ``data`` (index 0 is ``OSI``), or None."""
+    for line in data.split(b"\r\n"):
+        if line.startswith(b"$OSI,"):
+            return line[1:line.index(b"*")].decode().split(",")
+    return None
+
+
+class VirtualVehicle:
+    """The emulator core at 19200 baud, time scale 1, its clock set by hand (``now``)."""
+
+    def __init__(self, profile: Profile):
+        self.buf = io.StringIO()
+        log = WireLogWriter(self.buf, ("started 2026-11-26T08:00:00.000000Z  port virtual  baud 19200  "
+                                       "time_scale 1",))
+        self.core = EmulatorCore(profile, DirectoryCatalog([builtin_dir()]), start=0.0, time_scale=1.0,
+                                 baud=19200, log=log)
+        self.now = 0.0
+
+    def send(self, body: str) -> bytes:
+        """``$body*hh`` at ``now``; the core's answer, its bytes at the line's pace."""
+        out = self.core.feed(frame(body), self.now)
+        for _ in range(40):
+            wake = self.core.next_wakeup()
+            if wake is None or wake > self.now + 0.2:
+                break
+            out += self.core.tick(wake)
+        return out
+
+    def write(self, path: Path) -> Path:
+        path.write_text("".join(ln for ln in self.buf.getvalue().splitlines(keepends=True) if " ! " not in ln))
+        return path
