@@ -8,7 +8,7 @@ budget and a fixed seed, so that a finding on any other clause comes from the ex
 conforming configurations (the emulator, its freedoms, the independent simulator) are certified
 the same way and must get no FAIL.
 
-    .venv/bin/python benchmarks/explore_reach.py [--jobs N] [--seed S] [--only NAME …] [--json OUT]
+    .venv/bin/python benchmarks/explore_reach.py [--jobs N] [--seed S] [--only NAME …] [--json OUT] [--keep DIR]
 
 Prints one line per vehicle (found on its clause / found elsewhere / missed) and the figures.
 """
@@ -28,6 +28,17 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 SELECT = "RH-POS-1"
+KEEP = os.environ.get("HELMCHECK_REACH_KEEP")  #: --keep: a directory to keep each run's reports in
+
+
+def _workdir(family: str, name: str):
+    """Where one vehicle's runs write: a temporary directory, or ``--keep DIR/family-name``."""
+    import contextlib
+    if not KEEP:
+        return tempfile.TemporaryDirectory()
+    d = Path(KEEP) / f"{family}-{name}"
+    d.mkdir(parents=True, exist_ok=True)
+    return contextlib.nullcontext(str(d))
 
 
 def _other_choices():
@@ -72,7 +83,7 @@ def _emulator_case(name: str, seed: int, k: float, budget: float | None) -> dict
                                 time_scale=k, baud=115200, settings=FREEDOMS[name]())
         return make_core(mutant, k, start)
 
-    with tempfile.TemporaryDirectory() as tmp:
+    with _workdir("emulator", name) as tmp:
         with serve(core) as port:
             opts = Options(port=port, profile=EMU_PROFILE.replace(time_scale=k), time_scale=k,
                            report_dir=Path(tmp) / "r", select=[SELECT], progress=False, render=False, seed=seed,
@@ -91,7 +102,7 @@ def _third_party_case(fault: str, seed: int, k: float, budget: float | None) -> 
     import subprocess
 
     from tests.test_third_party_vehicle import BASE, OXFLT, uvc_sim
-    with tempfile.TemporaryDirectory() as tmp:
+    with _workdir("third-party", fault) as tmp:
         t = Path(tmp)
         with uvc_sim(t, k, fault="" if fault == "conforming" else fault) as port:
             prof = t / "profile.toml"
@@ -168,7 +179,12 @@ def main(argv=None) -> int:
     ap.add_argument("--budget", type=float, default=None, help="wall seconds (default: the fast profile's)")
     ap.add_argument("--only", nargs="*", default=[])
     ap.add_argument("--json", type=Path)
+    ap.add_argument("--keep", type=Path, help="keep each vehicle's report directory under this one")
     a = ap.parse_args(argv)
+    if a.keep:
+        os.environ["HELMCHECK_REACH_KEEP"] = str(a.keep.resolve())  # the worker processes read it
+        global KEEP
+        KEEP = os.environ["HELMCHECK_REACH_KEEP"]
     todo = cases(a.only)
     rows = []
     t0 = time.monotonic()

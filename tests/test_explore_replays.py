@@ -21,7 +21,8 @@ from helmcheck.certify.vehicle.runner import Options, certify
 from tests.faulty_vehicles import EMU_PROFILE, MUTANTS, make_core, serve
 
 K = 25.0
-FAULTS = {"lockout-10s": "RH-SAF-1", "opk-kept-after-interrupt": "RH-INT-3"}
+#: fault -> (its clause, the fixed seed the exploration runs at)
+FAULTS = {"lockout-10s": ("RH-SAF-1", 3), "opk-kept-after-interrupt": ("RH-INT-3", 2)}
 
 
 def _mutant(name):
@@ -30,30 +31,34 @@ def _mutant(name):
 
 @pytest.mark.parametrize("name", sorted(FAULTS))
 def test_an_exploration_finding_replays_on_a_fresh_vehicle(name, tmp_path, capsys):
+    """The fault's own clause is among the replays; every replay saved fails again on a fresh
+    instance of the faulty vehicle, naming its clause, and passes on the conforming one."""
     mutant = _mutant(name)
+    own, seed = FAULTS[name]
     with serve(lambda start: make_core(mutant, K, start)) as port:
         out = certify(Options(port=port, profile=EMU_PROFILE.replace(time_scale=K), time_scale=K,
                               report_dir=tmp_path / "r", select=["RH-POS-1"], progress=False, render=False,
-                              seed=2, explore_budget_s=45.0))
+                              seed=seed, explore_budget_s=45.0))
     failed = {c["id"] for c in out.results["clauses"] if c["verdict"] == "fail"}
-    assert failed, out.results["stats"]["explore"]
     replays = out.results["replays"]
-    assert replays and replays[0]["clause"] in failed, replays
-    clause = replays[0]["clause"]
-    path = tmp_path / "r" / replays[0]["file"]
-    doc = json.loads(path.read_text())
-    assert doc["version"] == 2 and doc["start"] == "verified-reset"
-    sent = [st["send"] for st in doc["steps"] if "send" in st]
-    assert sent[0].startswith("$OLOGL,"), sent[:3]  # what the sequence sent after its verified reset
-    if name == "lockout-10s":
-        assert any(x.startswith("$OXFLT,") for x in sent), sent  # the violation that set it going
-    capsys.readouterr()
-    with serve(lambda start: make_core(mutant, K, start)) as port:  # a fresh instance
-        code = cli_main(["replay", str(path), "--port", port])
-    text = capsys.readouterr().out
-    assert code == 1 and text.startswith("STILL FAILS: at step "), text
-    assert clause in text, text
-    with serve(lambda start: make_core(None, K, start)) as port:  # the conforming vehicle
-        code = cli_main(["replay", str(path), "--port", port])
-    text = capsys.readouterr().out
-    assert code == 0 and text.startswith("PASSES NOW"), text
+    assert own in failed and own in {r["clause"] for r in replays}, (replays, out.results["stats"]["explore"])
+    for rep in replays:
+        clause = rep["clause"]
+        assert clause in failed, (clause, failed)
+        path = tmp_path / "r" / rep["file"]
+        doc = json.loads(path.read_text())
+        assert doc["version"] == 2 and doc["start"] == "verified-reset"
+        sent = [st["send"] for st in doc["steps"] if "send" in st]
+        assert sent[0].startswith("$OLOGL,"), sent[:3]  # what the sequence sent after its verified reset
+        if clause == "RH-SAF-1":
+            assert any(x.startswith("$OXFLT,") for x in sent), sent  # the violation that set it going
+        capsys.readouterr()
+        with serve(lambda start: make_core(mutant, K, start)) as port:  # a fresh instance
+            code = cli_main(["replay", str(path), "--port", port])
+        text = capsys.readouterr().out
+        assert code == 1 and text.startswith("STILL FAILS: at step "), text
+        assert clause in text, text
+        with serve(lambda start: make_core(None, K, start)) as port:  # the conforming vehicle
+            code = cli_main(["replay", str(path), "--port", port])
+        text = capsys.readouterr().out
+        assert code == 0 and text.startswith("PASSES NOW"), text

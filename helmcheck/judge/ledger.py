@@ -212,11 +212,18 @@ class Ledger:
     def holding(self) -> bool:
         return self._held is not None
 
-    def release(self, confirmed: bool, why: str) -> None:
+    def release(self, confirmed: bool, why: str, clauses: Iterable[str] = ()) -> None:
         """Book the held violations: as violations when *confirmed*, else INCONCLUSIVE with *why*
-        before their reason. Holding ends."""
-        held, self._held = self._held or [], None
-        for cid, reason, evidence, case in held:
+        before their reason. With *clauses*, only those clauses' (holding goes on for the rest);
+        without, all of them, and holding ends."""
+        held = self._held or []
+        if clauses:
+            only = set(clauses)
+            now = [h for h in held if h[0] in only]
+            self._held = [h for h in held if h[0] not in only] if self._held is not None else None
+        else:
+            now, self._held = held, None
+        for cid, reason, evidence, case in now:
             if confirmed:
                 self._add(cid, FAIL, reason, evidence, case)
             else:

@@ -43,6 +43,8 @@ wire-log format (``docs/contracts.md``):
 ``confirmed: <how>``                        the held violations are booked as violations
 ``unconfirmed: <how>``                      the held violations are INCONCLUSIVE with ``<how>``
                                             (also when the record ends, or resumes, first)
+``confirmed RH-X,RH-Y: <how>``              the same for these clauses' held violations only;
+``unconfirmed RH-X: <how>``                 holding goes on for the others
 ``run resumed: <what>``                     an interrupted run goes on (``--resume``): the
                                             vehicle's state is unknown again; commands left
                                             unanswered at the interruption are not judged
@@ -108,6 +110,7 @@ class Note:
 _CASE = re.compile(r"^case (\S+)(?: ((?:RH-[A-Z]+-\d+ ?)+))?: (.*)$")
 _CASE_END = re.compile(r"^case (\S+) end$")
 _TESTER = re.compile(r"^(not tested|inconclusive) ((?:RH-[A-Z]+-\d+,?)+): (.*)$")
+_RELEASE = re.compile(r"^(confirmed|unconfirmed)(?: ((?:RH-[A-Z]+-\d+,?)+))?: (.*)$")
 _LINK = re.compile(r"^link: (\d+) baud 8N1\b")
 _PLANT = re.compile(r"^plant: (\w+)\((.*?)\)(?: \[[^\]]*\])? at v=([-0-9.eE]+)\s*$")
 _FAULT = re.compile(r"^fault injected \(([^)]*)\): (\w+)\s*$")
@@ -174,10 +177,9 @@ def parse_note(text: str) -> Optional[Note]:
         return Note("aborted", text=text[13:])
     if text.startswith("held: "):
         return Note("held", text=text[6:])
-    if text.startswith("confirmed: "):
-        return Note("confirmed", text=text[11:])
-    if text.startswith("unconfirmed: "):
-        return Note("unconfirmed", text=text[13:])
+    m = _RELEASE.match(text)
+    if m:
+        return Note(m.group(1), clauses=tuple(c for c in (m.group(2) or "").split(",") if c), text=m.group(3))
     if text.startswith("run resumed: "):
         return Note("resumed", text=text[13:])
     return None

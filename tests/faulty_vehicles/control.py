@@ -38,13 +38,16 @@ class ServoResumesS(Model):
 
 
 class OpkKeptAfterInterrupt(Model):
-    """RH-INT-3: a $OPK park interrupted by $OMS comes back when the servo ends."""
+    """RH-INT-3: a $OPK park interrupted by $OMS comes back when the servo ends (that servo's
+    own end: a park a stop or another command put away does not come back later)."""
 
     saved = None
 
     def receive(self, item, now):
         if self.mode == "mP" and isinstance(item, s.OMS):
             self.saved = self.opk
+        elif not isinstance(item, (s.OMS, s.OSD)):
+            self.saved = None
         return super().receive(item, now)
 
     def _release(self, row, now):

@@ -23,9 +23,17 @@ begins with one of its own) — and ends with a verified reset of its own, insid
 lockout or a park it set going is judged within it, never in the next one, so the replay of a
 failure holds everything from the reset that led to it.
 
-Shrinking re-runs candidates against the live vehicle. The run keeps the smallest failing
-sequence it saw and saves that as a version-independent replay file (:mod:`.replay`), whatever
-hypothesis ends with, and re-drives it twice to say whether it fails again. Exploration has a
+Shrinking re-runs candidates against the live vehicle, for at most :data:`SHRINK_SHARE` of the
+budget from a batch's first failure. A finding does not end the exploration: the batches after it
+do not stop at the clauses already found (:attr:`.session.Session.ignore`; their violations are
+still held and booked), so they look on for the others; nor does a sequence stop at a clause its
+starting reset already shows violated (carried over from an earlier sequence). The run keeps the
+smallest failing sequence of each clause, whatever hypothesis ends with, and re-drives each twice
+(the others found not stopped at) to say whether it fails again on its clause, inside its steps:
+2 of 2 books that clause's held violations as violations (``confirmed RH-X: …``) and saves the
+sequence as a version-independent replay file (:mod:`.replay`); fewer books them INCONCLUSIVE
+(``unconfirmed RH-X: …``) and keeps the sequence in ``replays/unconfirmed/`` for people. Held
+violations of no clause found (seen only in a reset between sequences) are INCONCLUSIVE too. Exploration has a
 budget (:data:`PROFILES`: ``fast`` for emulators, ``patient`` for hardware) in wall seconds and in
 vehicle seconds, whichever runs out first; when it is spent, the remaining
 candidates do nothing, so hypothesis finishes quickly — and the report says so: only the
@@ -81,6 +89,9 @@ class Budget(NamedTuple):
 #: the batches whose sequences wait for nothing (:func:`.machine.machine`, ``deep=False``).
 BATCH = 8
 SHALLOW_SHARE = 0.4
+#: The share of the wall budget one finding's shrinking may take (from its first failure); the
+#: exploration then goes on looking for violations of other clauses with the rest.
+SHRINK_SHARE = 0.2
 
 #: name -> :class:`Budget`
 PROFILES = {"fast": Budget(400, 40, 30.0, 1500.0), "patient": Budget(8, 10, 900.0, 600.0)}
@@ -107,7 +118,10 @@ class _State:
         self.k = float(run.session.k)
         self.executions = 0  #: sequences that ran at least their reset
         self.skipped = 0  #: sequences hypothesis asked for after the budget was spent
-        self.best: Optional[dict] = None  #: smallest failing trace so far
+        #: clause -> the smallest failing trace of it so far ({clause, reason, steps}), in the order found
+        self.found: dict[str, dict] = {}
+        self.ignored: frozenset = frozenset()  #: the clauses found before the present batch
+        self.batch_end = self.end  #: when the present batch stops (its shrinking is capped: :meth:`shrink_from`)
         self.examples = 0
         self.progress = None
         self.failures = 0
@@ -132,23 +146,44 @@ class _State:
     def spent(self) -> bool:
         return self.which_spent is not None or self.lost is not None or self.error is not None
 
+    @property
+    def batch_spent(self) -> bool:
+        """The whole budget is spent, or the present batch's share of it."""
+        return self.spent or time.monotonic() > self.batch_end
+
+    def new_batch(self) -> None:
+        self.batch_end = self.end
+
+    def shrink_from(self) -> None:
+        """A failure in the present batch: its shrinking gets :data:`SHRINK_SHARE` of the budget,
+        counted from the batch's first failure, and the batches after it the rest."""
+        if self.batch_end >= self.end:
+            self.batch_end = min(self.end, time.monotonic() + self.budget.wall_s * SHRINK_SHARE)
+
     def tester_error(self, e: Exception) -> None:
         if self.error is None:
             self.error = e
 
 
-def _confirm(run, best: dict) -> int:
-    """Re-drive the smallest failing sequence twice; how many times it failed again."""
-    from .replay import redrive
+def _confirm(run, best: dict, why: Optional[list] = None) -> int:
+    """Re-drive the smallest failing sequence of one clause twice; how many times it failed again
+    on that clause (the other clauses found are not stopped at: :attr:`.session.Session.ignore`)."""
+    from .replay import IN_RESET, redrive
     n = 0
+    session = run.session
     for _ in range(2):
-        try:
-            doc = {"steps": best["steps"], "time_scale": run.k, "lazy_silence": True}
-            verdict, _, _ = redrive(doc, run.session)
-        except LinkLost:
-            raise
-        n += verdict == "fail"
+        doc = {"steps": best["steps"], "time_scale": run.k, "lazy_silence": True}
+        verdict, reason, clause = redrive(doc, session)
+        n += verdict == "fail" and clause in best["also"] and not reason.startswith(IN_RESET)
+        if why is not None:
+            why.append(f"{verdict}: {reason}"[:300])
     return n
+
+
+def _found_clauses(found: dict) -> frozenset:
+    """Every clause the findings so far were booked on (each finding's own and those its
+    observation was booked on too, :meth:`.machine.VehicleMachine._failed`)."""
+    return frozenset(c for f in found.values() for c in f["also"])
 
 
 def explore(run) -> None:
@@ -193,7 +228,10 @@ def explore(run) -> None:
         done = 0
         batch = 0
         spent_by = [0.0, 0.0]  # wall seconds spent on the shallow and the deep batches
-        while done < examples and not state.spent and outcome == "pass":
+        while done < examples and not state.spent:
+            # a clause found is not stopped at again: the sequences look on for the others
+            state.ignored = session.ignore = _found_clauses(state.found)
+            state.new_batch()
             n = min(BATCH, examples - done)
             deep = spent_by[1] * SHALLOW_SHARE < spent_by[0] * (1 - SHALLOW_SHARE)  # behind its share; shallow first
             kind = kinds[deep]
@@ -201,12 +239,13 @@ def explore(run) -> None:
             b0 = time.monotonic()
             cfg = settings(max_examples=n, stateful_step_count=steps, deadline=None, database=db,
                            suppress_health_check=list(HealthCheck), report_multiple_bugs=False, print_blob=False,
-                           phases=(Phase.explicit, Phase.reuse, Phase.generate, Phase.shrink))
+                           phases=(Phase.explicit, *(() if state.found else (Phase.reuse,)), Phase.generate,
+                                   Phase.shrink))
             try:
                 run_state_machine_as_test(factory, settings=cfg)
             except Exception as e:  # noqa: BLE001 - a finding about the vehicle, or a tester error
                 if _vehicle_finding(e, state.failures):
-                    outcome = type(e).__name__
+                    outcome = type(e).__name__ if outcome == "pass" else outcome
                 else:
                     state.tester_error(e)
             spent_by[deep] += time.monotonic() - b0
@@ -216,6 +255,7 @@ def explore(run) -> None:
             outcome = "VehicleFailure"
     finally:
         session.trace = None
+        session.ignore = frozenset()
         session.lazy_silence = False
         session.on_poll = on_poll
         session.end_case()
@@ -239,30 +279,49 @@ def explore(run) -> None:
              f"budget"}.get(which or "wall")
     session.note(f"exploration: {state.executions} sequence(s) ran" +
                  (f"; {clock} was spent before {examples} examples" if spent else ""))
-    if state.best is not None:
-        run.stats["explore"]["found"] = state.best["reason"]
     if state.lost:
         raise LinkLost(state.lost)
-    best = state.best
-    if best is None:
+    if not state.found:
         session.note("confirmed: the exploration found no violation")
         return
-    cid = best["clause"] or best["reason"].split(":", 1)[0]
-    session.begin_case("explore-confirm", (), "the smallest failing sequence, driven again")
+    findings = []
+    session.begin_case("explore-confirm", (), "the smallest failing sequence of each clause found, driven again")
     try:
-        confirmed = _confirm(run, best)
+        for cid, best in state.found.items():
+            session.ignore = _found_clauses(state.found) - set(best["also"])
+            reruns: list = []
+            try:
+                confirmed = _confirm(run, best, reruns)
+            finally:
+                session.ignore = frozenset()
+            session.note(f"{'confirmed' if confirmed == 2 else 'unconfirmed'} {','.join(best['also'])}: reproduced "
+                         f"{confirmed} of 2 re-runs after shrinking")
+            findings.append({"clause": cid, "reason": best["reason"], "confirmed": f"{confirmed}/2",
+                             "flaky": confirmed < 2, "steps": len(best["steps"]), "reruns": reruns})
+        if run.ledger.holding:  # seen in the verified reset between two sequences only: never re-driven
+            session.note("unconfirmed: seen between the exploration's sequences (in a verified reset), "
+                         "not re-driven on its own")
     finally:
         session.end_case()
-    session.note(f"{'confirmed' if confirmed == 2 else 'unconfirmed'}: reproduced {confirmed} of 2 re-runs "
-                 f"after shrinking")
-    flaky = confirmed < 2
-    run.stats["explore"]["confirmed"] = f"{confirmed}/2"
-    if cid not in run.ledger:
-        return
-    n = sum(1 for r in run.results["replays"] if r["clause"] == cid) + 1
-    rel = f"replays/{cid}-{n}.json"
-    save_replay(run.dir / rel, cid, best["reason"], best["steps"], run.k, p)
     from ...reports import results as R
-    R.add_replay(run.results, cid, best["steps"], file=rel)
-    run.stats["explore"]["replay"] = rel
-    run.stats["explore"]["flaky"] = flaky
+    for f in findings:
+        cid = f["clause"]
+        if cid not in run.ledger:
+            continue
+        steps = state.found[cid]["steps"]
+        if f["flaky"]:  # kept for people, but no replay of the clause: it did not fail again twice
+            rel = f"replays/unconfirmed/{cid}.json"
+            save_replay(run.dir / rel, cid, f["reason"], steps, run.k, p)
+            f["unconfirmed_trace"] = rel
+            continue
+        n = sum(1 for r in run.results["replays"] if r["clause"] == cid) + 1
+        rel = f"replays/{cid}-{n}.json"
+        save_replay(run.dir / rel, cid, f["reason"], steps, run.k, p)
+        R.add_replay(run.results, cid, steps, file=rel)
+        f["replay"] = rel
+    ex = run.stats["explore"]
+    ex["findings"] = findings
+    first = findings[0]  # the first clause found, as one line
+    ex.update(found=first["reason"], confirmed=first["confirmed"], flaky=first["flaky"])
+    if first.get("replay"):
+        ex["replay"] = first["replay"]

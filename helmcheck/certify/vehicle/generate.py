@@ -182,6 +182,50 @@ def _start_stop():
     )
 
 
+def _one_off(fmt: str, inside: list, edges: list[list[str]]):
+    """Bodies with every field inside its range but one, which is at an edge or one past it: the
+    field a vehicle gets wrong is then the one the refusal (or acceptance) is about."""
+    def build(i: int):
+        parts = [st.sampled_from(edges[j]) if j == i else inside[j] for j in range(len(inside))]
+        return st.tuples(*parts).map(lambda vals: fmt.format(*vals))
+    return st.integers(0, len(inside) - 1).flatmap(build)
+
+
+def one_field_off(p: Profile, tos) -> st.SearchStrategy[str]:
+    """For each claimed command with ranged fields, a body with one field at an edge of its range
+    or one past it and the rest inside (:func:`_one_off`); ``$OSD`` with every letter the profile
+    serves; ``$OPOS`` a kilometre away (far enough that a report soon after tells whether it was
+    applied, RH-POS-2). Speeds stay within bench safety, so only their lower edge is drawn."""
+    spd = _num(0, bench_speed(p))
+    lo, hi = int(p.timeout_range[0]), int(p.timeout_range[1])
+    t_edges = [str(lo - 1), str(hi + 1)]
+    md = p.max_depth
+    b = p.waypoint_base
+    last = p.mission_waypoints - 1 + b
+    mot = st.integers(0x80, max(0x80, bench_motor(p))).map(lambda m: f"{m:02X}")
+    per = {
+        "OMS": _one_off("OMS,{},{},{},{},{}", [_num(0, 359), _num(0, min(4.0, md)), _num(0, 45, 0), spd, tos],
+                        [["0", "359.9", "-1", "360", "360.5"], ["0", f"{md:g}", "-1", f"{md + 1:g}", f"{md + 0.5:g}"],
+                         ["0", "45", "-1", "46"], ["0"], t_edges]),
+        "OMP": _one_off("OMP,808080{}{},00,{}", [st.just("80"), mot, tos], [["80"], ["80"], t_edges]),
+        "OJW": st.sampled_from([b - 1, b, last, last + 1, last + 1, b + 1 if last > b else b]).map(
+            lambda n: f"OJW,{n}"),
+        "OPK": _one_off("OPK,{},{},{},{}", [st.just("{lat}"), st.just("{lon}"), st.sampled_from(["1", "2"]), spd],
+                        [["{stn_lat}", "{far_lat}", "91", "-91"], ["181", "-181"], ["0", "1440", "1441"], ["0"]]),
+        "OMW": _one_off("OMW,{},{},{},,15,{},{},", [st.just("{near_lat}"), st.just("{lon}"), st.just("2"), spd,
+                                                   st.sampled_from(["0", "5"])],
+                        [["91", "-91"], ["181"], ["-100", "100", "-101", "101"], ["0"], ["86400", "86401"]]),
+        "ODVL": _one_off("ODVL,{},{},{}", [st.just("0.5"), st.just("0"), tos],
+                         [["5", "-5", "5.1", "-5.1"], ["5", "-5", "5.1", "-5.1"], ["0", str(hi), str(hi + 1)]]),
+        "OPOS": _one_off("OPOS,{},{},{},{},{}", [st.just("{km_lat}"), st.just("{lon}"), spd, st.just("35"),
+                                                 st.just("12")],
+                         [["91", "{lat}"], ["181"], ["0"], ["0", "100", "-1", "101"], ["-5", "50", "-6", "51"]]),
+        "OSD": st.permutations(list(p.osd_letters or "S")).map(lambda ls: "OSD," + ",".join(ls)),
+    }
+    claimed = [v for k, v in per.items() if k in p.commands]
+    return st.one_of(*claimed) if claimed else st.just("OSD,S")
+
+
 #: The families :func:`commands` draws from, each a rule of the exploration: the commands that
 #: move the vehicle, those that steer its mission, and those that read or write data.
 FAMILIES = {"motion": ("OMS", "OMP", "ODVL"), "navigation": ("OJW", "OPK", "OMW"),

@@ -54,7 +54,8 @@ def context(session: Session) -> dict:
 
 def _position(ctx: dict, lat: str, lon: str) -> None:
     ctx.update(lat=lat, lon=lon, near_lat=f"{float(lat) + 0.001:.6f}", near_lon=f"{float(lon) + 0.001:.6f}",
-               far_lat=f"{float(lat) + 1.0:.6f}", stn_lat=f"{float(lat) + 15.0 / 111320.0:.6f}")  # 15 m north
+               far_lat=f"{float(lat) + 1.0:.6f}", km_lat=f"{float(lat) + 0.01:.6f}",  # 1.1 km north
+               stn_lat=f"{float(lat) + 15.0 / 111320.0:.6f}")  # 15 m north
 
 
 def _other(session: Session, ctx: dict) -> None:

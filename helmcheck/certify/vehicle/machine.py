@@ -20,8 +20,10 @@ from hypothesis import strategies as st
 from hypothesis.stateful import RuleBasedStateMachine, initialize, precondition, rule
 
 from ...model.timers import tolerance
+from ...judge.vehicle.blame import GENERIC
 from .flow import CaseStop, LinkLost
-from .generate import EXPLORE_WRITES, bench_motor, bench_speed, commands, control_commands, invalid_lines
+from .generate import (EXPLORE_WRITES, bench_motor, bench_speed, commands, control_commands, invalid_lines,
+                       one_field_off)
 from .interpreter import _here, context, fill, raw_line
 from .safety import BenchSafetyRefused
 from .session import frame
@@ -82,6 +84,7 @@ def machine(state, p, tos, deep: bool = True):
     oxflt = p.fault_injection == "oxflt"
     claimed = set(p.commands)
     short = st.sampled_from(list(tos.elements)[:2]) if hasattr(tos, "elements") else tos  # episodes wait these out
+    hi_to = max(tos.elements) if hasattr(tos, "elements") else 30  # a steer that lasts (:meth:`steer_then_read`)
 
     def send(raw: bytes):
         """One line, exchanged, its model coverage counted."""
@@ -96,7 +99,7 @@ def machine(state, p, tos, deep: bool = True):
     class VehicleMachine(RuleBasedStateMachine):
         def __init__(self):
             super().__init__()
-            self.active = not state.spent
+            self.active = not state.batch_spent
             self.ctx: dict = {}
             self.failed = False
             # what this example has sent, for the preconditions: they read only the machine's own
@@ -115,11 +118,11 @@ def machine(state, p, tos, deep: bool = True):
                     except Exception as e:  # noqa: BLE001 - a tester error: kept, raised by explore()
                         state.tester_error(e)
                         self.active = False
-            else:
+            elif state.spent:  # not a shrink candidate past its batch's cap (explore.SHRINK_SHARE)
                 state.skipped += 1
 
         def _guard(self, fn):
-            if not self.active or state.which_spent is not None:  # the budget ends the sequence here too
+            if not self.active or state.batch_spent:  # the budget ends the sequence here too
                 return
             try:
                 fn()
@@ -142,8 +145,16 @@ def machine(state, p, tos, deep: bool = True):
             self.failed = True
             state.failures += 1
             trace = list(session.trace or [])
-            if state.best is None or len(trace) < len(state.best["steps"]):
-                state.best = {"clause": f.clause or "", "reason": f.reason, "steps": trace}
+            cid = f.clause or f.reason.split(":", 1)[0]
+            # the clauses the same observation was booked on (the generic RH-OUT-4 and the cause
+            # it names, blame.targets): the finding is the specific one's, and all go together
+            said = f.reason.split(": ", 1)[-1]
+            also = tuple(dict.fromkeys([cid] + [c for c, r in session.failures() if r == said]))
+            cid = next((c for c in also if c not in GENERIC), cid)
+            best = state.found.get(cid)
+            if best is None or len(trace) < len(best["steps"]):
+                state.found[cid] = {"clause": cid, "also": also, "reason": f.reason, "steps": trace}
+            state.shrink_from()
 
         @initialize(start=st.sampled_from(["S", "S", "S", "N", "N", "N", "N", "P"]))
         def start(self, start):
@@ -158,19 +169,17 @@ def machine(state, p, tos, deep: bool = True):
             # the vehicle does wrong in it was set going before this sequence (whose closing reset
             # finds it, unless that sequence had already failed): it is no finding of this one
             stop, session.stop_on_fail = session.stop_on_fail, False
+            before = session.ledger.mark()
             try:
+                # a lockout the mirror still counts (the vehicle's ended sooner: a finding of the
+                # sequence that raised it) is waited out, so this one starts from the same state
+                # on any vehicle
+                session.outwait_lockout()
                 session.reset(mission=False)
                 cust = session.custodian  # the settings as the run found them (a failed sequence left its own)
                 for rec in (cust.records.values() if cust is not None else ()):
                     if rec.written and rec.before is not None:
                         session.exchange(frame(f"ORWSET,{rec.name},W,{','.join(rec.before)}"))
-                # a lockout the mirror still counts (the vehicle's ended sooner: a finding of the
-                # sequence that raised it) is waited out, so this one starts from the same state
-                # on any vehicle
-                end = session.now() + (p.lockout_s * 1.5 + 30.0) / session.k
-                while obs.state().phase == "lockout" and session.now() < end:
-                    session.poll()
-                    session.link.sleep(max(session.poll_gap, 0.05))
             except CaseStop:
                 pass
             except LinkLost as e:
@@ -179,6 +188,10 @@ def machine(state, p, tos, deep: bool = True):
                 return
             finally:
                 session.stop_on_fail = stop
+            # a clause the reset already shows violated is carried over from an earlier sequence
+            # (whose own closing reset found it): this one does not stop at it, its replay could
+            # not show it on a fresh vehicle
+            session.ignore = state.ignored | {c for c, _ in session.ledger.failures_since(before)}
             session.trace = []
 
             def go():
@@ -252,6 +265,54 @@ def machine(state, p, tos, deep: bool = True):
                 mets = [cov.before(obs.state(), r) for r in raws]
                 for met, sent in zip(mets, session.burst(raws)):
                     cov.command(met, sent.expected)
+            self._guard(go)
+
+        @rule(bodies=st.lists(one_field_off(p, tos), min_size=2, max_size=6), together=st.booleans())
+        def edges(self, bodies, together):
+            """Lines with one field at an edge of its range or one past it, the others inside (§4–6,
+            RH-RD-9): one by one, each ``$OPOS`` between two reports (RH-POS-2: a position applied
+            or not shows at once), or written back to back (RH-ACK-6: a slow command first)."""
+            for b in bodies:
+                self._sent(b)
+
+            def go():
+                if together:
+                    raws = [frame(fill(b, self.ctx)) for b in bodies]
+                    mets = [cov.before(obs.state(), r) for r in raws]
+                    for met, sent in zip(mets, session.burst(raws)):
+                        cov.command(met, sent.expected)
+                    return
+                for b in bodies:
+                    if b.startswith("OPOS,"):
+                        session.poll()
+                    send(frame(fill(b, self.ctx)))
+                    if b.startswith("OPOS,"):
+                        session.poll()
+                _here(session, self.ctx)
+            self._guard(go)
+
+        @rule(heading=st.sampled_from(["359.9", "359", "0", "1", "180", "350"]),
+              letters=st.permutations(list(p.osd_letters or "S")))
+        def steer_then_read(self, heading, letters):
+            """In a running mission: steer to a heading at the wrap of the compass (or south), wait
+            until the vehicle reports it, then ask for every letter (RH-OUT-3: every heading the data
+            sentences show, true and magnetic, is within [0, 360))."""
+            def go():
+                if "OMS" not in claimed or mode() not in ("N", "P", "A"):
+                    return
+                send(frame(f"OMS,{heading},0,20,{min(speed, 1.0):g},{hi_to}"))
+                end = session.now() + HORIZON_V / session.k
+                while session.now() < end:
+                    osi = session.poll()
+                    if osi is None or osi.true_heading is None:  # not shown: read after a while
+                        session.wait(5.0)
+                        break
+                    off = abs((float(osi.true_heading) - float(heading) + 180.0) % 360.0 - 180.0)
+                    if osi.mode != "A" or off <= 2.0:
+                        break
+                    session.link.sleep(max(session.poll_gap, 0.05))
+                send(frame("OSD," + ",".join(letters)))
+                _here(session, self.ctx)
             self._guard(go)
 
         @precondition(lambda self: deep)
@@ -329,6 +390,29 @@ def machine(state, p, tos, deep: bool = True):
                 session.poll()
                 if release:
                     self._settle_next("remote")
+            self._guard(go)
+
+        @precondition(lambda self: deep and self.mission and "OPK" in claimed)
+        @rule(then=st.builds(lambda kind, t: kind.format(t=t), st.sampled_from(
+                  [f"OMS,90,2,20,{min(speed, 1.0):g},{{t}}", f"OMP,80808080{motor:02X},00,{{t}}"]), short),
+              minutes=st.sampled_from(["1", "2"]))
+        def park_interrupted(self, then, minutes):
+            """A ``$OPK`` park interrupted by another control, which is let run out: the park is
+            abandoned, the mission resumes (RH-INT-3, RH-INT-2)."""
+            self.timed = True
+
+            def go():
+                if mode() not in ("N", "P"):
+                    return
+                send(frame(fill(f"OPK,{{stn_lat}},{{lon}},{minutes},{speed:g}", self.ctx)))
+                session.poll()
+                if mode() != "mP":
+                    return
+                send(frame(fill(then, self.ctx)))
+                session.poll()
+                self._settle_next("remote")
+                session.poll()
+                _here(session, self.ctx)
             self._guard(go)
 
         @precondition(lambda self: deep and self.mission)
@@ -463,7 +547,7 @@ def machine(state, p, tos, deep: bool = True):
             """Back to a verified reset inside the example, so that whatever the example set going (a
             lockout, a park, a timer, a setting) is judged within it and its replay holds all of it."""
             try:
-                if self.active and not self.failed and not state.spent:
+                if self.active and not self.failed and not state.batch_spent:
                     self._guard(lambda: (session.finish(), session.reset(mission=False), self._put_back()))
             finally:
                 session.trace = None

@@ -42,6 +42,9 @@ FORMAT = "helmcheck-replay"
 #: Vehicle seconds a re-drive goes on polling after its last step (plus twice the observer's own
 #: slack): the RH-TIM-1 tolerance of a 30 s timer, and then some.
 LINGER_V = 3.0
+#: How a re-drive's reason begins when the vehicle failed before the steps: not a reproduction of
+#: the steps' failure (the exploration does not count it as one, :func:`.explore._confirm`).
+IN_RESET = "already in the verified reset before the steps"
 
 
 class ReplayError(ValueError):
@@ -89,6 +92,14 @@ def redrive(doc: dict, session, time_scale: Optional[float] = None) -> tuple[str
     when it was recorded (where the vehicle's state went another way)."""
     from .flow import CaseStop
 
+    stop, session.stop_on_fail = session.stop_on_fail, False
+    try:  # what an earlier drive left unanswered or running (it stopped at its failure) is its own
+        session.finish()
+        session.outwait_lockout()
+    except CaseStop:
+        pass
+    finally:
+        session.stop_on_fail = stop
     session.mark = session.ledger.mark()
     try:
         stop, session.stop_on_fail = session.stop_on_fail, False
@@ -99,9 +110,9 @@ def redrive(doc: dict, session, time_scale: Optional[float] = None) -> tuple[str
     except CaseStop as f:
         if f.outcome != "fail" and not session.failures():
             return "inconclusive", f"the verified reset before the steps failed: {f.reason}", None
-    got = session.failures()
+    got = [f for f in session.failures() if f[0] not in session.ignore]
     if got:  # a vehicle that breaks the profile in every reply already does in the reset
-        return "fail", f"already in the verified reset before the steps: {got[0][0]}: {got[0][1]}", got[0][0]
+        return "fail", f"{IN_RESET}: {got[0][0]}: {got[0][1]}", got[0][0]
     session.mark = session.ledger.mark()
     # the line pace the sequence was recorded at: an exploration does not sit out the window of a
     # line the vehicle must discard (the observer settles it later, :meth:`Session.finish`)

@@ -9,7 +9,7 @@ the clause on this vehicle: INCONCLUSIVE with that reason, never PASS.
 Templates in step text: ``{mission}`` the profile's mission, ``{speed}`` a speed within the
 bench-safety limit, ``{motor}`` a motor byte within it, ``{lat}``/``{lon}`` the vehicle's last
 reported position, ``{near_lat}``/``{near_lon}`` a point ~110 m north/east of it, ``{far_lat}`` one
-~111 km north, ``{wp_last}``/``{wp_bad}`` the last and one-past-the-last waypoint number,
+~111 km north, ``{km_lat}`` one ~1.1 km north, ``{wp_last}``/``{wp_bad}`` the last and one-past-the-last waypoint number,
 ``{wp_other}`` a waypoint of the test mission other than its learnt park waypoint,
 ``{depth_over}`` a depth just over ``max_depth``, ``{speed_over}`` a speed just over
 ``max_speed_kn``.

@@ -222,7 +222,7 @@ class VehicleObserver(Answers, Deadlines):
         elif n.kind == "held":
             self.ledger.hold()
         elif n.kind in ("confirmed", "unconfirmed"):
-            self.ledger.release(n.kind == "confirmed", n.text)
+            self.ledger.release(n.kind == "confirmed", n.text, n.clauses)
         elif n.kind == "resumed":
             if self.ledger.holding:
                 self.ledger.release(False, "not confirmed: the run was interrupted before the re-runs")
