@@ -1,9 +1,11 @@
 """Exploration: hypothesis sequences aimed at the model, judged step by step.
 
 The state machine (:mod:`.machine`) is a hypothesis ``RuleBasedStateMachine``. Its rules draw from
-:mod:`.generate` (every claimed command at the edges of its ranges, every error code, every
-mutation of a line, bursts), and walk the model's map: the remote controls (drawn more often, so
-that each control mode meets each command: the interrupt pairs), the mission park (``P`` as a
+:mod:`.generate` (every claimed command at the edges of its ranges, and with one field at a time
+at an edge or one past it; every error code, every mutation of a line, bursts), and walk the
+model's map: the remote controls (drawn more often, so that each control mode meets each command:
+the interrupt pairs; an ``$OPK`` park interrupted and released; a steer to the wrap of the compass
+read with every ``$OSD`` letter), the mission park (``P`` as a
 start, or reached from ``N``), a report landed just *before* the next model timer's deadline and
 the timer polled *across* it (RH-TIM-1's brackets; the lockout's end with a probe), a safety
 violation (``$OXFLT``, when the profile declares it) and ``$ORWSET`` written then read. Protocol

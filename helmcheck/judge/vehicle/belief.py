@@ -96,6 +96,8 @@ class Beliefs:
         #: vehicle seconds: the longest command round trip since the state was last known — a
         #: timer armed by a command started somewhere in that round trip (RH-RD-15)
         self.arm_v = 0.0
+        #: (depth in metres, vehicle seconds) of the last ``$OSI`` that showed a depth
+        self.last_depth: Optional[tuple[float, float]] = None
 
     @property
     def primary(self) -> Candidate:
@@ -144,6 +146,15 @@ class Beliefs:
                     self._keep([nominal[0]])  # accepted as it should be; only its data differ
                 else:  # accepted where a conforming vehicle refuses: its state is now unknown
                     self._keep([nominal[0]])
+                    if (not desync and want is not None and want.err == 26 and nominal[3] == ("M", "ascent")
+                            and self._surface_reachable(v)):
+                        # the $OMP that holds the depth defers the surface (RH-RD-12), but the vehicle
+                        # may have reached it before that $OMP: the mirror does not replay the two in
+                        # that order, so the answer cannot be judged
+                        desync = ("in the ascent the vehicle may have reached the surface before the $OMP "
+                                  "that holds its depth (RH-RD-12), which the observer does not replay")
+                        result.desync = desync
+                        self.desync = desync
                     if not self.desync:
                         self.desync = (f"the vehicle answered {brief(observed)} where a conforming "
                                        f"vehicle answers {brief(nominal[1])}")
@@ -259,6 +270,9 @@ class Beliefs:
         """Judge an ``$OSI`` produced in ``[v_sent, v_recv]`` (module docstring)."""
         v = (v_sent + v_recv) / 2
         slack = (v_recv - v_sent) / 2 + slack_v + self.arm_v
+        depth = osi_depth_m(osi, self.profile.depth_unit)
+        if depth is not None:
+            self.last_depth = (depth, v_recv)
         for c in self.cands:
             if c.code_unknown and osi.error_state != "N" and c.model.phase != "none":
                 c.model.error_state = osi.error_state
@@ -352,6 +366,14 @@ class Beliefs:
             self.desync = ""
         return result
 
+    def _surface_reachable(self, v: float) -> bool:
+        """Whether the vehicle may have reached the GPS-fix depth by ``v``, rising at most
+        :data:`VERTICAL_MPS` from the depth the last report showed (unknown: it may)."""
+        if self.last_depth is None:
+            return True
+        depth, at = self.last_depth
+        return depth - VERTICAL_MPS * max(0.0, v - at) <= self.profile.gps_fix_depth_m
+
     def _adopt(self, osi: s.OSI, v: float) -> bool:
         """While the state is unknown: take it from an ``$OSI`` that shows it whole — ``S``, or a
         mission running (``N``, ``P``) with no remote control and no safety episode. What a
@@ -439,6 +461,9 @@ class Beliefs:
             m.update_plant(snap.with_(**changes))
             c.drain()
 
+
+#: The fastest a vehicle rises (m/s): the bound on an unseen surface (:meth:`Beliefs._surface_reachable`).
+VERTICAL_MPS = 1.0
 
 #: the modes of remote-helm control (RH-INT-1)
 _REMOTE = frozenset(REMOTE_MODES)
