@@ -194,7 +194,8 @@ def _one_off(fmt: str, inside: list, edges: list[list[str]]):
 def one_field_off(p: Profile, tos) -> st.SearchStrategy[str]:
     """For each claimed command with ranged fields, a body with one field at an edge of its range
     or one past it and the rest inside (:func:`_one_off`); ``$OSD`` with every letter the profile
-    serves; ``$OPOS`` a kilometre away (far enough that a report soon after tells whether it was
+    serves; ``$OMLOAD`` and ``$OMSTART`` with every name a vehicle must refuse (RH-MSN-1); ``$OPOS``
+    a kilometre away (far enough that a report soon after tells whether it was
     applied, RH-POS-2). Speeds stay within bench safety, so only their lower edge is drawn."""
     spd = _num(0, bench_speed(p))
     lo, hi = int(p.timeout_range[0]), int(p.timeout_range[1])
@@ -221,6 +222,8 @@ def one_field_off(p: Profile, tos) -> st.SearchStrategy[str]:
                                                  st.just("12")],
                          [["91", "{lat}"], ["181"], ["0"], ["0", "100", "-1", "101"], ["-5", "50", "-6", "51"]]),
         "OSD": st.permutations(list(p.osd_letters or "S")).map(lambda ls: "OSD," + ",".join(ls)),
+        "OMLOAD": st.builds(lambda n, f: f"OMLOAD,{n},{f}", _mission_names(), st.sampled_from(["0", "1"])),
+        "OMSTART": _mission_names().map(lambda n: f"OMSTART,0,0,0,0,{n},"),
     }
     claimed = [v for k, v in per.items() if k in p.commands]
     return st.one_of(*claimed) if claimed else st.just("OSD,S")

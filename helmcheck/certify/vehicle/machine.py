@@ -201,6 +201,8 @@ def machine(state, p, tos, deep: bool = True):
                     send(frame("OLOGL,a,b"))
                 if "OMLOAD" in claimed:
                     send(frame(f"OMLOAD,{p.mission},0"))
+                if "OPOS" in claimed:  # conductivity and temperature outlive a reset: the sequence sets its own
+                    send(frame(fill("OPOS,{lat},{lon},0,35,12", self.ctx)))
                 if start in ("N", "P"):
                     send(frame(f"OMSTART,0,0,0,0,{p.mission},"))
                     session.poll()
@@ -291,6 +293,7 @@ def machine(state, p, tos, deep: bool = True):
                 _here(session, self.ctx)
             self._guard(go)
 
+        @precondition(lambda self: deep)  # it waits for the turn
         @rule(heading=st.sampled_from(["359.9", "359", "0", "1", "180", "350"]),
               letters=st.permutations(list(p.osd_letters or "S")))
         def steer_then_read(self, heading, letters):
