@@ -40,7 +40,7 @@ from tests.faulty_vehicles import EMU_PROFILE, make_core, serve
 from tests.faulty_vehicles.base import Mutant, reframe
 
 K = 20.0
-SEED = 1
+SEED = 2
 CLAUSE = "RH-ACK-4"
 
 
