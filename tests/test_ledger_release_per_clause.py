@@ -25,8 +25,10 @@ def test_a_clause_release_books_that_clause_only_and_holding_goes_on():
     led.failed("RH-SRV-2", "360 accepted")
     led.failed("RH-INT-3", "park came back")
     assert not any(led.has_failed(c) for c in ("RH-ACK-3", "RH-SRV-2", "RH-INT-3"))
+    assert led.held_clauses() == {"RH-ACK-3", "RH-SRV-2", "RH-INT-3"}
     led.release(True, "reproduced 2 of 2", ["RH-ACK-3"])
     assert led.has_failed("RH-ACK-3") and led.holding
+    assert led.held_clauses() == {"RH-SRV-2", "RH-INT-3"}
     assert not led.has_failed("RH-SRV-2")
     led.release(False, "reproduced 1 of 2", ["RH-SRV-2"])
     assert led.verdict("RH-SRV-2").verdict == "inconclusive" and led.holding

@@ -212,6 +212,10 @@ class Ledger:
     def holding(self) -> bool:
         return self._held is not None
 
+    def held_clauses(self) -> set[str]:
+        """The clauses with violations still held."""
+        return {h[0] for h in self._held or ()}
+
     def release(self, confirmed: bool, why: str, clauses: Iterable[str] = ()) -> None:
         """Book the held violations: as violations when *confirmed*, else INCONCLUSIVE with *why*
         before their reason. With *clauses*, only those clauses' (holding goes on for the rest);

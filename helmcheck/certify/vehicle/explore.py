@@ -302,9 +302,11 @@ def explore(run) -> None:
                          f"{confirmed} of 2 re-runs after shrinking")
             findings.append({"clause": cid, "reason": best["reason"], "confirmed": f"{confirmed}/2",
                              "flaky": confirmed < 2, "steps": len(best["steps"]), "reruns": reruns})
-        if run.ledger.holding:  # seen in the verified reset between two sequences only: never re-driven
+        if run.ledger.held_clauses():  # seen in the verified reset between two sequences only: never re-driven
             session.note("unconfirmed: seen between the exploration's sequences (in a verified reset), "
                          "not re-driven on its own")
+        else:  # holding ends: what is observed from here on is booked as it comes
+            session.note("confirmed: every clause found was re-driven on its own")
     finally:
         session.end_case()
     from ...reports import results as R
