@@ -220,13 +220,14 @@ class Ledger:
         """Book the held violations: as violations when *confirmed*, else INCONCLUSIVE with *why*
         before their reason. With *clauses*, only those clauses' (holding goes on for the rest);
         without, all of them, and holding ends."""
-        held = self._held or []
+        if self._held is None:
+            return
         if clauses:
             only = set(clauses)
-            now = [h for h in held if h[0] in only]
-            self._held = [h for h in held if h[0] not in only] if self._held is not None else None
+            now = [h for h in self._held if h[0] in only]
+            self._held = [h for h in self._held if h[0] not in only]
         else:
-            now, self._held = held, None
+            now, self._held = self._held, None
         for cid, reason, evidence, case in now:
             if confirmed:
                 self._add(cid, FAIL, reason, evidence, case)

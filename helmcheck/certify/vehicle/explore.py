@@ -169,19 +169,19 @@ class _State:
             self.error = e
 
 
-def _confirm(run, best: dict, why: Optional[list] = None) -> int:
-    """Re-drive the smallest failing sequence of one clause twice; how many times it failed again
-    on that clause (the other clauses found are not stopped at: :attr:`.session.Session.ignore`)."""
+def _confirm(run, best: dict) -> tuple[int, list[str]]:
+    """Re-drive the smallest failing sequence of one clause twice: how many times it failed again
+    on that clause (the other clauses found are not stopped at: :attr:`.session.Session.ignore`),
+    and what each re-run said."""
     from .replay import IN_RESET, redrive
     n = 0
-    session = run.session
+    said = []
     for _ in range(2):
         doc = {"steps": best["steps"], "time_scale": run.k, "lazy_silence": True}
-        verdict, reason, clause = redrive(doc, session)
+        verdict, reason, clause = redrive(doc, run.session)
         n += verdict == "fail" and clause in best["also"] and not reason.startswith(IN_RESET)
-        if why is not None:
-            why.append(f"{verdict}: {reason}"[:300])
-    return n
+        said.append(f"{verdict}: {reason}"[:300])
+    return n, said
 
 
 def _found_clauses(found: dict) -> frozenset:
@@ -243,6 +243,7 @@ def explore(run) -> None:
             b0 = time.monotonic()
             cfg = settings(max_examples=n, stateful_step_count=steps, deadline=None, database=db,
                            suppress_health_check=list(HealthCheck), report_multiple_bugs=False, print_blob=False,
+                           # once something is found, reusing the saved examples would replay that finding
                            phases=(Phase.explicit, *(() if state.found else (Phase.reuse,)), Phase.generate,
                                    Phase.shrink))
             try:
@@ -293,9 +294,8 @@ def explore(run) -> None:
     try:
         for cid, best in state.found.items():
             session.ignore = _found_clauses(state.found) - set(best["also"])
-            reruns: list = []
             try:
-                confirmed = _confirm(run, best, reruns)
+                confirmed, reruns = _confirm(run, best)
             finally:
                 session.ignore = frozenset()
             session.note(f"{'confirmed' if confirmed == 2 else 'unconfirmed'} {','.join(best['also'])}: reproduced "

@@ -201,7 +201,7 @@ def machine(state, p, tos, deep: bool = True):
                     send(frame("OLOGL,a,b"))
                 if "OMLOAD" in claimed:
                     send(frame(f"OMLOAD,{p.mission},0"))
-                if "OPOS" in claimed:  # conductivity and temperature outlive a reset: the sequence sets its own
+                if "OPOS" in claimed:  # conductivity and temperature (always applied, RH-POS-2) outlive a reset
                     send(frame(fill("OPOS,{lat},{lon},0,35,12", self.ctx)))
                 if start in ("N", "P"):
                     send(frame(f"OMSTART,0,0,0,0,{p.mission},"))
@@ -262,12 +262,14 @@ def machine(state, p, tos, deep: bool = True):
             for b in bodies:
                 self._sent(b)
 
-            def go():
-                raws = [frame(fill(b, self.ctx)) for b in bodies]
-                mets = [cov.before(obs.state(), r) for r in raws]
-                for met, sent in zip(mets, session.burst(raws)):
-                    cov.command(met, sent.expected)
-            self._guard(go)
+            self._guard(lambda: self._together(bodies))
+
+        def _together(self, bodies) -> None:
+            """Write the lines back to back, then read the answers (RH-ACK-6), coverage counted."""
+            raws = [frame(fill(b, self.ctx)) for b in bodies]
+            mets = [cov.before(obs.state(), r) for r in raws]
+            for met, sent in zip(mets, session.burst(raws)):
+                cov.command(met, sent.expected)
 
         @rule(bodies=st.lists(one_field_off(p, tos), min_size=2, max_size=6), together=st.booleans())
         def edges(self, bodies, together):
@@ -279,10 +281,7 @@ def machine(state, p, tos, deep: bool = True):
 
             def go():
                 if together:
-                    raws = [frame(fill(b, self.ctx)) for b in bodies]
-                    mets = [cov.before(obs.state(), r) for r in raws]
-                    for met, sent in zip(mets, session.burst(raws)):
-                        cov.command(met, sent.expected)
+                    self._together(bodies)
                     return
                 for b in bodies:
                     if b.startswith("OPOS,"):

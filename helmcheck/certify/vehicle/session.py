@@ -162,7 +162,7 @@ class Session:
         return sent
 
     def outwait_lockout(self) -> None:
-        """Poll until the lockout the observer's mirror still counts is over (at most 1.5 times the
+        """Poll until the lockout (RH-SAF-1) the observer's mirror still counts is over (at most 1.5 times the
         profile's lockout and 30 s more, vehicle time): a sequence or a re-drive then starts from
         the same state on any vehicle, whether its lockout ended sooner (a finding of whatever set
         it going, not of what comes next) or not. Stops at nothing: call it with ``stop_on_fail``

@@ -46,7 +46,7 @@ from ..facts import ASCENT_REFUSED, LOCKOUT_REFUSED
 from .brackets import bracket, pre_shown, retime
 from .branches import branches
 from .candidate import Candidate
-from .closure import explain_osi, explain_reply, osi_depth_m, osi_numbers, reply_keys
+from .closure import VERTICAL_MPS, explain_osi, explain_reply, osi_depth_m, osi_numbers, reply_keys
 from .sent import brief
 
 __all__ = ["Beliefs", "CommandResult", "OsiResult", "CAP"]
@@ -96,8 +96,8 @@ class Beliefs:
         #: vehicle seconds: the longest command round trip since the state was last known — a
         #: timer armed by a command started somewhere in that round trip (RH-RD-15)
         self.arm_v = 0.0
-        #: (depth in metres, vehicle seconds) of the last ``$OSI`` that showed a depth
-        self.last_depth: Optional[tuple[float, float]] = None
+        #: the last ``$OSI`` and the vehicle second it arrived (its depth is read only when needed)
+        self.last_osi: Optional[tuple[s.OSI, float]] = None
 
     @property
     def primary(self) -> Candidate:
@@ -270,9 +270,7 @@ class Beliefs:
         """Judge an ``$OSI`` produced in ``[v_sent, v_recv]`` (module docstring)."""
         v = (v_sent + v_recv) / 2
         slack = (v_recv - v_sent) / 2 + slack_v + self.arm_v
-        depth = osi_depth_m(osi, self.profile.depth_unit)
-        if depth is not None:
-            self.last_depth = (depth, v_recv)
+        self.last_osi = (osi, v_recv)
         for c in self.cands:
             if c.code_unknown and osi.error_state != "N" and c.model.phase != "none":
                 c.model.error_state = osi.error_state
@@ -367,12 +365,13 @@ class Beliefs:
         return result
 
     def _surface_reachable(self, v: float) -> bool:
-        """Whether the vehicle may have reached the GPS-fix depth by ``v``, rising at most
-        :data:`VERTICAL_MPS` from the depth the last report showed (unknown: it may)."""
-        if self.last_depth is None:
+        """Whether the vehicle may have reached the GPS-fix depth (RH-RD-10) by ``v``, rising at most
+        :data:`~.closure.VERTICAL_MPS` from the depth the last report showed (unknown: it may)."""
+        if self.last_osi is None:
             return True
-        depth, at = self.last_depth
-        return depth - VERTICAL_MPS * max(0.0, v - at) <= self.profile.gps_fix_depth_m
+        osi, at = self.last_osi
+        depth = osi_depth_m(osi, self.profile.depth_unit)
+        return depth is None or depth - VERTICAL_MPS * max(0.0, v - at) <= self.profile.gps_fix_depth_m
 
     def _adopt(self, osi: s.OSI, v: float) -> bool:
         """While the state is unknown: take it from an ``$OSI`` that shows it whole — ``S``, or a
@@ -461,9 +460,6 @@ class Beliefs:
             m.update_plant(snap.with_(**changes))
             c.drain()
 
-
-#: The fastest a vehicle rises (m/s): the bound on an unseen surface (:meth:`Beliefs._surface_reachable`).
-VERTICAL_MPS = 1.0
 
 #: the modes of remote-helm control (RH-INT-1)
 _REMOTE = frozenset(REMOTE_MODES)

@@ -75,6 +75,11 @@ def same_replies(want: list, got: list) -> bool:
     return reply_keys(want) == reply_keys(got)
 
 
+#: The fastest a vehicle rises or sinks (m/s): what bounds a surface, or a GPS-fix depth, that no
+#: report showed (RH-RD-10).
+VERTICAL_MPS = 1.0
+
+
 def osi_depth_m(osi: s.OSI, depth_unit: str) -> Optional[float]:
     d = osi_numbers(osi)[4]
     if d is None:

@@ -53,15 +53,13 @@ from ...model.geo import distance_m
 from ...model.plant import NEUTRAL
 from ...model.timers import tolerance
 from ..timing import JITTER_S, PLANT_REACT_S
-from .closure import osi_depth_m, osi_numbers
+from .closure import VERTICAL_MPS, osi_depth_m, osi_numbers
 from .queuetarget import QueueTarget
 
 __all__ = ["OsiChecks"]
 
 _KN = 1852.0 / 3600.0
 #: Metres below which an ``$OPOS`` position cannot be told from where the vehicle already was.
-#: The fastest a vehicle rises or sinks (m/s), for the GPS-fix depth a report does not settle (RH-RD-10).
-_VERTICAL_MPS = 1.0
 _POS_DECIDABLE_M = 30.0
 #: Reports away from the park position kept per ``$OPK`` (the latest; enough to time a count).
 _AWAY_KEPT = 32
@@ -295,7 +293,7 @@ class OsiChecks:
             # RH-RD-10: whether the vehicle had a fix when the $OPOS came is known from the reports
             # on either side of it; one that crossed the GPS-fix depth between them, or was rising
             # or sinking within the way it can make in that time of it, may have had either
-            margin = _VERTICAL_MPS * dt_v
+            margin = VERTICAL_MPS * dt_v
             moving = abs(d1 - d0) > 0.02  # a vehicle holding its depth stays on its side of it
             if (d0 <= fix) != (d1 <= fix) or (moving and min(abs(d0 - fix), abs(d1 - fix)) <= margin):
                 return
