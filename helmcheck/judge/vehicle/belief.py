@@ -344,7 +344,9 @@ class Beliefs:
                 # back to an earlier one, as a mission that did not end at its last would): the
                 # end it owes there
                 causes.append("RH-MSN-4")
-            if p.refused_locked and p.model.phase != "lockout":
+            if p.refused_locked and (p.model.phase != "lockout" or any(r.event == "lockout_end" for r in ahead)):
+                # a command refused in the lockout, and the lockout over (or ending within the
+                # tolerance before this report): what changed may be that command, carried out
                 causes.insert(0, "RH-SAF-2")
             if osi.mode == p.model.mode:  # the mode is right: a countdown is what differs
                 causes += {"mP": ["RH-PK-2"], "W": ["RH-OMW-4"]}.get(osi.mode, [])
