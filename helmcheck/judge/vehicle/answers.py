@@ -23,7 +23,7 @@ from ...grammar import sentences as s
 from ...grammar.wirelog import escape
 from ..ledger import Evidence
 from ..timing import JITTER_S, ack_allowance, ack_uncertainty, ack_verdict, transmit_time
-from .blame import command_clauses, passable
+from .blame import command_clauses, looked_up, passable
 from .sent import Sent, brief, names, text_of
 
 __all__ = ["Answers", "UNSOLICITED", "OWN_REASON"]
@@ -182,6 +182,7 @@ class Answers:
                 # refused, as it should be, with the wrong error number: RH-ACK-4 for a refused
                 # precondition, else RH-ACK-3 (each command's own "incorrect values" error)
                 first = "RH-ACK-4" if "RH-ACK-4" in cands else "RH-ACK-3"
+                first = looked_up(p.kind.item, a.err) or first
                 cands = (first,) + tuple(c for c in cands if c != first)
             what = (f"{text_of(p)}: a conforming vehicle in mode {res.before[0]} answers "
                     f"{brief(res.expected)}; got {brief(observed)}")

@@ -8,13 +8,18 @@ Every finding names an ordered tuple of *candidate* clauses, the most specific f
   clauses (RH-INT-1 first when it takes over from another remote control). A value out of range is booked on the clause that sets the range, whether the
   grammar (a field's form: ``$OMP`` field 1 not ten hex digits, a timeout that is not an integer)
   or the range check (``$OMP`` field 2 not ``00``, a timeout of 0) finds it: :data:`FIELD_CLAUSE`
-  names that clause for each field whose form or range a vehicle clause sets; a field count, or
-  a field whose range only a reading sets (``RH-RD-9``: ``$OPOS`` speed, ``$ODVL`` x/y, the
-  ``$OMW`` fields), is RH-ACK-3's. Readings (``RH-RD-*``) are never booked: they say how a clause
+  names that clause for each field whose form or range a vehicle clause sets, also where a reading
+  spells the range out (``RH-RD-6``: the rh5 ``$OMSTART`` flags are RH-MSN-2's, its names follow
+  RH-MSN-1's path rules); a field count, or a field whose range only a reading sets
+  (``RH-RD-9``: ``$OPOS`` speed, ``$ODVL`` x/y, the ``$OMW`` fields), is RH-ACK-3's. Readings (``RH-RD-*``) are never booked: they say how a clause
   is read, not what a vehicle must do;
 * an ``$OSI`` no conforming state explains — RH-OUT-4 and the clauses of what changed since the
   last confirmed report (a timer's row, an accepted command's row); RH-TIM-1/2 follow when a
   duration was being timed around the report;
+* a command refused, as it should be, with the wrong error number: RH-ACK-4 for a refused
+  precondition, else RH-ACK-3 — but a mission name the path rules reject, answered with a
+  look-up's error (1, 3, 31), is RH-MSN-1's (:func:`looked_up`: the name was looked up, not
+  rejected);
 * a line the vehicle must discard but answered — the discard's own clause (RH-FRM-2/4/5/6/7),
   whatever else is wrong with the answer.
 
@@ -51,7 +56,7 @@ from ...clauses import catalogue
 from ...grammar import sentences as s
 from ...grammar.errors import SentenceError
 
-__all__ = ["command_clauses", "targets", "vehicle_clause", "OWN_EVIDENCE", "FIELD_CLAUSE", "passable"]
+__all__ = ["command_clauses", "looked_up", "targets", "vehicle_clause", "OWN_EVIDENCE", "FIELD_CLAUSE", "passable"]
 
 #: clause → the observation that passes it (instead of a row's confirmation).
 OWN_EVIDENCE = {
@@ -84,6 +89,11 @@ FIELD_CLAUSE = {
     ("OPOS", "lat"): "RH-POS-1", ("OPOS", "lon"): "RH-POS-1",
     ("ODVL", "timeout"): "RH-DVL-1",
     ("OMSTOP", "flag"): "RH-MSN-3",
+    # the rh5 ``$OMSTART`` (RH-RD-6 reads RH-MSN-2): its flags are RH-MSN-2's; its mission and SRP
+    # names follow "the $OMLOAD path rules", which are RH-MSN-1's text (nothing outside the
+    # mission directory is opened), so a name that breaks them is RH-MSN-1's
+    **{("OMSTART", f): "RH-MSN-2" for f in ("ignore_gps", "ignore_sounder", "calibrate_pressure", "mission_type")},
+    ("OMSTART", "name"): "RH-MSN-1", ("OMSTART", "srp"): "RH-MSN-1",
 }
 
 _KNOWN = None
@@ -125,7 +135,8 @@ def command_clauses(item, expected_ack: Optional[s.ACK], row, before_mode: str =
         if expected_ack is not None and expected_ack.err == 26:
             return ("RH-SAF-1",) if row is None else _dedupe(row.clauses)
         first = "RH-OSD-2" if item.sentence_id == "OSD" else item.clause
-        if first == "RH-ACK-3" and item.field:  # a field's form: the clause that sets it
+        if (first == "RH-ACK-3" or first.startswith("RH-RD-")) and item.field:
+            # a field's form or range (set by a clause, or by a reading of one): the clause that sets it
             first = FIELD_CLAUSE.get((item.sentence_id, item.field), first)
         return _dedupe((first, "RH-ACK-3")) or ("RH-ACK-3",)
     if row is None:
@@ -139,6 +150,22 @@ def command_clauses(item, expected_ack: Optional[s.ACK], row, before_mode: str =
         # row's own clause (RH-JW-1, RH-LOG-2, RH-MSN-1/2, RH-PK-1) says what was checked
         out = out[:1]
     return out or ("RH-ACK-1",)
+
+
+#: The answers of a mission look-up (RH-MSN-1/2, RH-RD-6): 1 not found, 3 does not parse, 31 the SRP.
+LOOKUP_ERRORS = frozenset({1, 3, 31})
+
+
+def looked_up(item, err: int) -> Optional[str]:
+    """RH-MSN-1 when a mission or SRP name that its path rules reject (an absolute path, a drive
+    letter, a ``..`` component) is refused with a look-up's error (:data:`LOOKUP_ERRORS`) instead
+    of the rejection's 29 (``$OMLOAD``) or 30 (``$OMSTART``, RH-RD-6): the vehicle looked the
+    name up rather than rejecting it, which is RH-MSN-1's rule broken, not only a wrong number
+    (RH-ACK-3, as any other refusal with the wrong error is). None otherwise."""
+    if (isinstance(item, SentenceError) and item.sentence_id in ("OMLOAD", "OMSTART")
+            and item.field in ("name", "srp") and err in LOOKUP_ERRORS):
+        return "RH-MSN-1"
+    return None
 
 
 #: The remote-control modes (RH-INT-1).
