@@ -177,7 +177,7 @@ def _confirm(run, best: dict) -> tuple[int, list[str]]:
     n = 0
     said = []
     for _ in range(2):
-        doc = {"steps": best["steps"], "time_scale": run.k, "lazy_silence": True}
+        doc = {"steps": best["steps"], "time_scale": run.k, "lazy_silence": True, "origin": best.get("origin")}
         verdict, reason, clause = redrive(doc, run.session)
         n += verdict == "fail" and clause in best["also"] and not reason.startswith(IN_RESET)
         said.append(f"{verdict}: {reason}"[:300])
@@ -317,12 +317,12 @@ def explore(run) -> None:
         steps = state.found[cid]["steps"]
         if f["flaky"]:  # kept for people, but no replay of the clause: it did not fail again twice
             rel = f"replays/unconfirmed/{cid}.json"
-            save_replay(run.dir / rel, cid, f["reason"], steps, run.k, p)
+            save_replay(run.dir / rel, cid, f["reason"], steps, run.k, p, origin=state.found[cid].get("origin"))
             f["unconfirmed_trace"] = rel
             continue
         n = sum(1 for r in run.results["replays"] if r["clause"] == cid) + 1
         rel = f"replays/{cid}-{n}.json"
-        save_replay(run.dir / rel, cid, f["reason"], steps, run.k, p)
+        save_replay(run.dir / rel, cid, f["reason"], steps, run.k, p, origin=state.found[cid].get("origin"))
         R.add_replay(run.results, cid, steps, file=rel)
         f["replay"] = rel
     ex = run.stats["explore"]

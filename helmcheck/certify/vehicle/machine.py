@@ -153,7 +153,8 @@ def machine(state, p, tos, deep: bool = True):
             cid = next((c for c in also if c not in GENERIC), cid)
             best = state.found.get(cid)
             if best is None or len(trace) < len(best["steps"]):
-                state.found[cid] = {"clause": cid, "also": also, "reason": f.reason, "steps": trace}
+                state.found[cid] = {"clause": cid, "also": also, "reason": f.reason, "steps": trace,
+                                    "origin": session.trace_origin}
             state.shrink_from()
 
         @initialize(start=st.sampled_from(["S", "S", "S", "N", "N", "N", "N", "P"]))
@@ -192,11 +193,13 @@ def machine(state, p, tos, deep: bool = True):
             # (whose own closing reset found it): this one does not stop at it, its replay could
             # not show it on a fresh vehicle
             session.ignore = state.ignored | {c for c, _ in session.ledger.failures_since(before)}
-            session.trace = []
+            session.trace, session.trace_origin = [], None
 
             def go():
                 session.mark = session.ledger.mark()
                 self.ctx = context(session)  # a rule after a failed start still has its fields
+                # the steps' positions are relative to here (a replay moves them: .relocate)
+                session.trace_origin = (float(self.ctx["lat"]), float(self.ctx["lon"]))
                 if "OLOGL" in claimed:
                     send(frame("OLOGL,a,b"))
                 if "OMLOAD" in claimed:

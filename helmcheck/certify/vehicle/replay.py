@@ -12,7 +12,10 @@ A replay file is JSON::
 when it was sent (wall seconds from the first step, at the recorded time scale); ``wait`` is
 vehicle seconds (divided by the time scale when re-driven, RH-TIM-2); ``expect`` says in words
 what the model expected then (for people, and to say where a re-drive went another way; the
-re-drive asks the model afresh). ``lazy_silence``: the sequence did not sit out the ACK window of
+re-drive asks the model afresh). ``origin`` (optional): the vehicle's position (lat, lon) when
+the steps began; a re-drive moves every position the steps send by the difference to where the
+vehicle is when it begins them (:mod:`.relocate`), so that they ask, relative to the vehicle, what
+they asked when recorded. ``lazy_silence``: the sequence did not sit out the ACK window of
 a line the vehicle must discard (the exploration's pace); the re-drive keeps that pace and lets
 the observer settle every line before its verdict. Nothing in it depends on a hypothesis version.
 
@@ -35,6 +38,7 @@ from typing import Optional
 from ...grammar.wirelog import unescape
 from ...profile import Profile
 from ...reports.atomic import write_text_atomic
+from .relocate import shift_line
 
 __all__ = ["save_replay", "load_replay", "redrive", "ReplayError", "FORMAT"]
 
@@ -52,7 +56,7 @@ class ReplayError(ValueError):
 
 
 def save_replay(path: Path, clause: str, reason: str, steps: list, time_scale: float, profile: Profile,
-                lazy_silence: bool = True) -> Path:
+                lazy_silence: bool = True, origin: Optional[tuple] = None) -> Path:
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     t0 = next((float(s["t"]) for s in steps if "t" in s), 0.0)
@@ -63,7 +67,10 @@ def save_replay(path: Path, clause: str, reason: str, steps: list, time_scale: f
             s["t"] = round(float(s["t"]) - t0, 6)
         out.append(s)
     doc = {"format": FORMAT, "version": 2, "clause": clause, "reason": reason, "time_scale": time_scale,
-           "profile": profile.as_dict(), "start": "verified-reset", "lazy_silence": lazy_silence, "steps": out}
+           "profile": profile.as_dict(), "start": "verified-reset", "lazy_silence": lazy_silence}
+    if origin is not None:
+        doc["origin"] = [round(float(origin[0]), 6), round(float(origin[1]), 6)]
+    doc["steps"] = out
     write_text_atomic(path, json.dumps(doc, indent=1) + "\n")
     return path
 
@@ -77,6 +84,10 @@ def load_replay(path: Path) -> dict:
         raise ReplayError(f"{path}: not JSON: {e}") from None
     if not isinstance(doc, dict) or doc.get("format") != FORMAT or not isinstance(doc.get("steps"), list):
         raise ReplayError(f"{path}: not a helmcheck replay file (want format {FORMAT!r} and a steps list)")
+    origin = doc.get("origin")
+    if origin is not None and not (isinstance(origin, list) and len(origin) == 2
+                                   and all(isinstance(x, (int, float)) and not isinstance(x, bool) for x in origin)):
+        raise ReplayError(f"{path}: origin must be [lat, lon], two numbers (got {origin!r})")
     for i, st in enumerate(doc["steps"]):
         if not isinstance(st, dict) or sum(k in st for k in ("send", "wait", "expect")) != 1:
             raise ReplayError(f"{path}: step {i} needs exactly one of send, wait, expect")
@@ -114,16 +125,31 @@ def redrive(doc: dict, session, time_scale: Optional[float] = None) -> tuple[str
     if got:  # a vehicle that breaks the profile in every reply already does in the reset
         return "fail", f"{IN_RESET}: {got[0][0]}: {got[0][1]}", got[0][0]
     session.mark = session.ledger.mark()
+    shift = _shift(doc, session)
     # the line pace the sequence was recorded at: an exploration does not sit out the window of a
     # line the vehicle must discard (the observer settles it later, :meth:`Session.finish`)
     lazy, session.lazy_silence = session.lazy_silence, bool(doc.get("lazy_silence", False))
     try:
-        return _steps(doc, session, time_scale)
+        return _steps(doc, session, time_scale, shift)
     finally:
         session.lazy_silence = lazy
 
 
-def _steps(doc: dict, session, time_scale: Optional[float]) -> tuple[str, str, Optional[str]]:
+def _shift(doc: dict, session) -> tuple[float, float]:
+    """How far the steps' positions move: from the replay's ``origin`` to where the vehicle is now
+    (:mod:`.relocate`); nothing for a replay without one. Said in the log when it is not nothing."""
+    origin = doc.get("origin")
+    if origin is None:
+        return 0.0, 0.0
+    lat, lon = session.here()
+    dlat, dlon = round(float(lat) - float(origin[0]), 6), round(float(lon) - float(origin[1]), 6)
+    if dlat or dlon:
+        session.note(f"replay: the steps' positions moved {dlat:+.6f}, {dlon:+.6f} degrees, from where they "
+                     f"were recorded ({origin[0]}, {origin[1]}) to where this vehicle begins ({lat}, {lon})")
+    return dlat, dlon
+
+
+def _steps(doc: dict, session, time_scale: Optional[float], shift=(0.0, 0.0)) -> tuple[str, str, Optional[str]]:
     from .flow import CaseStop
     from .safety import BenchSafetyRefused
     from .session import _brief
@@ -143,7 +169,7 @@ def _steps(doc: dict, session, time_scale: Optional[float]) -> tuple[str, str, O
                 where["send"] = st["send"]
                 if "t" in st:
                     session.link.sleep(max(0.0, start + (float(st["t"]) - t_first) * pace - session.now()))
-                raw = unescape(st["send"])
+                raw = shift_line(unescape(st["send"]), *shift)
                 try:
                     last = session.exchange(raw)
                 except BenchSafetyRefused as e:

@@ -64,6 +64,8 @@ class Session:
         self.poll_gap = max(0.02, min(0.25, 1.0 / self.k))
         self.forced_wait = 0.0  #: wall seconds spent waiting for protocol durations
         self.trace: Optional[list] = None  #: replay steps while recording
+        #: where the vehicle was when the recorded steps began (lat, lon; :mod:`.relocate`)
+        self.trace_origin: Optional[tuple[float, float]] = None
         self.lazy_silence = False  #: do not sit out the window after a line the vehicle discards
         self.stop_on_fail = True
         #: clauses whose violations do not stop a step (:meth:`check`): the exploration, once it
