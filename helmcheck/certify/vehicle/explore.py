@@ -18,10 +18,11 @@ cannot replay: a rule whose state the vehicle is not in does nothing), and its s
 rules. What the sequences reached of the model is counted (:mod:`.modelcover`) and kept in
 ``stats.explore.model_coverage``.
 
-Each example starts from a verified reset (with ``$OLOGL`` and ``$OMLOAD`` in ``S`` so that the
+Each example starts from a verified reset, at the surface (a dive before it: the vehicle's GPS fix
+back, :meth:`.session.Session.outwait_surface`), with ``$OLOGL`` and ``$OMLOAD`` in ``S`` so that the
 observer knows the log labels and the loaded mission, and an ``$OPOS`` at the vehicle's own
 position so that the conductivity and temperature it reports are the sequence's own, not what
-came before the reset), then starts the test mission or reaches
+came before the reset; then starts the test mission or reaches
 its park if drawn — all of it recorded from the reset on (the reset itself is not: a replay
 begins with one of its own) — and ends with a verified reset of its own, inside the example: a
 lockout or a park it set going is judged within it, never in the next one, so the replay of a

@@ -177,6 +177,7 @@ def machine(state, p, tos, deep: bool = True):
                 # on any vehicle
                 session.outwait_lockout()
                 session.reset(mission=False)
+                session.outwait_surface()  # a dive or safety episode before: the GPS fix back (RH-POS-2)
                 cust = session.custodian  # the settings as the run found them (a failed sequence left its own)
                 for rec in (cust.records.values() if cust is not None else ()):
                     if rec.written and rec.before is not None:

@@ -23,7 +23,8 @@ The steps are the *whole* sequence from the verified reset that began it (the ex
 from there, and ends every sequence with a verified reset of its own, so a lockout or a park a
 sequence set going is judged inside it): whatever state the failure needs, the steps build it.
 :func:`redrive` first brings the vehicle to that reset (``$OMSTOP,0`` until accepted, waiting out
-a lockout left by whatever ran before, then ``S`` seen), then sends the steps at their recorded
+a lockout left by whatever ran before, then ``S`` seen, at the surface when it gets there within
+two minutes of vehicle time: :meth:`.session.Session.outwait_surface`), then sends the steps at their recorded
 pace (a step never earlier than its ``t`` scaled to the present time scale), judging every reply
 with the present model, and says whether it still fails — and at which step, or at which step the
 vehicle first went another way than when it was recorded.
@@ -116,6 +117,7 @@ def redrive(doc: dict, session, time_scale: Optional[float] = None) -> tuple[str
         stop, session.stop_on_fail = session.stop_on_fail, False
         try:
             session.reset(mission=False)
+            session.outwait_surface()
         finally:
             session.stop_on_fail = stop
     except CaseStop as f:

@@ -174,6 +174,22 @@ class Session:
             self.poll()
             self.link.sleep(max(self.poll_gap, 0.05))
 
+    def outwait_surface(self, within_v: float = 120.0) -> None:
+        """Poll until the vehicle reports itself at the surface (depth within ``gps_fix_depth_m``:
+        it has a GPS fix, RH-POS-2, RH-RD-10), for at most ``within_v`` vehicle seconds: after a
+        reset that found it under water (a dive or a safety episode before it), a sequence or a
+        re-drive then starts from the same state on any vehicle — an ``$OPOS`` is applied or not
+        as on a fresh one. A vehicle still under water after that starts where it is."""
+        from ...judge.vehicle.closure import osi_depth_m
+        end = self.now() + within_v / self.k
+        osi = self.obs.last_osi or self.poll()
+        while self.now() < end:
+            depth = osi_depth_m(osi, self.profile.depth_unit)
+            if depth is None or depth <= self.profile.gps_fix_depth_m:
+                return
+            self.link.sleep(max(self.poll_gap, 0.05))
+            osi = self.poll()
+
     def finish(self, linger_v: float = 0.0) -> None:
         """Let every line sent so far be settled by the observer — a line answered late or not at
         all, which a ``lazy_silence`` exchange did not wait for, is judged now — then poll once (so
