@@ -7,7 +7,8 @@ position it sends by the difference to where the vehicle begins it. Unit propert
 their framing stay byte for byte), and the case that made it necessary: an ``$OPOS`` 1.1 km north
 of a vehicle that applies it with a GPS fix (RH-POS-2), recorded where the vehicle was before the
 fault moved it there — re-driven on the same vehicle without the move it asks for the vehicle's
-own position and shows nothing.
+own position and shows nothing. And a vehicle further than 10 m from where the steps began is
+driven back there first (``replay._return``), when it claims ``$OMW``.
 """
 
 from __future__ import annotations
@@ -69,11 +70,15 @@ def test_lines_written_back_to_back_each_move():
 
 
 def _replay(tmp_path, origin):
-    """An ``$OPOS`` at the vehicle's start position, recorded where the vehicle was 1.1 km south."""
+    """An ``$OPOS`` at the vehicle's start position, recorded where the vehicle was 1.1 km south;
+    for a vehicle that does not claim ``$OMW`` (a re-drive cannot drive it back to where the steps
+    began: only the move of the positions makes the steps ask what they asked)."""
     home = EmulatorSettings()
+    profile = EMU_PROFILE.replace(time_scale=K).as_dict()
+    profile["commands"] = [c for c in profile["commands"] if c != "OMW"]
     body = f"OPOS,{home.start_lat:.6f},{home.start_lon:.6f},0,35,12"
     doc = {"format": "helmcheck-replay", "version": 2, "clause": "RH-POS-2", "reason": "by hand",
-           "time_scale": K, "profile": EMU_PROFILE.replace(time_scale=K).as_dict(), "start": "verified-reset",
+           "time_scale": K, "profile": profile, "start": "verified-reset",
            "lazy_silence": True,
            "steps": [{"send": "$OSD,S*27\\r\\n", "t": 0.0}, {"send": line(body).decode().replace("\r\n", "\\r\\n"),
                                                                 "t": 0.05},
@@ -100,3 +105,23 @@ def test_an_opos_applied_with_a_fix_fails_again_only_where_it_is_asked_relative_
         assert code == 0, text
     with serve(lambda start: make_core(None, K, start)) as port:  # the conforming vehicle
         assert cli_main(["replay", str(path), "--port", port]) == 0, capsys.readouterr().out
+
+
+def test_a_vehicle_far_from_where_the_steps_began_is_driven_back_first(tmp_path, capsys):
+    """30 m from the replay's origin, the re-drive drives the vehicle back ($OMSTART, $OMW to the
+    origin) before the steps: the first report of the steps is within the on-station distance of it."""
+    from helmcheck.model.geo import distance_m
+    home = EmulatorSettings()
+    origin = [round(home.start_lat + 30.0 / 111320.0, 6), home.start_lon]
+    doc = {"format": "helmcheck-replay", "version": 2, "clause": "RH-OUT-4", "reason": "by hand", "time_scale": K,
+           "profile": EMU_PROFILE.replace(time_scale=K).as_dict(), "start": "verified-reset", "lazy_silence": True,
+           "origin": origin, "steps": [{"send": "$OSD,S*27\\r\\n", "t": 0.0}]}
+    path = tmp_path / "far.json"
+    path.write_text(json.dumps(doc))
+    log = tmp_path / "wire.log"
+    with serve(lambda start: make_core(None, K, start)) as port:
+        assert cli_main(["replay", str(path), "--port", port, "--wire-log", str(log)]) == 0, capsys.readouterr().out
+    text = log.read_text()
+    assert "driven back there first" in text, text[-2000:]
+    last = [ln for ln in text.splitlines() if "< $OSI," in ln][-1].split(",")
+    assert distance_m(float(last[4]), float(last[5]), *origin) <= EMU_PROFILE.on_station_m + 1.0, last

@@ -24,7 +24,9 @@ from there, and ends every sequence with a verified reset of its own, so a locko
 sequence set going is judged inside it): whatever state the failure needs, the steps build it.
 :func:`redrive` first brings the vehicle to that reset (``$OMSTOP,0`` until accepted, waiting out
 a lockout left by whatever ran before, then ``S`` seen, at the surface when it gets there within
-two minutes of vehicle time: :meth:`.session.Session.outwait_surface`), then sends the steps at their recorded
+two minutes of vehicle time: :meth:`.session.Session.outwait_surface`; and, when the replay says
+where the steps began and the vehicle is more than 10 m from there, driven back first,
+:func:`_return`), then sends the steps at their recorded
 pace (a step never earlier than its ``t`` scaled to the present time scale), judging every reply
 with the present model, and says whether it still fails — and at which step, or at which step the
 vehicle first went another way than when it was recorded.
@@ -50,6 +52,10 @@ LINGER_V = 3.0
 #: How a re-drive's reason begins when the vehicle failed before the steps: not a reproduction of
 #: the steps' failure (the exploration does not count it as one, :func:`.explore._confirm`).
 IN_RESET = "already in the verified reset before the steps"
+#: A re-drive that finds the vehicle further than this from where the steps began drives it back
+#: there first, for at most this long in vehicle time (:func:`_return`).
+RETURN_BEYOND_M = 10.0
+RETURN_WITHIN_V = 600.0
 
 
 class ReplayError(ValueError):
@@ -118,6 +124,9 @@ def redrive(doc: dict, session, time_scale: Optional[float] = None) -> tuple[str
         try:
             session.reset(mission=False)
             session.outwait_surface()
+            if _return(doc, session):
+                session.reset(mission=False)
+                session.outwait_surface()
         finally:
             session.stop_on_fail = stop
     except CaseStop as f:
@@ -135,6 +144,46 @@ def redrive(doc: dict, session, time_scale: Optional[float] = None) -> tuple[str
         return _steps(doc, session, time_scale, shift)
     finally:
         session.lazy_silence = lazy
+
+
+def _return(doc: dict, session) -> bool:
+    """Drive the vehicle back to the replay's ``origin`` when it is more than
+    :data:`RETURN_BEYOND_M` from it: the steps may depend on where it is against the mission (a
+    release toward waypoint 0 from 70 m away, which a vehicle that begins on waypoint 0 reaches at
+    once). The test mission started, one ``$OMW`` to the origin at the surface (depth 0, no park,
+    the bench speed) followed until the queue is done, for at most :data:`RETURN_WITHIN_V` vehicle
+    seconds and only while it gets nearer; the caller resets again. Needs ``$OMSTART`` and ``$OMW``
+    claimed; said in the log. True when it drove."""
+    from ...model.geo import distance_m
+    from .generate import bench_speed
+    from .session import frame
+    origin = doc.get("origin")
+    p = session.profile
+    if origin is None or not {"OMSTART", "OMW"} <= set(p.commands) or not p.mission:
+        return False
+    lat, lon = map(float, session.here())
+    apart = distance_m(lat, lon, float(origin[0]), float(origin[1]))
+    if apart <= RETURN_BEYOND_M:
+        return False
+    session.note(f"replay: the vehicle is {apart:.0f} m from where the steps began; driven back there first "
+                 f"($OMSTART, then $OMW to it)")
+    sent = session.exchange(frame(f"OMSTART,0,0,0,0,{p.mission},"))
+    if sent is None or not sent.accepted:
+        return True
+    session.exchange(frame(f"OMW,{float(origin[0]):.6f},{float(origin[1]):.6f},0,,15,{bench_speed(p):g},0,"))
+    end, window = session.now() + RETURN_WITHIN_V / session.k, session.now() + 60.0 / session.k
+    best = apart
+    while session.now() < end:
+        osi = session.poll()
+        left = distance_m(float(osi.lat), float(osi.lon), float(origin[0]), float(origin[1]))
+        if osi.mode != "W" or left <= p.on_station_m:
+            break
+        if session.now() > window:  # a minute of vehicle time and no nearer: it does not move
+            if left > best - 1.0:
+                break
+            best, window = left, session.now() + 60.0 / session.k
+        session.link.sleep(max(session.poll_gap, 0.05))
+    return True
 
 
 def _shift(doc: dict, session) -> tuple[float, float]:
