@@ -299,15 +299,12 @@ def _with_setting(session: Session, st: WithSetting, ctx: dict) -> None:
 
 def _restore(session: Session, setting: str, orig: list) -> None:
     """Stop the mission (verified reset) and write ``orig`` back; verified by a read."""
-    stop, session.stop_on_fail = session.stop_on_fail, False
-    try:
+    with session.not_stopping():
         session.reset(mission=False)
         session.exchange(frame(f"ORWSET,{setting},W,{','.join(orig)}"))
         back = session.exchange(frame(f"ORWSET,{setting},R"))
         if back is None or back.ack is None or list(back.ack.extra[2:]) != orig:
             session.note(f"restore: {setting} could not be verified as {','.join(orig)}")
-    finally:
-        session.stop_on_fail = stop
 
 
 def _set_round_trip(session: Session, st: SetRoundTrip) -> None:
@@ -322,11 +319,8 @@ def _set_round_trip(session: Session, st: SetRoundTrip) -> None:
         session.exchange(frame(f"ORWSET,{st.setting},W,{new_state},7"))
         session.exchange(frame(f"ORWSET,{st.setting},R"))
     finally:
-        stop, session.stop_on_fail = session.stop_on_fail, False
-        try:
+        with session.not_stopping():
             session.exchange(frame(f"ORWSET,{st.setting},W,{','.join(orig)}"))
-        finally:
-            session.stop_on_fail = stop
 
 
 #: Wall seconds an operator gets to trip a sensor once told (``violation_trigger = "operator"``).

@@ -169,27 +169,25 @@ def machine(state, p, tos, deep: bool = True):
             # the verified reset, not recorded: a replay begins with one of its own (.replay); what
             # the vehicle does wrong in it was set going before this sequence (whose closing reset
             # finds it, unless that sequence had already failed): it is no finding of this one
-            stop, session.stop_on_fail = session.stop_on_fail, False
             before = session.ledger.mark()
             try:
-                # a lockout the mirror still counts (the vehicle's ended sooner: a finding of the
-                # sequence that raised it) is waited out, so this one starts from the same state
-                # on any vehicle
-                session.outwait_lockout()
-                session.reset(mission=False)
-                session.outwait_surface()  # a dive or safety episode before: the GPS fix back (RH-POS-2)
-                cust = session.custodian  # the settings as the run found them (a failed sequence left its own)
-                for rec in (cust.records.values() if cust is not None else ()):
-                    if rec.written and rec.before is not None:
-                        session.exchange(frame(f"ORWSET,{rec.name},W,{','.join(rec.before)}"))
+                with session.not_stopping():
+                    # a lockout the mirror still counts (the vehicle's ended sooner: a finding of
+                    # the sequence that raised it) is waited out, so this one starts from the same
+                    # state on any vehicle
+                    session.outwait_lockout()
+                    session.reset(mission=False)
+                    session.outwait_surface()  # a dive or safety episode before: the GPS fix back (RH-POS-2)
+                    cust = session.custodian  # the settings as the run found them (a failed sequence left its own)
+                    for rec in (cust.records.values() if cust is not None else ()):
+                        if rec.written and rec.before is not None:
+                            session.exchange(frame(f"ORWSET,{rec.name},W,{','.join(rec.before)}"))
             except CaseStop:
                 pass
             except LinkLost as e:
                 state.lost = str(e)
                 self.active = False
                 return
-            finally:
-                session.stop_on_fail = stop
             # a clause the reset already shows violated is carried over from an earlier sequence
             # (whose own closing reset found it): this one does not stop at it, its replay could
             # not show it on a fresh vehicle

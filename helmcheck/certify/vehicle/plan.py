@@ -227,11 +227,8 @@ def _link_check(session: Session, custodian: Custodian) -> None:
                 link.drain()
                 custodian.found(obs.last_osi)
                 if obs.last_osi is not None and obs.last_osi.mode == "S":
-                    stop, session.stop_on_fail = session.stop_on_fail, False
-                    try:
+                    with session.not_stopping():
                         custodian.survey(session)
-                    finally:
-                        session.stop_on_fail = stop
                 return
     raise PlanError("the reference vehicle did not answer $OSD,S in the virtual run")
 

@@ -110,25 +110,20 @@ def redrive(doc: dict, session, time_scale: Optional[float] = None) -> tuple[str
     when it was recorded (where the vehicle's state went another way)."""
     from .flow import CaseStop
 
-    stop, session.stop_on_fail = session.stop_on_fail, False
     try:  # what an earlier drive left unanswered or running (it stopped at its failure) is its own
-        session.finish()
-        session.outwait_lockout()
+        with session.not_stopping():
+            session.finish()
+            session.outwait_lockout()
     except CaseStop:
         pass
-    finally:
-        session.stop_on_fail = stop
     session.mark = session.ledger.mark()
     try:
-        stop, session.stop_on_fail = session.stop_on_fail, False
-        try:
+        with session.not_stopping():
             session.reset(mission=False)
             session.outwait_surface()
             if _return(doc, session):
                 session.reset(mission=False)
                 session.outwait_surface()
-        finally:
-            session.stop_on_fail = stop
     except CaseStop as f:
         if f.outcome != "fail" and not session.failures():
             return "inconclusive", f"the verified reset before the steps failed: {f.reason}", None

@@ -132,9 +132,8 @@ class Custodian:
     def restore(self, session: Any) -> None:
         """Stop the vehicle, put every written setting back, read it again (module docstring)."""
         self.attempted = True
-        stop, session.stop_on_fail = session.stop_on_fail, False
         session.note("restore: leaving the vehicle as it was found")
-        try:
+        with session.not_stopping():
             why = self._stop(session)
             if why:
                 self.problems.append(f"the vehicle could not be verified as stopped: {why}")
@@ -152,8 +151,6 @@ class Custodian:
                 if not rec.verified:
                     self.problems.append(f"{rec.name} reads {_show(rec.after)} after the restore, not "
                                          f"{_show(rec.before)}")
-        finally:
-            session.stop_on_fail = stop
 
     def _stop(self, session: Any) -> Optional[str]:
         """``$OMSTOP,0`` until an ``$OSI`` after it shows ``S``; why not. A refusal in the lockout

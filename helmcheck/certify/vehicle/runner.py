@@ -239,11 +239,8 @@ class Run(ExecChild):
         osi = self.observer.last_osi
         self.custodian.found(osi)
         if osi is not None and osi.mode == "S" and self.session is not None:
-            stop, self.session.stop_on_fail = self.session.stop_on_fail, False
-            try:
+            with self.session.not_stopping():
                 self.custodian.survey(self.session)
-            finally:
-                self.session.stop_on_fail = stop
 
     def restore(self) -> None:
         """Leave the vehicle as it was found (:mod:`.restore`), whatever ended the run."""

@@ -26,6 +26,7 @@ check of the log reaches the same verdicts.
 
 from __future__ import annotations
 
+from contextlib import contextmanager
 from typing import Callable, Optional
 
 from ...grammar import checksum_hex
@@ -163,12 +164,22 @@ class Session:
         self.check()
         return sent
 
+    @contextmanager
+    def not_stopping(self):
+        """A block in which a failure the observer books does not stop the case (``stop_on_fail``
+        off; put back as it was after): a reset, a restore, a survey — the judge still books."""
+        stop, self.stop_on_fail = self.stop_on_fail, False
+        try:
+            yield
+        finally:
+            self.stop_on_fail = stop
+
     def outwait_lockout(self) -> None:
         """Poll until the lockout (RH-SAF-1) the observer's mirror still counts is over (at most 1.5 times the
         profile's lockout and 30 s more, vehicle time): a sequence or a re-drive then starts from
         the same state on any vehicle, whether its lockout ended sooner (a finding of whatever set
-        it going, not of what comes next) or not. Stops at nothing: call it with ``stop_on_fail``
-        off."""
+        it going, not of what comes next) or not. Stops at nothing: call it inside
+        :meth:`not_stopping`."""
         end = self.now() + (self.profile.lockout_s * 1.5 + 30.0) / self.k
         while self.obs.state().phase == "lockout" and self.now() < end:
             self.poll()
@@ -358,9 +369,7 @@ class Session:
             raise CaseStop("not-tested", why)
         t0 = self.now()
         end = t0 + self._cap((p.lockout_s * 1.5 + 60.0) / self.k + 5.0)
-        stop = self.stop_on_fail
-        self.stop_on_fail = False
-        try:
+        with self.not_stopping():
             while True:
                 sent = self.exchange(frame("OMSTOP,0"))
                 if sent is not None and sent.accepted:
@@ -370,8 +379,6 @@ class Session:
                     continue
                 raise CaseStop("inconclusive", f"the reset failed: $OMSTOP,0 answered "
                                                f"{_brief([sent.ack]) if sent and sent.ack else 'nothing'}")
-        finally:
-            self.stop_on_fail = stop
         osi = self.poll()
         if osi.mode != "S":
             raise CaseStop("inconclusive", f"after an accepted $OMSTOP,0 the vehicle reports {osi.mode}")
