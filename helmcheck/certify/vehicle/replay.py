@@ -27,7 +27,9 @@ a lockout left by whatever ran before, then ``S`` seen, at the surface when it g
 two minutes of vehicle time: :meth:`.session.Session.outwait_surface`; and, when the replay says
 where the steps began and the vehicle is more than 10 m from there, driven back first,
 :func:`_return`), then sends the steps at their recorded
-pace (a step never earlier than its ``t`` scaled to the present time scale), judging every reply
+pace (a line never sooner after the line before it than when recorded, scaled to the present
+time scale: a delay shifts what follows, so a timer a line set going runs out before the lines
+that polled across it), judging every reply
 with the present model, and says whether it still fails — and at which step, or at which step the
 vehicle first went another way than when it was recorded.
 """
@@ -55,7 +57,8 @@ IN_RESET = "already in the verified reset before the steps"
 #: A re-drive that finds the vehicle further than this from where the steps began drives it back
 #: there first, for at most this long in vehicle time (:func:`_return`).
 RETURN_BEYOND_M = 10.0
-RETURN_WITHIN_V = 600.0
+RETURN_WITHIN_V = 300.0
+KNOT_MPS = 1852.0 / 3600.0
 
 
 class ReplayError(ValueError):
@@ -147,7 +150,8 @@ def _return(doc: dict, session) -> bool:
     release toward waypoint 0 from 70 m away, which a vehicle that begins on waypoint 0 reaches at
     once). The test mission started, one ``$OMW`` to the origin at the surface (depth 0, no park,
     the bench speed) followed until the queue is done, for at most :data:`RETURN_WITHIN_V` vehicle
-    seconds and only while it gets nearer; the caller resets again. Needs ``$OMSTART`` and ``$OMW``
+    seconds and only while it gets nearer; not tried when the bench speed cannot cover the distance
+    in that time; the caller resets again. Needs ``$OMSTART`` and ``$OMW``
     claimed; said in the log. True when it drove."""
     from ...model.geo import distance_m
     from .generate import bench_speed
@@ -159,6 +163,10 @@ def _return(doc: dict, session) -> bool:
     lat, lon = map(float, session.here())
     apart = distance_m(lat, lon, float(origin[0]), float(origin[1]))
     if apart <= RETURN_BEYOND_M:
+        return False
+    if apart > bench_speed(p) * KNOT_MPS * RETURN_WITHIN_V:
+        session.note(f"replay: the vehicle is {apart:.0f} m from where the steps began, too far to drive back "
+                     f"within {RETURN_WITHIN_V:g} s at the bench speed; the steps' positions are moved instead")
         return False
     session.note(f"replay: the vehicle is {apart:.0f} m from where the steps began; driven back there first "
                  f"($OMSTART, then $OMW to it)")
@@ -205,8 +213,10 @@ def _steps(doc: dict, session, time_scale: Optional[float], shift=(0.0, 0.0)) ->
     pace = k_rec / float(time_scale or session.k)
     where = {"i": -1, "send": ""}
     diverged: list = []
-    start = session.now()
-    t_first = next((float(st["t"]) for st in steps if "t" in st), 0.0)
+    # each line no sooner after the line before it than when recorded (scaled to the present time
+    # scale): a delay early on shifts the rest, so a timeout set going by a line still runs out
+    # before the lines that polled across it
+    prev_t, prev_at = next((float(st["t"]) for st in steps if "t" in st), 0.0), session.now()
     last = None
     try:
         for i, st in enumerate(steps):
@@ -214,7 +224,8 @@ def _steps(doc: dict, session, time_scale: Optional[float], shift=(0.0, 0.0)) ->
             if "send" in st:
                 where["send"] = st["send"]
                 if "t" in st:
-                    session.link.sleep(max(0.0, start + (float(st["t"]) - t_first) * pace - session.now()))
+                    session.link.sleep(max(0.0, prev_at + (float(st["t"]) - prev_t) * pace - session.now()))
+                    prev_t, prev_at = float(st["t"]), session.now()
                 raw = shift_line(unescape(st["send"]), *shift)
                 try:
                     last = session.exchange(raw)
