@@ -97,10 +97,6 @@ SHALLOW_SHARE = 0.4
 #: The share of the wall budget one finding's shrinking may take (from its first failure); the
 #: exploration then goes on looking for violations of other clauses with the rest.
 SHRINK_SHARE = 0.2
-#: The share of a budget's steps a deep sequence gets: its episodes wait out timers, parks and the
-#: lockout, so a few of them take as long as a shallow sequence's many lines; shorter deep
-#: sequences are more of them (more starts, more episodes drawn afresh) in the same time.
-DEEP_STEPS_SHARE = 1 / 3
 
 #: name -> :class:`Budget`
 PROFILES = {"fast": Budget(400, 40, 30.0, 1500.0), "patient": Budget(8, 10, 900.0, 600.0)}
@@ -246,8 +242,7 @@ def explore(run) -> None:
             kind = kinds[deep]
             factory = kind if o.seed is None else seed(o.seed * 1000 + batch)(kind)
             b0 = time.monotonic()
-            cfg = settings(max_examples=n, deadline=None, database=db,
-                           stateful_step_count=max(6, round(steps * DEEP_STEPS_SHARE)) if deep else steps,
+            cfg = settings(max_examples=n, stateful_step_count=steps, deadline=None, database=db,
                            suppress_health_check=list(HealthCheck), report_multiple_bugs=False, print_blob=False,
                            # once something is found, reusing the saved examples would replay that finding
                            phases=(Phase.explicit, *(() if state.found else (Phase.reuse,)), Phase.generate,
