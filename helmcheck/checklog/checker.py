@@ -347,7 +347,8 @@ class SessionJudge:
         self.backseat_entries: Optional[list] = None
         self.sides: list[_Side] = [x for x in (self.vehicle, self.backseat) if x is not None]
         self.facts = RunFacts()
-        self.feeds = [x.observer.feed for x in self.sides] + [self.facts.feed]
+        #: the observers' ``feed`` s (the run facts are in notes alone: :meth:`chunk` gives them those)
+        self.feeds = [x.observer.feed for x in self.sides]
         self.scale = scale
         self.r = resolution
         self.mission_known = catalog is not None
@@ -372,15 +373,19 @@ class SessionJudge:
             self.last_t = c.t
         if d == TO_VEHICLE or d == FROM_VEHICLE:
             self._bytes[d] += len(c.data)
-        elif d != NOTE:
+            for feed in self.feeds:  # the same event to both observers (neither changes it)
+                feed(c)
+            return
+        if d != NOTE:
             self.finding_count += 1
             if len(self.findings) < MAX_FINDINGS:
                 self.findings.append({"line": c.lineno, "finding": c.note})
             for side in self.sides:
                 side.unreadable(c)  # type: ignore[arg-type]
             return
-        for feed in self.feeds:  # the same event to both observers (neither changes it)
+        for feed in self.feeds:
             feed(c)
+        self.facts.feed(c)
 
     def close(self) -> None:
         for side in self.sides:
