@@ -23,17 +23,20 @@ helm line: the whole log is consumed, in order, and every byte is attributed. It
    :func:`helmcheck.reports.assemble.assemble`.
 
 No judging happens here. Memory is bounded: the ledgers keep a few evidence lines per clause;
-timeline and events are capped by the observers.
+timeline and events are capped by the observers. While the records are fed the cyclic garbage
+collector runs rarely (:func:`_few_collections`): the records make short-lived objects that
+reference counting frees.
 """
 
 from __future__ import annotations
 
+import gc
 import hashlib
 import io
 import itertools
 import os
 import time
-from contextlib import ExitStack
+from contextlib import ExitStack, contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import BinaryIO, Callable, Optional
@@ -177,8 +180,9 @@ def _feed(files: list[BinaryIO], sizes: list[int], checker: "SessionJudge", fmt:
     that cannot be read: what it held is unknown."""
     sha = hashlib.sha256()
     lines = _Hashing(list(zip(files, sizes)), sha)
-    for chunk in read_chunks(lines, fmt, meta, swap=swap, progress=progress):
-        checker.chunk(chunk)
+    with _few_collections():
+        for chunk in read_chunks(lines, fmt, meta, swap=swap, progress=progress):
+            checker.chunk(chunk)
     if missing is not None:
         checker.chunk(Unreadable(checker.last_t, UNREADABLE, b"", f"the log continues in {missing}, which is "
                                  f"not there", lines.count + 1, ""))
@@ -198,6 +202,27 @@ def _backseat_entries(paths: list[str], fmt: str, profile: Profile, scale: float
         checker = SessionJudge(profile, "backseat", None, scale, resolution, baud)
         sha = _feed(files, sizes, checker, fmt, meta, swap, None)
     return checker.backseat.ledger.entries(), sha  # type: ignore[union-attr]
+
+
+#: The cyclic collector's first threshold while the records are fed (Python's default is 700).
+GC_THRESHOLD = 50_000
+
+
+@contextmanager
+def _few_collections():
+    """The cyclic garbage collector run rarely while the records are fed: the observers make a
+    few short-lived objects per record (records, decodings, evidence, replies), which reference
+    counting frees, and at the default threshold a collection every few hundred records would
+    walk them and the observers' long-lived state again and again for almost no garbage. The
+    collector still runs (after :data:`GC_THRESHOLD` net allocations of the objects it tracks),
+    so memory stays bounded; the thresholds are restored afterwards."""
+    old = gc.get_threshold()
+    if old[0]:  # (0: collection switched off by whoever runs the check; left so)
+        gc.set_threshold(max(old[0], GC_THRESHOLD), *old[1:])
+    try:
+        yield
+    finally:
+        gc.set_threshold(*old)
 
 
 class _Hashing:
@@ -322,7 +347,8 @@ class SessionJudge:
         self.backseat_entries: Optional[list] = None
         self.sides: list[_Side] = [x for x in (self.vehicle, self.backseat) if x is not None]
         self.facts = RunFacts()
-        self.feeds = [x.observer.feed for x in self.sides] + [self.facts.feed]
+        #: the observers' ``feed`` s (the run facts are in notes alone: :meth:`chunk` gives them those)
+        self.feeds = [x.observer.feed for x in self.sides]
         self.scale = scale
         self.r = resolution
         self.mission_known = catalog is not None
@@ -347,15 +373,19 @@ class SessionJudge:
             self.last_t = c.t
         if d == TO_VEHICLE or d == FROM_VEHICLE:
             self._bytes[d] += len(c.data)
-        elif d != NOTE:
+            for feed in self.feeds:  # the same event to both observers (neither changes it)
+                feed(c)
+            return
+        if d != NOTE:
             self.finding_count += 1
             if len(self.findings) < MAX_FINDINGS:
                 self.findings.append({"line": c.lineno, "finding": c.note})
             for side in self.sides:
                 side.unreadable(c)  # type: ignore[arg-type]
             return
-        for feed in self.feeds:  # the same event to both observers (neither changes it)
+        for feed in self.feeds:
             feed(c)
+        self.facts.feed(c)
 
     def close(self) -> None:
         for side in self.sides:

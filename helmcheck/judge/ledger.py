@@ -158,6 +158,10 @@ class Ledger:
         if lv.full and (not case or case in e.cases):
             lv.count += 1  # the common, repeated pass: only the count changes
             return
+        if (not evidence and type(evidence) in (tuple, list) and (lv.reason or not reason)
+                and (not case or case in e.cases)):
+            lv.count += 1  # a pass that brings nothing to keep: only the count changes (as in _add)
+            return
         self._add(cid, PASS, reason, evidence, case)
 
     def passed_all(self, passes: Iterable[tuple[str, str]], evidence: Iterable[Evidence] = (),

@@ -29,7 +29,6 @@ frozen mission (RH-RD-5).
 from __future__ import annotations
 
 from dataclasses import dataclass, fields, replace
-from operator import attrgetter
 from typing import Optional
 
 __all__ = [
@@ -81,20 +80,33 @@ class PlantSnapshot:
         setters = _SNAP_SETTERS
         if not changes.keys() <= setters.keys():
             return replace(self, **changes)  # an unknown field: replace's own TypeError
-        new = _new(PlantSnapshot)
-        for put, value in zip(_SNAP_PUTS, _snap_values(self)):
-            put(new, value)
+        new = _copy(self)
         for name, value in changes.items():
             setters[name](new, value)
         return new
 
 
-_new = object.__new__
 _SNAP_NAMES = tuple(f.name for f in fields(PlantSnapshot))
-_snap_values = attrgetter(*_SNAP_NAMES)
 #: each field's slot setter (the frozen class's own ``__setattr__`` refuses)
 _SNAP_PUTS = tuple(getattr(PlantSnapshot, name).__set__ for name in _SNAP_NAMES)
 _SNAP_SETTERS = dict(zip(_SNAP_NAMES, _SNAP_PUTS))
+
+
+def _copier():
+    """``copy(snapshot)``: a new snapshot with the same fields, generated from the field list
+    (one slot store per field written out, not a loop over the fields: the judge copies the
+    snapshot at nearly every report)."""
+    env = {"_new": object.__new__, "cls": PlantSnapshot}
+    lines = ["def copy(src):", "    o = _new(cls)"]
+    for i, (name, put) in enumerate(zip(_SNAP_NAMES, _SNAP_PUTS)):
+        env[f"put{i}"] = put
+        lines.append(f"    put{i}(o, src.{name})")
+    lines.append("    return o")
+    exec(compile("\n".join(lines) + "\n", "<PlantSnapshot copy>", "exec"), env)
+    return env["copy"]
+
+
+_copy = _copier()
 
 
 class PlantEvent:

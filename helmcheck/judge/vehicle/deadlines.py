@@ -32,16 +32,19 @@ class Deadlines:
             q = self.silent.popleft()
             self._silence_kept(q)
         window = self.profile.ack_window_s
-        over = []
+        over = None
         for p in self.pending:
             if t - p.t <= window:
                 continue  # inside the bare window: inside every allowance (ack_allowance ≥ the window)
             allowance = ack_allowance(window, len(p.raw), self.vbytes - p.vbytes0, self.baud, self.res)
             if t - p.t > ack_give_up_after(allowance):
+                if over is None:
+                    over = []
                 over.append((p, allowance))
-        for p, allowance in over:  # in order (each one's allowance does not depend on the others)
-            self.pending.remove(p)
-            self._missing(p, allowance)
+        if over is not None:
+            for p, allowance in over:  # in order (each one's allowance does not depend on the others)
+                self.pending.remove(p)
+                self._missing(p, allowance)
         if self.gave_up:
             self._give_up(t)
 

@@ -143,7 +143,8 @@ class OutputJudge:
     def line(self, d: Decoded, ev: Evidence, case: str) -> Optional[s.Sentence]:
         """Judge one vehicle line; returns the sentence when it is valid."""
         led = self.ledger
-        self._prefix(ev, case)
+        if self.noise_before is not None or self.prefix is not None:  # (else _prefix changes nothing)
+            self._prefix(ev, case)
         known = self._clean.get(d.raw)
         if known is not None:  # a line seen before without fault: the same passes again
             led.passed_all(known[1], [ev], case)
