@@ -19,7 +19,8 @@ entry point is :func:`.runner.certify`. Modules, one concern each:
   range edges and error codes, every mutation of a line); :mod:`.modelcover` — what of the
   model they reached (rows, interrupt pairs, timer boundaries, error codes).
 * :mod:`.replay` — version-independent replay files: write, read, re-drive from the verified
-  reset, naming the step that failed or went another way.
+  reset, naming the step that failed or went another way; :mod:`.relocate` moves the positions
+  a replay's lines send to where the vehicle begins it.
 * :mod:`.clockrate` — the vehicle's clock rate from ``$GPRMC`` readings, and whether it is the
   declared time scale (sans-IO); :mod:`.clockprobe` reads the clock at start.
 * :mod:`.restore` — leaving the vehicle as it was found: its settings and its mode.
