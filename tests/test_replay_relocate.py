@@ -125,3 +125,24 @@ def test_a_vehicle_far_from_where_the_steps_began_is_driven_back_first(tmp_path,
     assert "driven back there first" in text, text[-2000:]
     last = [ln for ln in text.splitlines() if "< $OSI," in ln][-1].split(",")
     assert distance_m(float(last[4]), float(last[5]), *origin) <= EMU_PROFILE.on_station_m + 1.0, last
+
+
+def test_after_the_last_step_a_redrive_follows_a_queue_to_its_end():
+    """``replay._arrive``: a vehicle still following its ``$OMW`` queue after the last step is polled
+    until the queue is done (a vehicle a few metres from where the recording began takes longer to
+    get where the recorded failure showed); one that follows nothing is not waited for."""
+    from helmcheck.certify.vehicle.replay import _arrive
+    from helmcheck.certify.vehicle.session import frame
+    from tests.test_certify_vehicle_surface_start import session
+    ses = session()
+    ses.reset(mission=True)
+    lat, lon = map(float, ses.here())
+    assert ses.exchange(frame(f"OMW,{lat + 10.0 / 111320.0:.6f},{lon:.6f},0,,15,0.5,0,")).accepted
+    assert ses.poll().mode == "W"
+    t0 = ses.now()
+    _arrive(ses)
+    assert ses.obs.last_osi.mode != "W" and ses.now() > t0
+    t1 = ses.now()
+    _arrive(ses)
+    assert ses.now() - t1 < 0.2
+    assert not ses.failures(), ses.failures()

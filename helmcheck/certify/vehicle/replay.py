@@ -57,6 +57,8 @@ IN_RESET = "already in the verified reset before the steps"
 #: A re-drive that finds the vehicle further than this from where the steps began drives it back
 #: there first, for at most this long in vehicle time (:func:`_return`).
 RETURN_BEYOND_M = 10.0
+#: The longest a re-drive polls on after its last step while the vehicle travels (:func:`_arrive`).
+ARRIVE_WITHIN_V = 60.0
 RETURN_WITHIN_V = 300.0
 KNOT_MPS = 1852.0 / 3600.0
 
@@ -189,6 +191,21 @@ def _return(doc: dict, session) -> bool:
     return True
 
 
+def _arrive(session) -> None:
+    """After the last step: while the vehicle still follows a queue (``W``) or travels to its
+    ``$OPK`` park (``mP`` not yet on station), poll on until it is done, for at most
+    :data:`ARRIVE_WITHIN_V` vehicle seconds, judging every report (:meth:`.session.Session.check`).
+    A vehicle that begins a few metres from where the recording's did (within the on-station
+    distance of the drive back) takes a little longer to get where the recorded failure showed."""
+    end = session.now() + ARRIVE_WITHIN_V / session.k
+    osi = session.obs.last_osi
+    while (osi is not None and session.now() < end
+           and (osi.mode == "W" or (osi.mode == "mP" and float(osi.distance or 0) > session.profile.on_station_m))):
+        session.link.sleep(max(session.poll_gap, 0.05))
+        osi = session.poll()
+        session.check()
+
+
 def _shift(doc: dict, session) -> tuple[float, float]:
     """How far the steps' positions move: from the replay's ``origin`` to where the vehicle is now
     (:mod:`.relocate`); nothing for a replay without one. Said in the log when it is not nothing."""
@@ -242,6 +259,7 @@ def _steps(doc: dict, session, time_scale: Optional[float], shift=(0.0, 0.0)) ->
         # a line the vehicle left unanswered, and a transition that comes late by more than its
         # tolerance, are judged before the verdict
         session.finish(LINGER_V + 2 * session.obs.slack_v())
+        _arrive(session)
     except CaseStop as f:
         at = f"step {where['i'] + 1} of {len(steps)} ({where['send'].strip() or 'a wait'})"
         why = f"at {at}: {f.reason}" + (f"; first, {diverged[0]}" if diverged else "")
