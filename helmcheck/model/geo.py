@@ -1,4 +1,5 @@
-"""Small geodesy helpers: great-circle distance (``$OPK`` 10-mile rule, ``$OSI`` field 7).
+"""Small geodesy helpers: great-circle distance (``$OPK`` 10-mile rule, ``$OSI`` field 7), and
+the knot in metres per second (speeds are in knots: ``$OMS``, ``$OPK``, ``$OMW``, ``$OSI`` field 6).
 
 Distances use the haversine formula on a sphere of radius 6 371 008.8 m (the IUGG mean
 radius); over the 16 km of the ``$OPK`` limit (RH-PK-1, RH-RD-9) it differs from the ellipsoid
@@ -9,9 +10,10 @@ from __future__ import annotations
 
 import math
 
-__all__ = ["distance_m", "EARTH_RADIUS_M"]
+__all__ = ["distance_m", "EARTH_RADIUS_M", "KNOT_MPS"]
 
 EARTH_RADIUS_M = 6_371_008.8
+KNOT_MPS = 1852.0 / 3600.0  #: metres per second in one knot
 
 
 def distance_m(lat1: float, lon1: float, lat2: float, lon2: float) -> float:

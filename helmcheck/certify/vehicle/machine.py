@@ -19,6 +19,7 @@ from typing import Optional
 from hypothesis import strategies as st
 from hypothesis.stateful import RuleBasedStateMachine, initialize, precondition, rule
 
+from ...model.geo import KNOT_MPS
 from ...model.timers import tolerance
 from ...judge.vehicle.blame import GENERIC
 from .flow import CaseStop, LinkLost
@@ -59,7 +60,7 @@ def _reach_park(session, ctx: dict) -> None:
     if wp is not None and session.obs.state().mission_wp != wp:
         session.exchange(frame(f"OJW,{wp + session.profile.waypoint_base}"))
     osi = session.poll()
-    mps = max(0.5, float(osi.speed or 0)) * 0.514444
+    mps = max(0.5, float(osi.speed or 0)) * KNOT_MPS
     if osi.mode != "N" or float(osi.distance or 0) / mps > PARK_WITHIN_V:
         _here(session, ctx)
         return

@@ -57,10 +57,9 @@ IN_RESET = "already in the verified reset before the steps"
 #: A re-drive that finds the vehicle further than this from where the steps began drives it back
 #: there first, for at most this long in vehicle time (:func:`_return`).
 RETURN_BEYOND_M = 10.0
+RETURN_WITHIN_V = 300.0
 #: The longest a re-drive polls on after its last step while the vehicle travels (:func:`_arrive`).
 ARRIVE_WITHIN_V = 60.0
-RETURN_WITHIN_V = 300.0
-KNOT_MPS = 1852.0 / 3600.0
 
 
 class ReplayError(ValueError):
@@ -155,7 +154,7 @@ def _return(doc: dict, session) -> bool:
     seconds and only while it gets nearer; not tried when the bench speed cannot cover the distance
     in that time; the caller resets again. Needs ``$OMSTART`` and ``$OMW``
     claimed; said in the log. True when it drove."""
-    from ...model.geo import distance_m
+    from ...model.geo import KNOT_MPS, distance_m
     from .generate import bench_speed
     from .session import frame
     origin = doc.get("origin")
@@ -192,8 +191,8 @@ def _return(doc: dict, session) -> bool:
 
 
 def _arrive(session) -> None:
-    """After the last step: while the vehicle still follows a queue (``W``) or travels to its
-    ``$OPK`` park (``mP`` not yet on station), poll on until it is done, for at most
+    """After the last step: while the vehicle still follows a queue (``W``, RH-OMW-2/4) or travels
+    to its ``$OPK`` park (``mP`` not yet on station, RH-PK-2), poll on until it is done, for at most
     :data:`ARRIVE_WITHIN_V` vehicle seconds, judging every report (:meth:`.session.Session.check`).
     A vehicle that begins a few metres from where the recording's did (within the on-station
     distance of the drive back) takes a little longer to get where the recorded failure showed."""

@@ -49,7 +49,7 @@ from decimal import Decimal, InvalidOperation
 from typing import Optional
 
 from ...grammar import sentences as s
-from ...model.geo import distance_m
+from ...model.geo import KNOT_MPS, distance_m
 from ...model.plant import NEUTRAL
 from ...model.timers import tolerance
 from ..timing import JITTER_S, PLANT_REACT_S
@@ -58,7 +58,6 @@ from .queuetarget import QueueTarget
 
 __all__ = ["OsiChecks"]
 
-_KN = 1852.0 / 3600.0
 #: Metres below which an ``$OPOS`` position cannot be told from where the vehicle already was.
 _POS_DECIDABLE_M = 30.0
 #: Reports away from the park position kept per ``$OPK`` (the latest; enough to time a count).
@@ -284,7 +283,7 @@ class OsiChecks:
         prev = pos["prev"]
         here = (float(osi.lat), float(osi.lon))
         dt_v = max(0.0, o.v(o.t) - o.v(pos["prev_t"]))
-        allow = max(float(osi.speed), o.profile.max_speed_kn) * _KN * dt_v + 10.0
+        allow = max(float(osi.speed), o.profile.max_speed_kn) * KNOT_MPS * dt_v + 10.0
         apart = distance_m(*prev, *target)
         if apart < max(_POS_DECIDABLE_M, 3 * allow):
             return  # the two readings cannot be told apart
@@ -376,7 +375,7 @@ class OsiChecks:
                 return
             if not near and park.on is None and not park.failed:
                 begin = (max(park.v0, lo - most), hi - least)
-                if not _possible(begin, park.away, park.knots * _KN, prof.on_station_m):
+                if not _possible(begin, park.away, park.knots * KNOT_MPS, prof.on_station_m):
                     park.failed = True
                     far = max(park.away, key=lambda a: a[2])
                     o.book("fail", ("RH-PK-2",), f"{what} {d:g} m from its position, not on station "

@@ -27,12 +27,11 @@ from decimal import Decimal
 from typing import Optional
 
 from ...grammar import sentences as s
-from ...model.geo import distance_m
+from ...model.geo import KNOT_MPS, distance_m
 from .closure import osi_numbers
 
 __all__ = ["QueueTarget", "allowance"]
 
-_KN = 1852.0 / 3600.0
 _M_PER_DEG = 111_320.0
 
 
@@ -73,7 +72,7 @@ class QueueTarget:
         here = (lat, lon)
         if key != self.key:  # a new queue: it set out from where the last report saw it
             self.key, self.index, self.seen = key, 0, before
-        mps = max(self.max_speed_kn, float(osi.speed)) * _KN
+        mps = max(self.max_speed_kn, float(osi.speed)) * KNOT_MPS
         d7 = float(osi.distance)
         fits = [i for i, w in enumerate(queue)
                 if abs(d7 - (d := distance_m(*here, float(w.lat), float(w.lon)))) <= allowance(osi, d, mps)]
