@@ -220,3 +220,24 @@ def test_a_faulty_variant_is_told_apart_on_its_clause(tmp_path, fault, k, select
 
 
 pytest_plugins = ["pytester"]
+
+
+@pytest.mark.parametrize("fault,code", [("release-to-next-waypoint", 1), ("", 0)])
+def test_a_replay_recorded_on_it_judges_a_fresh_instance_as_the_run_did(tmp_path, capsys, fault, code):
+    """A replay the exploration saved (RH-OMW-3/RH-OUT-4: a release toward waypoint 1 where the
+    mission's waypoint 0 was still 9 m off) fails again on a fresh instance of the same faulty
+    build and passes on the conforming one. The fresh instance begins 68 m from where the steps
+    began and the judge has not got its mission files: the re-drive drives it back and lets a
+    report show the first waypoint's distance from there (``replay._return``), as the run's
+    earlier sequences had; without that survey the judge could not tell the release from one on
+    station, and the replay passed."""
+    from helmcheck.cli import main as cli_main
+    replay = Path(__file__).resolve().parent / "fixtures" / "replays" / "third-party-release-to-next-waypoint.json"
+    log = tmp_path / "wire.log"
+    with uvc_sim(tmp_path, 20.0, fault=fault) as port:
+        got = cli_main(["replay", str(replay), "--port", port, "--wire-log", str(log)])
+    out = capsys.readouterr().out
+    assert got == code, out
+    assert "driven back there first" in log.read_text() and "surveyed" in log.read_text()
+    if code:
+        assert "STILL FAILS" in out and "next waypoint 1 in mode N" in out, out

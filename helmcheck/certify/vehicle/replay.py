@@ -25,8 +25,8 @@ sequence set going is judged inside it): whatever state the failure needs, the s
 :func:`redrive` first brings the vehicle to that reset (``$OMSTOP,0`` until accepted, waiting out
 a lockout left by whatever ran before, then ``S`` seen, at the surface when it gets there within
 two minutes of vehicle time: :meth:`.session.Session.outwait_surface`; and, when the replay says
-where the steps began and the vehicle is more than 10 m from there, driven back first,
-:func:`_return`), then sends the steps at their recorded
+where the steps began, driven back there when the vehicle is more than 1 m off, and the mission's
+first waypoint surveyed from there, :func:`_return`), then sends the steps at their recorded
 pace (a line never sooner after the line before it than when recorded, scaled to the present
 time scale: a delay shifts what follows, so a timer a line set going runs out before the lines
 that polled across it), judging every reply
@@ -56,8 +56,10 @@ LINGER_V = 3.0
 IN_RESET = "already in the verified reset before the steps"
 #: A re-drive that finds the vehicle further than this from where the steps began drives it back
 #: there first, for at most this long in vehicle time (:func:`_return`).
-RETURN_BEYOND_M = 10.0
+RETURN_BEYOND_M = 1.0
 RETURN_WITHIN_V = 300.0
+#: Where the drive back stops: this near the origin (:func:`_return`).
+ON_ORIGIN_M = 0.5
 #: The longest a re-drive polls on after its last step while the vehicle travels (:func:`_arrive`).
 ARRIVE_WITHIN_V = 60.0
 
@@ -146,14 +148,28 @@ def redrive(doc: dict, session, time_scale: Optional[float] = None) -> tuple[str
 
 
 def _return(doc: dict, session) -> bool:
-    """Drive the vehicle back to the replay's ``origin`` when it is more than
-    :data:`RETURN_BEYOND_M` from it: the steps may depend on where it is against the mission (a
-    release toward waypoint 0 from 70 m away, which a vehicle that begins on waypoint 0 reaches at
-    once). The test mission started, one ``$OMW`` to the origin at the surface (depth 0, no park,
-    the bench speed) followed until the queue is done, for at most :data:`RETURN_WITHIN_V` vehicle
-    seconds and only while it gets nearer; not tried when the bench speed cannot cover the distance
-    in that time; the caller resets again. Needs ``$OMSTART`` and ``$OMW``
-    claimed; said in the log. True when it drove."""
+    """Bring the vehicle back to the replay's ``origin`` and let the judge see where the mission's
+    first waypoint is from there; True when it sent anything (the caller resets again).
+
+    The steps may depend on where the vehicle is against the mission's waypoints, which no shift
+    of the steps' own positions moves: a release toward waypoint 0 from 9 m away is wrong, and
+    from 6 m the vehicle may have got on station (within 3 m, RH-RD-5) inside RH-TIM-1's tolerance.
+    And the judge can tell only what the reports showed: a vehicle whose mission files it does not
+    have is judged against the distances the reports gave (RH-RD-5's field 7), and a run's earlier
+    sequences had shown them where a fresh vehicle has not. So, with ``$OMSTART`` and ``$OMW``
+    claimed and a test mission named, said in the log:
+
+    * **Drive back**, when the vehicle is more than :data:`RETURN_BEYOND_M` from the origin and
+      the bench speed covers the distance within :data:`RETURN_WITHIN_V` vehicle seconds (else the
+      steps' positions are moved instead, :func:`_shift`): the test mission started and one
+      ``$OMW`` at the surface (depth 0, no park, the bench speed), followed while it gets nearer.
+      The ``$OMW`` aims past the origin by the on-station distance, on the line the vehicle comes
+      along, so that it passes about over the origin rather than counting the waypoint reached up
+      to ``on_station_m`` short of it; the drive ends within :data:`ON_ORIGIN_M` of the origin, past
+      its nearest point, or with the queue, and the queue is cleared.
+    * **Survey**: the mission running (started here, or resumed by the cleared queue), one
+      ``$OSD`` reports the distance to its first waypoint from the origin, then ``$OMSTOP`` at
+      once, before the mission takes the vehicle on."""
     from ...model.geo import KNOT_MPS, distance_m
     from .generate import bench_speed
     from .session import frame
@@ -161,32 +177,44 @@ def _return(doc: dict, session) -> bool:
     p = session.profile
     if origin is None or not {"OMSTART", "OMW"} <= set(p.commands) or not p.mission:
         return False
+    o_lat, o_lon = float(origin[0]), float(origin[1])
     lat, lon = map(float, session.here())
-    apart = distance_m(lat, lon, float(origin[0]), float(origin[1]))
-    if apart <= RETURN_BEYOND_M:
-        return False
-    if apart > bench_speed(p) * KNOT_MPS * RETURN_WITHIN_V:
+    apart = distance_m(lat, lon, o_lat, o_lon)
+    drive = apart > RETURN_BEYOND_M
+    if drive and apart > bench_speed(p) * KNOT_MPS * RETURN_WITHIN_V:
         session.note(f"replay: the vehicle is {apart:.0f} m from where the steps began, too far to drive back "
                      f"within {RETURN_WITHIN_V:g} s at the bench speed; the steps' positions are moved instead")
         return False
-    session.note(f"replay: the vehicle is {apart:.0f} m from where the steps began; driven back there first "
-                 f"($OMSTART, then $OMW to it)")
+    session.note(f"replay: the vehicle is {apart:.0f} m from where the steps began; "
+                 + ("driven back there first ($OMSTART, then $OMW to it), " if drive else "")
+                 + "the mission's first waypoint surveyed from there ($OMSTART, $OSD, $OMSTOP)")
     sent = session.exchange(frame(f"OMSTART,0,0,0,0,{p.mission},"))
     if sent is None or not sent.accepted:
         return True
-    session.exchange(frame(f"OMW,{float(origin[0]):.6f},{float(origin[1]):.6f},0,,15,{bench_speed(p):g},0,"))
-    end, window = session.now() + RETURN_WITHIN_V / session.k, session.now() + 60.0 / session.k
-    best = apart
-    while session.now() < end:
-        osi = session.poll()
-        left = distance_m(float(osi.lat), float(osi.lon), float(origin[0]), float(origin[1]))
-        if osi.mode != "W" or left <= p.on_station_m:
-            break
-        if session.now() > window:  # a minute of vehicle time and no nearer: it does not move
-            if left > best - 1.0:
+    if drive:
+        past = p.on_station_m / apart  # the aim: beyond the origin, on the line from here
+        aim = (o_lat + (o_lat - lat) * past, o_lon + (o_lon - lon) * past)
+        session.exchange(frame(f"OMW,{aim[0]:.6f},{aim[1]:.6f},0,,15,{bench_speed(p):g},0,"))
+        end, window = session.now() + RETURN_WITHIN_V / session.k, session.now() + 60.0 / session.k
+        best, near = apart + p.on_station_m, apart
+        while session.now() < end:
+            osi = session.poll()
+            here = distance_m(float(osi.lat), float(osi.lon), o_lat, o_lon)
+            # done: the queue ended, on the origin, or past the nearest point of the way to the aim
+            if osi.mode != "W" or here <= ON_ORIGIN_M or (here < p.on_station_m and here > near):
                 break
-            best, window = left, session.now() + 60.0 / session.k
-        session.link.sleep(max(session.poll_gap, 0.05))
+            near = min(near, here)
+            left = distance_m(float(osi.lat), float(osi.lon), *aim)
+            if session.now() > window:  # a minute of vehicle time and no nearer: it does not move
+                if left > best - 1.0:
+                    break
+                best, window = left, session.now() + 60.0 / session.k
+            session.link.sleep(max(session.poll_gap, 0.05))
+        if session.obs.last_osi is not None and session.obs.last_osi.mode == "W" and p.omw_clear_keywords:
+            session.exchange(frame(f"OMW,{p.omw_clear_keywords[0]}"))
+    session.poll()
+    if "OMSTOP" in p.commands:
+        session.exchange(frame("OMSTOP,0"))
     return True
 
 
