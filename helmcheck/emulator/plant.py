@@ -47,14 +47,13 @@ import math
 from dataclasses import dataclass, field
 from typing import Any, Optional
 
-from ..model.geo import EARTH_RADIUS_M, distance_m
+from ..model.geo import EARTH_RADIUS_M, KNOT_MPS, distance_m
 from ..model.plant import (AtSurface, OnStation, PlantEvent, PlantSnapshot, QueueWaypointReached,
                             Submerged, WaypointReached)
 from ..profile import Profile
 
-__all__ = ["PlantParams", "Plant", "Target", "KN"]
+__all__ = ["PlantParams", "Plant", "Target"]
 
-KN = 1852.0 / 3600.0  #: metres per second in one knot
 _FT = 0.3048
 
 
@@ -208,7 +207,7 @@ class Plant:
         """Metres per second the depth may change by toward ``t.depth``."""
         if t.rise_mps is not None:
             return t.rise_mps
-        speed = t.speed_kn * KN
+        speed = t.speed_kn * KNOT_MPS
         return speed * math.sin(math.radians(min(max(t.max_pitch, 0.0), 89.0)))
 
     def _depth_step(self, t: Target, dt: float) -> None:
@@ -327,12 +326,12 @@ class Plant:
         if t.kind == "primitive":
             self.heading = (self.heading + t.turn_dps * h) % 360.0
             self.speed_kn = t.speed_kn
-            self._move(t.speed_kn * KN * h)
+            self._move(t.speed_kn * KNOT_MPS * h)
             return 0.0
         if t.kind == "course":
             err = self._slew(t.heading, h)  # type: ignore[arg-type]
             self.speed_kn = t.speed_kn
-            self._move(t.speed_kn * KN * h)
+            self._move(t.speed_kn * KNOT_MPS * h)
             return err
         # goto
         if self._arrived:
@@ -342,7 +341,7 @@ class Plant:
         err = self._slew(self._bearing_mag(t.lat, t.lon), h)
         factor = max(0.2, math.cos(math.radians(min(abs(err), 90.0))))
         self.speed_kn = t.speed_kn * factor
-        self._move(min(dist, self.speed_kn * KN * h))
+        self._move(min(dist, self.speed_kn * KNOT_MPS * h))
         return err
 
     def _actuators(self, t: Target, heading_err: float) -> None:
@@ -362,7 +361,7 @@ class Plant:
         best: Optional[float] = None
         if t.arrive is not None and not self._arrived and t.speed_kn > 0:
             d = distance_m(self.lat, self.lon, t.lat, t.lon) - self.profile.on_station_m
-            best = max(0.0, d) / (t.speed_kn * KN)
+            best = max(0.0, d) / (t.speed_kn * KNOT_MPS)
         if t.depth is not None:
             fix = self.profile.gps_fix_depth_m
             crossing = (self.depth > fix >= t.depth) or (self.depth <= fix < t.depth)
@@ -387,7 +386,7 @@ class Plant:
         pct = 100.0 * self.energy_wh / p.capacity_wh if p.capacity_wh else 0.0
         volts = 24.0 + 5.0 * pct / 100.0
         watts = self.watts
-        speed_ms = self.speed_kn * KN
+        speed_ms = self.speed_kn * KNOT_MPS
         return base.with_(
             lat=self.lat, lon=self.lon, speed_kn=self.speed_kn, depth_m=self.depth,
             heading=self.heading % 360.0, declination=p.declination, pitch=self.pitch, roll=0.0,
@@ -411,7 +410,7 @@ class Plant:
                 leg = 0.0
                 if i + 1 < len(wps):
                     a, b = wps[i], wps[i + 1]
-                    leg = distance_m(a.lat, a.lon, b.lat, b.lon) / max(b.speed * KN, 1e-6)
+                    leg = distance_m(a.lat, a.lon, b.lat, b.lon) / max(b.speed * KNOT_MPS, 1e-6)
                 suffix[i] = wps[i].park_s + leg + suffix[i + 1]
             c = self._remaining_cache = (mission, suffix)
         suffix = c[1]
@@ -421,7 +420,7 @@ class Plant:
             left = m.park_left if m.park_left is not None else (m.park_remaining(now) or 0.0)
             secs = left + suffix[i] - w.park_s
         else:
-            secs = distance_m(self.lat, self.lon, w.lat, w.lon) / max(w.speed * KN, 1e-6) + suffix[i]
+            secs = distance_m(self.lat, self.lon, w.lat, w.lon) / max(w.speed * KNOT_MPS, 1e-6) + suffix[i]
         return max(0.0, secs) / 3600.0
 
 

@@ -64,7 +64,7 @@ from __future__ import annotations
 import time
 from typing import NamedTuple, Optional
 
-from hypothesis import HealthCheck, Phase, seed, settings
+from hypothesis import HealthCheck, Phase, Verbosity, seed, settings
 from hypothesis.database import DirectoryBasedExampleDatabase
 from hypothesis.errors import Flaky
 from hypothesis.stateful import run_state_machine_as_test
@@ -244,6 +244,9 @@ def explore(run) -> None:
             b0 = time.monotonic()
             cfg = settings(max_examples=n, stateful_step_count=steps, deadline=None, database=db,
                            suppress_health_check=list(HealthCheck), report_multiple_bugs=False, print_blob=False,
+                           # quiet: hypothesis would print the steps of a failing example to stdout;
+                           # the run records its own (the replay, the wire log)
+                           verbosity=Verbosity.quiet,
                            # once something is found, reusing the saved examples would replay that finding
                            phases=(Phase.explicit, *(() if state.found else (Phase.reuse,)), Phase.generate,
                                    Phase.shrink))

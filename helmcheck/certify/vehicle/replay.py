@@ -222,15 +222,11 @@ def _arrive(session) -> None:
     """After the last step: while the vehicle still follows a queue (``W``, RH-OMW-2/4) or travels
     to its ``$OPK`` park (``mP`` not yet on station, RH-PK-2), poll on until it is done, for at most
     :data:`ARRIVE_WITHIN_V` vehicle seconds, judging every report (:meth:`.session.Session.check`).
-    A vehicle that begins a few metres from where the recording's did (within the on-station
-    distance of the drive back) takes a little longer to get where the recorded failure showed."""
-    end = session.now() + ARRIVE_WITHIN_V / session.k
-    osi = session.obs.last_osi
-    while (osi is not None and session.now() < end
-           and (osi.mode == "W" or (osi.mode == "mP" and float(osi.distance or 0) > session.profile.on_station_m))):
-        session.link.sleep(max(session.poll_gap, 0.05))
-        osi = session.poll()
-        session.check()
+    A vehicle that begins a little off where the recording's did (within :data:`ON_ORIGIN_M` of the
+    drive back, or a shift) takes a little longer to get where the recorded failure showed."""
+    on = session.profile.on_station_m
+    session.poll_while(lambda osi: osi.mode == "W" or (osi.mode == "mP" and float(osi.distance or 0) > on),
+                       ARRIVE_WITHIN_V, judge=True)
 
 
 def _shift(doc: dict, session) -> tuple[float, float]:

@@ -192,14 +192,26 @@ class Session:
         re-drive then starts from the same state on any vehicle — an ``$OPOS`` is applied or not
         as on a fresh one. A vehicle still under water after that starts where it is."""
         from ...judge.vehicle.closure import osi_depth_m
+
+        def under(osi) -> bool:
+            depth = osi_depth_m(osi, self.profile.depth_unit)
+            return depth is not None and depth > self.profile.gps_fix_depth_m
+        self.poll_while(under, within_v)
+
+    def poll_while(self, keep, within_v: float, judge: bool = False):
+        """Poll, a poll gap apart, while ``keep(report)`` holds of the last report (one is polled
+        when none was seen), for at most ``within_v`` vehicle seconds; stop on a failure after each
+        report when ``judge`` (:meth:`check`). Returns the last report. Running out of time is
+        silent: the caller says what a vehicle still ``keep``-ing means (:meth:`until` makes it
+        INCONCLUSIVE instead)."""
         end = self.now() + within_v / self.k
         osi = self.obs.last_osi or self.poll()
-        while self.now() < end:
-            depth = osi_depth_m(osi, self.profile.depth_unit)
-            if depth is None or depth <= self.profile.gps_fix_depth_m:
-                return
+        while keep(osi) and self.now() < end:
             self.link.sleep(max(self.poll_gap, 0.05))
             osi = self.poll()
+            if judge:
+                self.check()
+        return osi
 
     def finish(self, linger_v: float = 0.0) -> None:
         """Let every line sent so far be settled by the observer — a line answered late or not at

@@ -43,6 +43,7 @@ from typing import Callable, Optional
 
 from ...grammar import sentences as s
 from ...grammar.errors import SentenceError
+from ...model.geo import KNOT_MPS
 from ...model.plant import OnStation, QueueWaypointReached, SafetyViolation, WaypointReached
 from ...profile import SAFETY_CODES
 from .candidate import Candidate
@@ -240,7 +241,7 @@ def _motion_trials(c: Candidate, osi: s.OSI, tp: float, gap: float, catalog) -> 
         from ...model.timers import tolerance
         prof = m.profile
         knots = max([prof.max_speed_kn, float(osi.speed)] + [x[-1] for x in (c.nav_seen, c.fix_seen) if x is not None])
-        vmax = knots * 1852.0 / 3600.0  # m/s
+        vmax = knots * KNOT_MPS  # m/s
         counted = max(0.0, m.opk_seconds - osi.park_time) + 1.0 + tolerance(m.opk_seconds)
         if float(osi.distance) <= prof.on_station_m + vmax * counted:
             def on_station(t: Candidate) -> Candidate:
@@ -276,7 +277,7 @@ def reachable(c: Candidate, k: int, v: float, catalog, speed_kn: float = 0.0) ->
     if run is None:
         return True
     knots = max([prof.max_speed_kn, speed_kn] + [x[-1] for x in (nav, fix) if x is not None])
-    vmax = knots * 1852.0 / 3600.0  # m/s
+    vmax = knots * KNOT_MPS  # m/s
     need = []  # (since when, metres it still had to make at least to be on station at k)
     if nav is not None and nav[0] == run.name and nav[1] == k:
         _, _, d, t0, lat, lon, _ = nav
