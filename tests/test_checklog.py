@@ -54,6 +54,7 @@ def test_faulty_vehicle_flagged_with_line_numbers():
     assert b["RH-ACK-3"] == [13]  # err 21 instead of 20 for a heading out of range
     assert b["RH-SRV-4"] == [23]  # still A after the 5 s servo timeout
     assert b["RH-OUT-4"] == [23]
+    assert "RH-INT-2" not in b  # control never ended: what it resumes is not in question
     assert b["RH-BS-2"] == [12]  # the backseat's own range error, too
     ev = verdicts(out)["RH-ACK-3"]["evidence"]
     assert ev[0]["line"].startswith("line 12: $OMS,400") and ev[1]["line"].startswith("line 13: $ACK,9,1,21")

@@ -12,8 +12,10 @@ conforming counterpart that passes the same clause:
   has lost the vehicle's state; a vehicle that arrived between two reports and drifted a little
   since is not failed;
 * released from remote control, a vehicle that heads for the waypoint after the one it was heading
-  for (it cannot have reached that one in the time) fails RH-INT-2; one that was close to it, or
-  was driven close to it under remote control, and reaches it passes.
+  for (it cannot have reached that one in the time) fails RH-INT-2 — and not the clause of what
+  released it, which it did; one still under remote control fails that clause, not RH-INT-2; one
+  that was close to the waypoint, or was driven close to it under remote control, and reaches it
+  passes.
 """
 
 from __future__ import annotations
@@ -242,6 +244,43 @@ def test_RH_INT_2_released_toward_the_next_waypoint_fails(tmp_path):
     assert verdict(v, "RH-INT-2") == "fail", v["RH-INT-2"]
     assert verdict(v, "RH-OUT-4") == "fail"
     assert "next waypoint 1" in v["RH-INT-2"]["reason"]
+    # the servo control did end, as RH-SRV-4 says: what it resumed is RH-INT-2's alone
+    assert verdict(v, "RH-SRV-4") != "fail", v["RH-SRV-4"]
+
+
+def clear(t: float) -> list[tuple]:
+    """Under servo control (A, polled), ``$OMW,Clr`` accepted: a release (RH-OMW-3)."""
+    return (send(t, "OMS,90,2,20,0,60", "ACK,9,0,0") + poll(t + 0.5, mode="A", speed=0)
+            + send(t + 1.0, "OMW,Clr", "ACK,16,0,0"))
+
+
+def test_RH_INT_2_released_by_OMW_Clr_toward_the_next_waypoint_is_RH_INT_2_not_RH_OMW_3(tmp_path):
+    """``$OMW,Clr`` ended the servo control (mode N, as RH-OMW-3 says) but the vehicle heads for
+    waypoint 1 where it was heading for waypoint 0, 150 m off: RH-INT-2 fails, RH-OMW-3 does not."""
+    rec = start() + poll(0.5, mode="N", wp=0, dist=150.0, speed=2.0) + clear(1.0)
+    rec += poll(2.5, mode="N", wp=1, dist=140.0, speed=2.0)
+    v = judge(tmp_path, rec)
+    assert verdict(v, "RH-INT-2") == "fail", v["RH-INT-2"]
+    assert verdict(v, "RH-OMW-3") != "fail", v["RH-OMW-3"]
+
+
+def test_RH_OMW_3_still_under_servo_control_after_OMW_Clr_is_RH_OMW_3_not_RH_INT_2(tmp_path):
+    """``$OMW,Clr`` accepted and the vehicle still in A: control did not end (RH-OMW-3); what it
+    resumes when it ends (RH-INT-2) is not in question."""
+    rec = start() + poll(0.5, mode="N", wp=0, dist=150.0, speed=2.0) + clear(1.0)
+    rec += poll(2.5, mode="A", speed=0)
+    v = judge(tmp_path, rec)
+    assert verdict(v, "RH-OMW-3") == "fail", v["RH-OMW-3"]
+    assert verdict(v, "RH-INT-2") != "fail", v["RH-INT-2"]
+
+
+def test_RH_OMW_3_released_as_it_should_passes_both(tmp_path):
+    """The conforming counterpart: released toward waypoint 0."""
+    rec = start() + poll(0.5, mode="N", wp=0, dist=150.0, speed=2.0) + clear(1.0)
+    rec += poll(2.5, mode="N", wp=0, dist=149.0, speed=2.0)
+    v = judge(tmp_path, rec)
+    assert failed(v) == set(), {c: v[c]["reason"] for c in failed(v)}
+    assert verdict(v, "RH-OMW-3") == "pass" and verdict(v, "RH-INT-2") == "pass"
 
 
 def test_RH_INT_2_released_toward_the_next_waypoint_fails_in_its_case(tmp_path):

@@ -54,7 +54,7 @@ from ..grammar import sentences as s
 from .timers import tolerance
 
 __all__ = ["Acceptable", "Expectation", "expectation", "steady_expectation", "quick_expectation",
-           "quick_check"]
+           "quick_check", "finding_field"]
 
 
 @dataclass(frozen=True, slots=True)
@@ -236,6 +236,18 @@ def quick_expectation(model, now: float, slack: float = 0.0) -> Expectation:
     """:func:`steady_expectation` when it answers, else :func:`expectation`."""
     exp = steady_expectation(model, now, slack)
     return exp if exp is not None else expectation(model, now, slack)
+
+
+#: How :meth:`Expectation.check` begins the finding of each field it compares, by field.
+_FIELD_PREFIX = (("mode", "mode '"), ("next_waypoint", "next waypoint "), ("error_state", "error state "),
+                 ("park_time", "park time "), ("srp_active", "SRP active "))
+
+
+def finding_field(message: str) -> Optional[str]:
+    """The report field a finding of :meth:`Expectation.check` is about (``mode``,
+    ``next_waypoint``, ``error_state``, ``park_time``, ``srp_active``); None for fields that each
+    fit some state but no single state fits them all."""
+    return next((f for f, pre in _FIELD_PREFIX if message.startswith(pre)), None)
 
 
 def quick_check(model, osi: s.OSI, now: float, slack: float = 0.0) -> list[tuple[str, str]]:

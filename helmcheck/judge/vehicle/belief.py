@@ -38,6 +38,7 @@ from typing import Optional
 
 from ...grammar import sentences as s
 from ...grammar.errors import SentenceError
+from ...model.observe import finding_field
 from ...model.timers import tolerance
 from ...model.transitions import INTERNAL_EVENTS, REMOTE_MODES, STAY, rows_for
 from ...model.vehicle import VehicleModel
@@ -336,6 +337,18 @@ class Beliefs:
                 # controls (RH-INT-1), after the interrupted kind's own clause
                 at = sum(1 for c in causes[:2] if c in ("RH-INT-3", "RH-OMW-5"))
                 causes.insert(at, "RH-INT-1")
+            elif released and osi.mode in released_from:
+                # still in the remote control the release ends: the trigger's clause (the timeout,
+                # $OMW,Clr, the queue done, the park time up) is what failed; RH-INT-2, what the
+                # vehicle resumes once control ends, is not yet in question
+                causes = [c for c in causes if c != "RH-INT-2"]
+            elif (released and osi.mode == p.model.mode and osi.mode not in _REMOTE
+                  and all(finding_field(msg) in _RESUMED for _, msg in result.findings)):
+                # released into the behaviour it should resume — as the trigger's clause says,
+                # also where it says the mission resumes (RH-PK-3, RH-OMW-4) — but toward another
+                # waypoint or with another park time left: RH-INT-2's alone. (Released into another
+                # mode breaks both where the trigger's clause says the mission resumes: both stay.)
+                causes.insert(0, "RH-INT-2")
             m = p.model
             if m.mode == "N" and m.mission is not None and osi.mode != "S" and (
                     (not m.mission.is_open and m.mission_wp == m.mission.last)
@@ -465,6 +478,8 @@ class Beliefs:
 
 #: the modes of remote-helm control (RH-INT-1)
 _REMOTE = frozenset(REMOTE_MODES)
+#: The report fields RH-INT-2 sets besides the mode: the next waypoint, the park time left.
+_RESUMED = frozenset({"next_waypoint", "park_time"})
 
 
 def finite(x: Optional[float]) -> bool:

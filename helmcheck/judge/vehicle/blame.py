@@ -34,9 +34,12 @@ specific cause as well), with three refinements of that first cause:
   cause is taken (RH-PK-2 "mode becomes mP", not RH-PK-1);
 * a release (:data:`RELEASES`): a timer or command that ends remote control says *that* control
   ends, RH-INT-2 says *what* the vehicle resumes — the waypoint it was heading for, the park time
-  left. A report no conforming state explains after one may be wrong in either (still in the
-  remote mode: the trigger's clause; released, but to the wrong waypoint or park: RH-INT-2), and
-  the candidates do not say which: both are booked;
+  left. A report no conforming state explains after one may be wrong in either, and the report
+  says which (:meth:`.belief.Beliefs.osi` orders the candidates): still in the remote mode the
+  release ends — the trigger's clause alone; released into the right mode but toward another
+  waypoint or with another park time left — RH-INT-2 alone. Where the candidates still name both
+  (released into another mode, which breaks both where the trigger's clause says the mission
+  resumes, RH-PK-3 and RH-OMW-4; a wrong error state or SRP flag as well), both are booked;
 * a report whose only specific cause is a clause its own check judges on that same report
   (:data:`REPORT_JUDGED`: the ``$OPK`` countdown, RH-PK-2, judged from fields 7 and 10 by
   :mod:`.osichecks`) is booked on RH-OUT-4 alone: the own check books the clause, with the
