@@ -11,6 +11,11 @@ the same way and must get no FAIL.
     .venv/bin/python benchmarks/explore_reach.py [--jobs N] [--seed S] [--only NAME …] [--json OUT] [--keep DIR]
 
 Prints one line per vehicle (found on its clause / found elsewhere / missed) and the figures.
+
+The run measures the ``helmcheck`` package as it is when it starts: it copies it to a temporary
+directory and imports it from there, in its workers and in the ``helmcheck`` processes it spawns,
+so that an edit to the checkout during the half hour does not change the code under measurement
+halfway (:func:`_snapshot`).
 """
 
 from __future__ import annotations
@@ -18,6 +23,7 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import shutil
 import sys
 import tempfile
 import time
@@ -172,6 +178,19 @@ def run_one(family: str, name: str, seed: int, budget: float | None) -> dict:
     return r
 
 
+def _snapshot() -> Path:
+    """A copy of the ``helmcheck`` package as it is now, put first on the import path of this
+    process, its workers and every process they spawn (``PYTHONPATH``); it takes effect where
+    nothing imported ``helmcheck`` before (the command line, not an in-process call from a test
+    session). The tests stay where they are: they find the independent simulator beside the
+    checkout."""
+    code = Path(tempfile.mkdtemp(prefix="explore-reach-code-"))
+    shutil.copytree(ROOT / "helmcheck", code / "helmcheck", ignore=shutil.ignore_patterns("__pycache__"))
+    sys.path.insert(0, str(code))
+    os.environ["PYTHONPATH"] = os.pathsep.join(p for p in (str(code), os.environ.get("PYTHONPATH", "")) if p)
+    return code
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--jobs", type=int, default=4)
@@ -185,9 +204,20 @@ def main(argv=None) -> int:
         os.environ["HELMCHECK_REACH_KEEP"] = str(a.keep.resolve())  # the worker processes read it
         global KEEP
         KEEP = os.environ["HELMCHECK_REACH_KEEP"]
-    todo = cases(a.only)
-    rows = []
-    t0 = time.monotonic()
+    before = os.environ.get("PYTHONPATH"), list(sys.path)
+    code = _snapshot()  # before anything imports helmcheck
+    try:
+        return _run(a, cases(a.only), [], time.monotonic())
+    finally:
+        if before[0] is None:
+            os.environ.pop("PYTHONPATH", None)
+        else:
+            os.environ["PYTHONPATH"] = before[0]
+        sys.path[:] = before[1]
+        shutil.rmtree(code, ignore_errors=True)
+
+
+def _run(a, todo, rows, t0) -> int:
     with ProcessPoolExecutor(a.jobs) as pool:
         futs = [pool.submit(run_one, f, n, a.seed, a.budget) for f, n in todo]
         for fut in as_completed(futs):

@@ -274,6 +274,16 @@ def test_RH_OMW_3_still_under_servo_control_after_OMW_Clr_is_RH_OMW_3_not_RH_INT
     assert verdict(v, "RH-INT-2") != "fail", v["RH-INT-2"]
 
 
+def test_released_toward_the_next_waypoint_then_taken_again_by_OMS_is_still_RH_INT_2(tmp_path):
+    """``$OMW,Clr`` released the servo control, and an ``$OMS`` right after it (no report between)
+    took control again: the report in A shows the frozen waypoint 1 where 0 was owed. The vehicle
+    is in a remote mode the release ends, but not still in it: RH-INT-2 stays among the clauses."""
+    rec = start() + poll(0.5, mode="N", wp=0, dist=150.0, speed=2.0) + clear(1.0)
+    rec += send(1.2, "OMS,90,2,20,0,60", "ACK,9,0,0") + poll(2.5, mode="A", wp=1, speed=0)
+    v = judge(tmp_path, rec)
+    assert verdict(v, "RH-INT-2") == "fail", v["RH-INT-2"]
+
+
 def test_RH_OMW_3_released_as_it_should_passes_both(tmp_path):
     """The conforming counterpart: released toward waypoint 0."""
     rec = start() + poll(0.5, mode="N", wp=0, dist=150.0, speed=2.0) + clear(1.0)

@@ -57,7 +57,7 @@ IN_RESET = "already in the verified reset before the steps"
 #: A re-drive that finds the vehicle further than this from where the steps began drives it back
 #: there first, for at most this long in vehicle time (:func:`_return`).
 RETURN_BEYOND_M = 1.0
-RETURN_WITHIN_V = 300.0
+RETURN_WITHIN_V = 600.0
 #: Where the drive back stops: this near the origin (:func:`_return`).
 ON_ORIGIN_M = 0.5
 #: The longest a re-drive polls on after its last step while the vehicle travels (:func:`_arrive`).
@@ -161,7 +161,8 @@ def _return(doc: dict, session) -> bool:
 
     * **Drive back**, when the vehicle is more than :data:`RETURN_BEYOND_M` from the origin and
       the bench speed covers the distance within :data:`RETURN_WITHIN_V` vehicle seconds (else the
-      steps' positions are moved instead, :func:`_shift`): the test mission started and one
+      steps' positions are moved instead, :func:`_shift`, and the survey is made where the vehicle
+      is): the test mission started and one
       ``$OMW`` at the surface (depth 0, no park, the bench speed), followed while it gets nearer.
       The ``$OMW`` aims past the origin by the on-station distance, on the line the vehicle comes
       along, so that it passes about over the origin rather than counting the waypoint reached up
@@ -182,12 +183,14 @@ def _return(doc: dict, session) -> bool:
     apart = distance_m(lat, lon, o_lat, o_lon)
     drive = apart > RETURN_BEYOND_M
     if drive and apart > bench_speed(p) * KNOT_MPS * RETURN_WITHIN_V:
+        drive = False
         session.note(f"replay: the vehicle is {apart:.0f} m from where the steps began, too far to drive back "
-                     f"within {RETURN_WITHIN_V:g} s at the bench speed; the steps' positions are moved instead")
-        return False
-    session.note(f"replay: the vehicle is {apart:.0f} m from where the steps began; "
-                 + ("driven back there first ($OMSTART, then $OMW to it), " if drive else "")
-                 + "the mission's first waypoint surveyed from there ($OMSTART, $OSD, $OMSTOP)")
+                     f"within {RETURN_WITHIN_V:g} s at the bench speed; the steps' positions are moved instead, "
+                     f"and the mission's first waypoint surveyed from where it is ($OMSTART, $OSD, $OMSTOP)")
+    else:
+        session.note(f"replay: the vehicle is {apart:.0f} m from where the steps began; "
+                     + ("driven back there first ($OMSTART, then $OMW to it), " if drive else "")
+                     + "the mission's first waypoint surveyed from there ($OMSTART, $OSD, $OMSTOP)")
     sent = session.exchange(frame(f"OMSTART,0,0,0,0,{p.mission},"))
     if sent is None or not sent.accepted:
         return True

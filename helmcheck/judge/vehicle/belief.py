@@ -337,10 +337,11 @@ class Beliefs:
                 # controls (RH-INT-1), after the interrupted kind's own clause
                 at = sum(1 for c in causes[:2] if c in ("RH-INT-3", "RH-OMW-5"))
                 causes.insert(at, "RH-INT-1")
-            elif released and osi.mode in released_from:
-                # still in the remote control the release ends: the trigger's clause (the timeout,
-                # $OMW,Clr, the queue done, the park time up) is what failed; RH-INT-2, what the
-                # vehicle resumes once control ends, is not yet in question
+            elif released and osi.mode in released_from and _release_last(p.pending + ahead):
+                # still in the remote control the release ends, and nothing took control after it:
+                # the trigger's clause (the timeout, $OMW,Clr, the queue done, the park time up) is
+                # what failed; RH-INT-2, what the vehicle resumes once control ends, is not yet in
+                # question
                 causes = [c for c in causes if c != "RH-INT-2"]
             elif (released and osi.mode == p.model.mode and osi.mode not in _REMOTE
                   and all(finding_field(msg) in _RESUMED for _, msg in result.findings)):
@@ -478,6 +479,13 @@ class Beliefs:
 
 #: the modes of remote-helm control (RH-INT-1)
 _REMOTE = frozenset(REMOTE_MODES)
+def _release_last(rows) -> bool:
+    """Whether the last of ``rows`` that sets a mode is a release (RH-INT-2): no control was taken
+    again after it (an ``$OMS`` after ``$OMW,Clr`` leaves the vehicle in ``A`` again)."""
+    last = next((row for row in reversed(rows) if row.target != STAY), None)
+    return last is not None and "RH-INT-2" in last.clauses
+
+
 #: The report fields RH-INT-2 sets besides the mode: the next waypoint, the park time left.
 _RESUMED = frozenset({"next_waypoint", "park_time"})
 
