@@ -207,7 +207,7 @@ def main(argv=None) -> int:
     before = os.environ.get("PYTHONPATH"), list(sys.path)
     code = _snapshot()  # before anything imports helmcheck
     try:
-        return _run(a, cases(a.only), [], time.monotonic())
+        return _run(a, cases(a.only))
     finally:
         if before[0] is None:
             os.environ.pop("PYTHONPATH", None)
@@ -217,7 +217,10 @@ def main(argv=None) -> int:
         shutil.rmtree(code, ignore_errors=True)
 
 
-def _run(a, todo, rows, t0) -> int:
+def _run(a, todo) -> int:
+    """Certify every vehicle of ``todo``, ``a.jobs`` at a time; print and write the figures."""
+    rows: list = []
+    t0 = time.monotonic()
     with ProcessPoolExecutor(a.jobs) as pool:
         futs = [pool.submit(run_one, f, n, a.seed, a.budget) for f, n in todo]
         for fut in as_completed(futs):

@@ -7,7 +7,7 @@ north, …). Re-driven where the vehicle is somewhere else — a fresh vehicle a
 the same one after the sequence moved it — the same bytes would ask for other things (a park 30 km
 off is refused for its distance; an ``$OPOS`` at the vehicle's present position shows nothing).
 So a replay carries the position it began at (``origin``). A re-drive first drives the vehicle
-back there when it can (more than 10 m off, near enough, ``$OMW`` claimed:
+back there when it can (more than 1 m off, near enough, ``$OMW`` claimed:
 :func:`.replay._return`; what the steps do against the mission, a waypoint reached or not,
 depends on where the vehicle is), and :func:`shift_line` moves every position a line gives by
 what is left of the difference: the line asks, relative to the vehicle, what it asked when

@@ -479,6 +479,8 @@ class Beliefs:
 
 #: the modes of remote-helm control (RH-INT-1)
 _REMOTE = frozenset(REMOTE_MODES)
+
+
 def _release_last(rows) -> bool:
     """Whether the last of ``rows`` that sets a mode is a release (RH-INT-2): no control was taken
     again after it (an ``$OMS`` after ``$OMW,Clr`` leaves the vehicle in ``A`` again)."""
