@@ -1,9 +1,9 @@
 """The exploration's rules (``helmcheck/certify/vehicle/explore.py``), against faulty vehicles
 served behind real ptys:
 
-* a failure the exploration found is re-driven twice after shrinking, from a verified reset:
-  2 of 2 is FAIL, 0 or 1 of 2 is INCONCLUSIVE with the count as the reason (README, "Certify
-  vehicle");
+* a failure the exploration found is re-driven after shrinking, from a verified reset, until two
+  re-runs count (a re-drive that went another way than recorded and passed does not): 2 of 2 is
+  FAIL, 0 or 1 of 2 is INCONCLUSIVE with the count as the reason (README, "Certify vehicle");
 * what hypothesis ends with on a vehicle's failure — also a flaky one, which hypothesis reports as
   ``FlakyFailure`` — is a finding; anything else (a bug in helmcheck) is a tester error, which
   ends the run with exit 2 and its traceback in ``tester-error.txt`` beside ``results.json``.
@@ -147,6 +147,63 @@ def test_a_failure_the_reruns_do_not_both_reproduce_is_inconclusive(reproduced, 
     assert not (tmp_path / "r" / "tester-error.txt").exists()
     assert all(c["verdict"] not in ("fail", "non-strict") for c in r["clauses"]), \
         [(c["id"], c["reason"]) for c in r["clauses"] if c["verdict"] in ("fail", "non-strict")]
+
+
+# ---------------------------------------------------------------------------- what counts as a re-run
+
+def test_a_rerun_that_went_another_way_and_passed_is_not_counted(tmp_path, monkeypatch):
+    """The first re-drive finds the vehicle mended and the recording's first expectation
+    otherwise than the model's now (as when a timer raced a line differently): the steps did not
+    lead where they led, so its pass says nothing and is not counted; the vehicle misbehaves again
+    on the next two, which count: 2 of 2, FAIL. (Counting the first made it 1 of 2.)"""
+    cores: list = []
+    real = replay_mod.redrive
+    reruns: list = []
+
+    def first_rerun_goes_another_way(doc, session):
+        reruns.append(doc)
+        if len(reruns) == 1:
+            cores[-1].faults = 0
+            steps = [dict(st) for st in doc["steps"]]
+            first = next(st for st in steps if "expect" in st)
+            first["expect"] = "something the model does not expect now"
+            doc = dict(doc, steps=steps)
+        else:
+            cores[-1].faults = None
+        got = real(doc, session)
+        if len(reruns) == 1:
+            assert got.verdict == "pass" and not got.faithful and "went another way" in got.reason, got
+        return got
+
+    monkeypatch.setattr(replay_mod, "redrive", first_rerun_goes_another_way)
+    with _serve(RefusesWith21, cores) as port:
+        out = _certify(port, tmp_path / "r")
+    r = out.results
+    ex = r["stats"]["explore"]
+    assert len(reruns) == 3, ex
+    assert ex["confirmed"] == "2/2", ex
+    finding = next(f for f in ex["findings"] if f["clause"] == CLAUSE)
+    assert finding["reruns"][0].startswith("pass (not counted): "), finding["reruns"]
+    assert all(x.startswith("fail: ") for x in finding["reruns"][1:]), finding["reruns"]
+    assert _clause(r, CLAUSE)["verdict"] == "fail", _clause(r, CLAUSE)
+    assert out.verdict == "fail" and out.exit_code == 1, out.reason
+
+
+def _redrive(verdict: str, clause=None, faithful=True, reason="at step 3 of 5 ($OMS,…): …"):
+    return replay_mod.Redrive(verdict, reason, clause, faithful)
+
+
+@pytest.mark.parametrize("got, counted", [
+    (_redrive("fail", CLAUSE), True),
+    (_redrive("fail", CLAUSE, faithful=False), True),  # went another way, and failed on it all the same
+    (_redrive("fail", "RH-SRV-2"), False),  # the recorded way, but another clause failed first
+    (_redrive("pass"), False),
+    (_redrive("pass", faithful=False), None),
+    (_redrive("inconclusive"), None),
+    (_redrive("fail", CLAUSE, faithful=False, reason=f"{replay_mod.IN_RESET}: {CLAUSE}: …"), None),
+])
+def test_which_redrives_count_as_reruns(got, counted):
+    assert explore_mod.counts(got, (CLAUSE, "RH-ACK-3")) is counted
 
 
 # ---------------------------------------------------------------------------- finding or tester error

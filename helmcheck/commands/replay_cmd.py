@@ -93,7 +93,7 @@ def run(args: argparse.Namespace) -> int:
         link = TesterLink(raw, profile, recorder)
         session = Session(link, profile, k, observer)
         try:
-            verdict, reason, clause = redrive(doc, session)
+            verdict, reason = redrive(doc, session)[:2]
         except LinkLost as e:
             verdict, reason = "inconclusive", f"link fault: {e}"
     finally:

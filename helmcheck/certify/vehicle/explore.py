@@ -33,8 +33,11 @@ budget from a batch's first failure. A finding does not end the exploration: the
 do not stop at the clauses already found (:attr:`.session.Session.ignore`; their violations are
 still held and booked), so they look on for the others; nor does a sequence stop at a clause its
 starting reset already shows violated (carried over from an earlier sequence). The run keeps the
-smallest failing sequence of each clause, whatever hypothesis ends with, and re-drives each twice
-(the others found not stopped at) to say whether it fails again on its clause, inside its steps:
+smallest failing sequence of each clause, whatever hypothesis ends with, and re-drives each
+(the others found not stopped at) to say whether it fails again on its clause, inside its steps,
+until two re-runs count, at most four times: a re-drive in which the vehicle went another way
+than recorded and the failure did not come says nothing either way and is not counted
+(:func:`counts`), nor is one that failed before the steps or could not run them.
 2 of 2 books that clause's held violations as violations (``confirmed RH-X: …``) and saves the
 sequence as a version-independent replay file (:mod:`.replay`); fewer books them INCONCLUSIVE
 (``unconfirmed RH-X: …``) and keeps the sequence in ``replays/unconfirmed/`` for people. Held
@@ -170,19 +173,47 @@ class _State:
             self.error = e
 
 
-def _confirm(run, best: dict) -> tuple[int, list[str]]:
-    """Re-drive the smallest failing sequence of one clause twice: how many times it failed again
+#: A finding is confirmed when this many re-runs of its smallest failing sequence reproduce it …
+CONFIRM_RERUNS = 2
+#: … counting only re-runs that say something (:func:`counts`); at most this many re-drives.
+CONFIRM_TRIES = 4
+
+
+def counts(got, also) -> Optional[bool]:
+    """Whether a re-drive (a :class:`~.replay.Redrive`) counts as a re-run of a finding booked on
+    the clauses ``also``, and if so whether it reproduced it: ``True`` it failed again on one of
+    them, within the steps; ``False`` the steps ran the recorded way and it did not (a pass, or a
+    failure on another clause first); ``None`` it says nothing either way — the vehicle failed
+    already in the verified reset before the steps, the steps could not be run or judged
+    (INCONCLUSIVE), or the vehicle went another way than when they were recorded and the failure
+    did not come (a timer raced a line differently: the steps did not lead where they led)."""
+    from .replay import IN_RESET
+    if got.verdict == "fail" and got.clause in also and not got.reason.startswith(IN_RESET):
+        return True
+    if got.verdict == "inconclusive" or not got.faithful:
+        return None
+    return False
+
+
+def _confirm(run, best: dict) -> tuple[int, int, list[str]]:
+    """Re-drive the smallest failing sequence of one clause until :data:`CONFIRM_RERUNS` re-runs
+    count (:func:`counts`), at most :data:`CONFIRM_TRIES` times: how many reproduced the failure
     on that clause (the other clauses found are not stopped at: :attr:`.session.Session.ignore`),
-    and what each re-run said."""
-    from .replay import IN_RESET, redrive
-    n = 0
+    how many re-drives did not count, and what each said (those that did not count marked so)."""
+    from .replay import redrive
+    n = counted = 0
     said = []
-    for _ in range(2):
+    for _ in range(CONFIRM_TRIES):
         doc = {"steps": best["steps"], "time_scale": run.k, "lazy_silence": True, "origin": best.get("origin")}
-        verdict, reason, clause = redrive(doc, run.session)
-        n += verdict == "fail" and clause in best["also"] and not reason.startswith(IN_RESET)
-        said.append(f"{verdict}: {reason}"[:300])
-    return n, said
+        got = redrive(doc, run.session)
+        again = counts(got, best["also"])
+        said.append(f"{got.verdict}{' (not counted)' if again is None else ''}: {got.reason}"[:300])
+        if again is not None:
+            counted += 1
+            n += again
+            if counted == CONFIRM_RERUNS:
+                break
+    return n, len(said) - counted, said
 
 
 def _found_clauses(found: dict) -> frozenset:
@@ -299,13 +330,15 @@ def explore(run) -> None:
         for cid, best in state.found.items():
             session.ignore = _found_clauses(state.found) - set(best["also"])
             try:
-                confirmed, reruns = _confirm(run, best)
+                confirmed, idle, reruns = _confirm(run, best)
             finally:
                 session.ignore = frozenset()
-            session.note(f"{'confirmed' if confirmed == 2 else 'unconfirmed'} {','.join(best['also'])}: reproduced "
-                         f"{confirmed} of 2 re-runs after shrinking")
-            findings.append({"clause": cid, "reason": best["reason"], "confirmed": f"{confirmed}/2",
-                             "flaky": confirmed < 2, "steps": len(best["steps"]), "reruns": reruns})
+            session.note(f"{'confirmed' if confirmed == CONFIRM_RERUNS else 'unconfirmed'} "
+                         f"{','.join(best['also'])}: reproduced {confirmed} of {CONFIRM_RERUNS} re-runs after shrinking"
+                         + (f" ({idle} more re-drive{'s' if idle > 1 else ''} went another way than recorded "
+                            f"or could not run the steps: not counted)" if idle else ""))
+            findings.append({"clause": cid, "reason": best["reason"], "confirmed": f"{confirmed}/{CONFIRM_RERUNS}",
+                             "flaky": confirmed < CONFIRM_RERUNS, "steps": len(best["steps"]), "reruns": reruns})
         if run.ledger.held_clauses():  # seen in the verified reset between two sequences only: never re-driven
             session.note("unconfirmed: seen between the exploration's sequences (in a verified reset), "
                          "not re-driven on its own")

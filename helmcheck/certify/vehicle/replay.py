@@ -38,14 +38,14 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
-from typing import Optional
+from typing import NamedTuple, Optional
 
 from ...grammar.wirelog import unescape
 from ...profile import Profile
 from ...reports.atomic import write_text_atomic
 from .relocate import shift_line
 
-__all__ = ["save_replay", "load_replay", "redrive", "ReplayError", "FORMAT"]
+__all__ = ["save_replay", "load_replay", "redrive", "Redrive", "ReplayError", "FORMAT"]
 
 FORMAT = "helmcheck-replay"
 #: Vehicle seconds a re-drive goes on polling after its last step (plus twice the observer's own
@@ -66,6 +66,19 @@ ARRIVE_WITHIN_V = 60.0
 
 class ReplayError(ValueError):
     """A replay file that cannot be used; names the file."""
+
+
+class Redrive(NamedTuple):
+    """What a re-drive says: ``verdict`` (``fail`` / ``pass`` / ``inconclusive``), its ``reason``
+    and the ``clause`` a failure was booked on; ``faithful``: the steps ran and the model expected
+    every answer up to the verdict as it did when they were recorded (the vehicle went the
+    recorded way). A pass that is not faithful says nothing of the recorded failure: the steps
+    did not lead where they led then (:func:`.explore._confirm` does not count it)."""
+
+    verdict: str
+    reason: str
+    clause: Optional[str]
+    faithful: bool
 
 
 def save_replay(path: Path, clause: str, reason: str, steps: list, time_scale: float, profile: Profile,
@@ -107,8 +120,8 @@ def load_replay(path: Path) -> dict:
     return doc
 
 
-def redrive(doc: dict, session, time_scale: Optional[float] = None) -> tuple[str, str, Optional[str]]:
-    """Re-drive the steps on ``session``: (``fail``/``pass``/``inconclusive``, reason, clause).
+def redrive(doc: dict, session, time_scale: Optional[float] = None) -> Redrive:
+    """Re-drive the steps on ``session``: a :class:`Redrive`.
 
     First the verified reset the sequence began from (module docstring), then the steps at their
     recorded pace; the session's observer judges every reply, as in any run. The reason names the
@@ -132,10 +145,10 @@ def redrive(doc: dict, session, time_scale: Optional[float] = None) -> tuple[str
                 session.outwait_surface()
     except CaseStop as f:
         if f.outcome != "fail" and not session.failures():
-            return "inconclusive", f"the verified reset before the steps failed: {f.reason}", None
+            return Redrive("inconclusive", f"the verified reset before the steps failed: {f.reason}", None, False)
     got = [f for f in session.failures() if f[0] not in session.ignore]
     if got:  # a vehicle that breaks the profile in every reply already does in the reset
-        return "fail", f"{IN_RESET}: {got[0][0]}: {got[0][1]}", got[0][0]
+        return Redrive("fail", f"{IN_RESET}: {got[0][0]}: {got[0][1]}", got[0][0], False)
     session.mark = session.ledger.mark()
     shift = _shift(doc, session)
     # the line pace the sequence was recorded at: an exploration does not sit out the window of a
@@ -246,7 +259,7 @@ def _shift(doc: dict, session) -> tuple[float, float]:
     return dlat, dlon
 
 
-def _steps(doc: dict, session, time_scale: Optional[float], shift=(0.0, 0.0)) -> tuple[str, str, Optional[str]]:
+def _steps(doc: dict, session, time_scale: Optional[float], shift=(0.0, 0.0)) -> Redrive:
     from .flow import CaseStop
     from .safety import BenchSafetyRefused
     from .session import _brief
@@ -273,7 +286,7 @@ def _steps(doc: dict, session, time_scale: Optional[float], shift=(0.0, 0.0)) ->
                 try:
                     last = session.exchange(raw)
                 except BenchSafetyRefused as e:
-                    return "inconclusive", f"step {i + 1} was not sent: {e}", None
+                    return Redrive("inconclusive", f"step {i + 1} was not sent: {e}", None, False)
             elif "wait" in st:
                 session.wait(float(st["wait"]))
             elif "expect" in st and last is not None and not diverged:
@@ -289,7 +302,7 @@ def _steps(doc: dict, session, time_scale: Optional[float], shift=(0.0, 0.0)) ->
     except CaseStop as f:
         at = f"step {where['i'] + 1} of {len(steps)} ({where['send'].strip() or 'a wait'})"
         why = f"at {at}: {f.reason}" + (f"; first, {diverged[0]}" if diverged else "")
-        return ("fail" if f.outcome == "fail" else "inconclusive"), why, f.clause
+        return Redrive("fail" if f.outcome == "fail" else "inconclusive", why, f.clause, not diverged)
     if diverged:
-        return "pass", f"all {len(steps)} steps agreed with the model, but {diverged[0]}", None
-    return "pass", f"all {len(steps)} steps agreed with the model", None
+        return Redrive("pass", f"all {len(steps)} steps agreed with the model, but {diverged[0]}", None, False)
+    return Redrive("pass", f"all {len(steps)} steps agreed with the model", None, True)
