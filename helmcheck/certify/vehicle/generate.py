@@ -93,12 +93,15 @@ def _oms(p: Profile, spd, tos):
 def _omp(p: Profile, motor: int, tos):
     hexb = st.integers(0x60, 0xA0).map(lambda b: f"{b:02X}")
     mot = st.integers(0x80, max(0x80, motor)).map(lambda b: f"{b:02X}")
-    good = st.builds(lambda a, b, m, t: f"OMP,{a}{a}{b}{b}{m},00,{t}", hexb, hexb, mot, tos)
+    # one field off at a time: the timeout's edges with good bytes, bad bytes with a timeout the
+    # vehicle accepts (else the timeout alone explains the refusal, and a vehicle that reads nine
+    # hex digits as ten is not told apart from one that refuses them, RH-PRM-2)
+    good = st.builds(lambda a, b, m, t: f"OMP,{a}{a}{b}{b}{m},00,{t}", hexb, hexb, mot, _timeouts_edges(p, tos))
     bad = st.builds(lambda form, t: form.format(t=t),
                     st.sampled_from(["OMP,808080808,00,{t}", "OMP,80808080800,00,{t}", "OMP,8080G08080,00,{t}",
                                      "OMP,8080808080,01,{t}", "OMP,8080808080,10,{t}", "OMP,8080808080,00",
                                      "OMP,8080,00,{t}"]),
-                    _timeouts_edges(p, tos))
+                    tos)
     return st.one_of(good, bad)
 
 
@@ -193,7 +196,8 @@ def _one_off(fmt: str, inside: list, edges: list[list[str]]):
 
 def one_field_off(p: Profile, tos) -> st.SearchStrategy[str]:
     """For each claimed command with ranged fields, a body with one field at an edge of its range
-    or one past it and the rest inside (:func:`_one_off`); ``$OSD`` with every letter the profile
+    or one past it and the rest inside (:func:`_one_off`; ``$OMP``'s bytes: a digit short or over,
+    a letter past F, lower case); ``$OSD`` with every letter the profile
     serves; ``$OMLOAD`` and ``$OMSTART`` with every name a vehicle must refuse (RH-MSN-1); ``$OPOS``
     a kilometre away (far enough that a report soon after tells whether it was
     applied, RH-POS-2). Speeds stay within bench safety, so only their lower edge is drawn."""
@@ -208,7 +212,9 @@ def one_field_off(p: Profile, tos) -> st.SearchStrategy[str]:
         "OMS": _one_off("OMS,{},{},{},{},{}", [_num(0, 359), _num(0, min(4.0, md)), _num(0, 45, 0), spd, tos],
                         [["0", "359.9", "-1", "360", "360.5"], ["0", f"{md:g}", "-1", f"{md + 1:g}", f"{md + 0.5:g}"],
                          ["0", "45", "-1", "46"], ["0"], t_edges]),
-        "OMP": _one_off("OMP,808080{}{},00,{}", [st.just("80"), mot, tos], [["80"], ["80"], t_edges]),
+        # the bytes: nine and eleven hex digits, a letter past F, fins in lower case (accepted)
+        "OMP": _one_off("OMP,{},{},{}", [mot.map(lambda m: f"80808080{m}"), st.just("00"), tos],
+                        [["808080808", "80808080800", "8080G08080", "7f7f808080"], ["01", "10"], t_edges]),
         "OJW": st.sampled_from([b - 1, b, last, last + 1, last + 1, b + 1 if last > b else b]).map(
             lambda n: f"OJW,{n}"),
         "OPK": _one_off("OPK,{},{},{},{}", [st.just("{lat}"), st.just("{lon}"), st.sampled_from(["1", "2"]), spd],

@@ -274,11 +274,17 @@ def machine(state, p, tos, deep: bool = True):
             for met, sent in zip(mets, session.burst(raws)):
                 cov.command(met, sent.expected)
 
-        @rule(bodies=st.lists(one_field_off(p, tos), min_size=2, max_size=6), together=st.booleans())
-        def edges(self, bodies, together):
+        @rule(bodies=st.lists(one_field_off(p, tos), min_size=2, max_size=6), together=st.booleans(),
+              stopped=st.booleans())
+        def edges(self, bodies, together, stopped):
             """Lines with one field at an edge of its range or one past it, the others inside (§4–6,
             RH-RD-9): one by one, each ``$OPOS`` between two reports (RH-POS-2: a position applied
-            or not shows at once), or written back to back (RH-ACK-6: a slow command first)."""
+            or not shows at once), or written back to back (RH-ACK-6: a slow command first).
+            ``stopped``: after an ``$OMSTOP,0`` (RH-MSN-3: mode ``S``), where the commands accepted
+            only in ``S`` (RH-MSN-1/2) are refused for their fields alone — in another mode the
+            refusal for the mode hides a vehicle that accepts a name it must refuse."""
+            if stopped and "OMSTOP" in claimed:
+                bodies = ["OMSTOP,0"] + list(bodies)
             for b in bodies:
                 self._sent(b)
 
