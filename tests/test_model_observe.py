@@ -54,6 +54,9 @@ def test_RH_OUT_4_check_names_each_wrong_field():
     msgs = e.check(dataclasses.replace(osi, next_waypoint=2, park_time=10, error_state="Sle"))
     assert len(msgs) == 3 and all(c == "RH-OUT-4" for c, _ in msgs)
     assert "park time P10" in msgs[2][1]
+    # each finding says the field it is about (the judge's blame reads it, never the message)
+    assert [f.field for f in msgs] == ["next_waypoint", "error_state", "park_time"]
+    assert [f.field for f in e.check(dataclasses.replace(osi, mode="N"))] == ["mode"]
 
 
 def test_RH_OUT_4_expectation_survives_the_model_running_ahead():

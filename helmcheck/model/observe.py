@@ -2,9 +2,9 @@
 
 A tester mirrors every command it sent into a :class:`~helmcheck.model.vehicle.VehicleModel`
 (``receive(cmd, t)``) and, for an ``$OSI`` it received, asks ``expectation(model, t, slack)``
-(or ``model.expectation(t, slack)``); :meth:`Expectation.check` lists ``(clause, message)`` for
-every judged field (mode, next waypoint, park time, error state, SRP flag) no acceptable state
-explains.
+(or ``model.expectation(t, slack)``); :meth:`Expectation.check` lists a :class:`Finding` —
+``(clause, message)``, and the field it is about — for every judged field (mode, next waypoint,
+park time, error state, SRP flag) no acceptable state explains.
 
 Approach: skewed shadows
 ------------------------
@@ -53,8 +53,23 @@ from typing import Optional
 from ..grammar import sentences as s
 from .timers import tolerance
 
-__all__ = ["Acceptable", "Expectation", "expectation", "steady_expectation", "quick_expectation",
-           "quick_check", "finding_field"]
+__all__ = ["Acceptable", "Expectation", "Finding", "expectation", "steady_expectation", "quick_expectation",
+           "quick_check"]
+
+
+class Finding(tuple):
+    """``(clause, message)`` of :meth:`Expectation.check`, with ``field``: the report field it is
+    about (``mode``, ``next_waypoint``, ``error_state``, ``park_time``, ``srp_active``), or None
+    when each field fits some state but no single state fits them all. A pair like any other
+    (unpacked, compared, written as JSON), for the judges that only book it."""
+
+    def __new__(cls, clause: str, message: str, field: Optional[str]):
+        self = super().__new__(cls, (clause, message))
+        self.field = field
+        return self
+
+    def __getnewargs__(self):
+        return self[0], self[1], self.field
 
 
 @dataclass(frozen=True, slots=True)
@@ -92,7 +107,7 @@ class Expectation:
     def modes(self) -> tuple[str, ...]:
         return tuple(dict.fromkeys(a.mode for a in self.states))
 
-    def check(self, osi: s.OSI) -> list[tuple[str, str]]:
+    def check(self, osi: s.OSI) -> list[Finding]:
         """``[]`` when some acceptable state explains ``osi``; else one finding per field."""
         if any(a.matches(osi) for a in self.states):
             return []
@@ -100,13 +115,13 @@ class Expectation:
         out: list[tuple[str, str]] = []
         cands = [a for a in self.states if a.mode == osi.mode]
         if not cands:
-            return [("RH-OUT-4", f"mode {osi.mode!r} {at}; a conforming vehicle reports "
-                                 f"{' or '.join(self.modes)}")]
+            return [Finding("RH-OUT-4", f"mode {osi.mode!r} {at}; a conforming vehicle reports "
+                                        f"{' or '.join(self.modes)}", "mode")]
         wp = [a for a in cands if a.waypoint == osi.next_waypoint]
         if not wp:
             want = sorted({a.waypoint for a in cands})
-            out.append(("RH-OUT-4", f"next waypoint {osi.next_waypoint} in mode {osi.mode} {at}; "
-                                    f"expected {' or '.join(map(str, want))}"))
+            out.append(Finding("RH-OUT-4", f"next waypoint {osi.next_waypoint} in mode {osi.mode} {at}; "
+                                           f"expected {' or '.join(map(str, want))}", "next_waypoint"))
             wp = cands
         err = [a for a in wp if a.error_state == osi.error_state]
         if not err:
@@ -114,22 +129,23 @@ class Expectation:
             # a safety code every explanation shows, missing or another: field 8 in the lockout and
             # after it (RH-SAF-1, RH-RD-13)
             clause = "RH-SAF-1" if "N" not in want else "RH-OUT-4"
-            out.append((clause, f"error state {osi.error_state!r} {at}; expected {' or '.join(want)}"))
+            out.append(Finding(clause, f"error state {osi.error_state!r} {at}; expected {' or '.join(want)}",
+                               "error_state"))
             err = wp
         park = [a for a in err if a.park_lo <= osi.park_time <= a.park_hi]
         if not park:
             ranges = ", ".join(f"P{a.park_lo}..P{a.park_hi}" for a in err)
-            out.append(("RH-OUT-4", f"park time P{osi.park_time} in mode {osi.mode} {at}; "
-                                    f"expected {ranges}"))
+            out.append(Finding("RH-OUT-4", f"park time P{osi.park_time} in mode {osi.mode} {at}; "
+                                           f"expected {ranges}", "park_time"))
             park = err
         if osi.srp_active is not None and not any(
                 osi.srp_active == ("True" if a.srp_active else "False") for a in park):
-            out.append(("RH-OUT-4", f"SRP active {osi.srp_active} {at}; expected "
-                                    f"{'True' if park[0].srp_active else 'False'}"))
+            out.append(Finding("RH-OUT-4", f"SRP active {osi.srp_active} {at}; expected "
+                                           f"{'True' if park[0].srp_active else 'False'}", "srp_active"))
         if not out:  # each field fits some state, but no single state fits them all
-            out.append(("RH-OUT-4", f"mode {osi.mode}, waypoint {osi.next_waypoint}, error "
-                                    f"{osi.error_state}, P{osi.park_time} {at} fit no single "
-                                    f"state a conforming vehicle can be in"))
+            out.append(Finding("RH-OUT-4", f"mode {osi.mode}, waypoint {osi.next_waypoint}, error "
+                                           f"{osi.error_state}, P{osi.park_time} {at} fit no single "
+                                           f"state a conforming vehicle can be in", None))
         return out
 
 
@@ -238,19 +254,7 @@ def quick_expectation(model, now: float, slack: float = 0.0) -> Expectation:
     return exp if exp is not None else expectation(model, now, slack)
 
 
-#: How :meth:`Expectation.check` begins the finding of each field it compares, by field.
-_FIELD_PREFIX = (("mode", "mode '"), ("next_waypoint", "next waypoint "), ("error_state", "error state "),
-                 ("park_time", "park time "), ("srp_active", "SRP active "))
-
-
-def finding_field(message: str) -> Optional[str]:
-    """The report field a finding of :meth:`Expectation.check` is about (``mode``,
-    ``next_waypoint``, ``error_state``, ``park_time``, ``srp_active``); None for fields that each
-    fit some state but no single state fits them all."""
-    return next((f for f, pre in _FIELD_PREFIX if message.startswith(pre)), None)
-
-
-def quick_check(model, osi: s.OSI, now: float, slack: float = 0.0) -> list[tuple[str, str]]:
+def quick_check(model, osi: s.OSI, now: float, slack: float = 0.0) -> list[Finding]:
     """``quick_expectation(model, now, slack).check(osi)``; a report the one steady state
     explains (nearly every report of a session) is answered without making the expectation."""
     got = _steady(model, now, slack)

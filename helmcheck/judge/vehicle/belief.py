@@ -38,7 +38,6 @@ from typing import Optional
 
 from ...grammar import sentences as s
 from ...grammar.errors import SentenceError
-from ...model.observe import finding_field
 from ...model.timers import tolerance
 from ...model.transitions import INTERNAL_EVENTS, REMOTE_MODES, STAY, rows_for
 from ...model.vehicle import VehicleModel
@@ -344,7 +343,7 @@ class Beliefs:
                 # question
                 causes = [c for c in causes if c != "RH-INT-2"]
             elif (released and osi.mode == p.model.mode and osi.mode not in _REMOTE
-                  and all(finding_field(msg) in _RESUMED for _, msg in result.findings)):
+                  and all(f.field in _RESUMED for f in result.findings)):
                 # released into the behaviour it should resume — as the trigger's clause says,
                 # also where it says the mission resumes (RH-PK-3, RH-OMW-4) — but toward another
                 # waypoint or with another park time left: RH-INT-2's alone. (Released into another

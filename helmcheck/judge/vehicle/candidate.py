@@ -40,7 +40,7 @@ import math
 from dataclasses import dataclass
 from typing import Optional
 
-from ...model.observe import quick_check
+from ...model.observe import Finding, quick_check
 from ...model.transitions import STAY, Row
 from ...model.vehicle import VehicleModel
 
@@ -192,7 +192,7 @@ class Candidate:
             self.s_cause = ""
 
     # ------------------------------------------------------------------ questions
-    def check(self, osi, v: float, slack_v: float) -> list[tuple[str, str]]:
+    def check(self, osi, v: float, slack_v: float) -> list[Finding]:
         """``[]`` when this candidate explains ``osi`` at ``v`` (RH-OUT-4, RH-TIM-1)."""
         return quick_check(self.model, osi, v, slack_v + self.extra_v)
 
