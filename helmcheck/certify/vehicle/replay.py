@@ -26,7 +26,9 @@ sequence set going is judged inside it): whatever state the failure needs, the s
 a lockout left by whatever ran before, then ``S`` seen, at the surface when it gets there within
 two minutes of vehicle time: :meth:`.session.Session.outwait_surface`; and, when the replay says
 where the steps began, driven back there when the vehicle is more than 1 m off, and the mission's
-first waypoint surveyed from there, :func:`_return`), then sends the steps at their recorded
+first waypoint surveyed from there, :func:`_return`; when that reset does not end in ``S`` — also
+for a failure on a clause the re-drive ignores — the steps are not sent: INCONCLUSIVE, or the
+reset's own failure), then sends the steps at their recorded
 pace (a line never sooner after the line before it than when recorded, scaled to the present
 time scale: a delay shifts what follows, so a timer a line set going runs out before the lines
 that polled across it), judging every reply
@@ -144,8 +146,13 @@ def redrive(doc: dict, session, time_scale: Optional[float] = None) -> Redrive:
                 session.reset(mission=False)
                 session.outwait_surface()
     except CaseStop as f:
-        if f.outcome != "fail" and not session.failures():
-            return Redrive("inconclusive", f"the verified reset before the steps failed: {f.reason}", None, False)
+        # the steps were recorded from a verified reset: from anywhere else they ask something
+        # else (a vehicle left in A by a fault the run already found, whose $OMSTOP,0 does not
+        # end it, answers the steps' first $OMLOAD as one in A): they are not run
+        got = [x for x in session.failures() if x[0] not in session.ignore]
+        if got:
+            return Redrive("fail", f"{IN_RESET}: {got[0][0]}: {got[0][1]}", got[0][0], False)
+        return Redrive("inconclusive", f"the verified reset before the steps failed: {f.reason}", None, False)
     got = [f for f in session.failures() if f[0] not in session.ignore]
     if got:  # a vehicle that breaks the profile in every reply already does in the reset
         return Redrive("fail", f"{IN_RESET}: {got[0][0]}: {got[0][1]}", got[0][0], False)
