@@ -161,6 +161,8 @@ def test_a_rerun_that_went_another_way_and_passed_is_not_counted(tmp_path, monke
     reruns: list = []
 
     def first_rerun_goes_another_way(doc, session):
+        if CLAUSE in session.ignore:  # the confirmation of another clause found (it ignores this one)
+            return real(doc, session)
         reruns.append(doc)
         if len(reruns) == 1:
             cores[-1].faults = 0

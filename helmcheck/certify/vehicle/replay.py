@@ -29,9 +29,10 @@ where the steps began, driven back there when the vehicle is more than 1 m off, 
 first waypoint surveyed from there, :func:`_return`; when that reset does not end in ``S`` — also
 for a failure on a clause the re-drive ignores — the steps are not sent: INCONCLUSIVE, or the
 reset's own failure), then sends the steps at their recorded
-pace (a line never sooner after the line before it than when recorded, scaled to the present
-time scale: a delay shifts what follows, so a timer a line set going runs out before the lines
-that polled across it), judging every reply
+pace (each line at its recorded offset, scaled to the present time scale, from the last line that
+set a timer going — or as soon as the line before it is settled, when that is later — so that a
+line that polled across a timer's end, or into the window after it, still does, however slowly
+the vehicle answered the lines between this time), judging every reply
 with the present model, and says whether it still fails — and at which step, or at which step the
 vehicle first went another way than when it was recorded.
 """
@@ -266,6 +267,14 @@ def _shift(doc: dict, session) -> tuple[float, float]:
     return dlat, dlon
 
 
+def _armed(session) -> frozenset:
+    """The timers the observer's mirror runs, each as (name, start, duration): a line that adds
+    one set it going (or restarted it)."""
+    timers = session.obs.state().timers
+    return frozenset((n, round(timers.deadline(n) - timers.duration(n), 6), timers.duration(n))
+                     for n in timers.names())
+
+
 def _steps(doc: dict, session, time_scale: Optional[float], shift=(0.0, 0.0)) -> Redrive:
     from .flow import CaseStop
     from .safety import BenchSafetyRefused
@@ -276,24 +285,30 @@ def _steps(doc: dict, session, time_scale: Optional[float], shift=(0.0, 0.0)) ->
     pace = k_rec / float(time_scale or session.k)
     where = {"i": -1, "send": ""}
     diverged: list = []
-    # each line no sooner after the line before it than when recorded (scaled to the present time
-    # scale): a delay early on shifts the rest, so a timeout set going by a line still runs out
-    # before the lines that polled across it
-    prev_t, prev_at = next((float(st["t"]) for st in steps if "t" in st), 0.0), session.now()
+    # each line at its recorded offset (scaled to the present time scale) from the last line that
+    # set a timer going, or as soon as the line before it is settled when that is later: a line
+    # that polled across a timer's end or into the window after it (an ascent, a park) still
+    # does, however slowly the lines between were answered this time; a delay before a timer's
+    # line shifts it and what follows it
+    anchor_t, anchor_at = next((float(st["t"]) for st in steps if "t" in st), 0.0), session.now()
     last = None
     try:
         for i, st in enumerate(steps):
             where["i"] = i
             if "send" in st:
                 where["send"] = st["send"]
+                at = None
                 if "t" in st:
-                    session.link.sleep(max(0.0, prev_at + (float(st["t"]) - prev_t) * pace - session.now()))
-                    prev_t, prev_at = float(st["t"]), session.now()
+                    session.link.sleep(max(0.0, anchor_at + (float(st["t"]) - anchor_t) * pace - session.now()))
+                    at = session.now()
                 raw = shift_line(unescape(st["send"]), *shift)
+                armed = _armed(session)
                 try:
                     last = session.exchange(raw)
                 except BenchSafetyRefused as e:
                     return Redrive("inconclusive", f"step {i + 1} was not sent: {e}", None, False)
+                if at is not None and _armed(session) - armed:
+                    anchor_t, anchor_at = float(st["t"]), at
             elif "wait" in st:
                 session.wait(float(st["wait"]))
             elif "expect" in st and last is not None and not diverged:
