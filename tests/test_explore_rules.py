@@ -79,7 +79,7 @@ class OnlyOnce(RefusesWith21):
 
 def _certify(port: str, report_dir: Path):
     return certify(Options(port=port, profile=EMU_PROFILE.replace(time_scale=K), time_scale=K,
-                           report_dir=report_dir, select=[CLAUSE], examples=20, explore_budget_s=15.0,
+                           report_dir=report_dir, select=[CLAUSE], examples=20, explore_budget_s=8.0,
                            progress=False, render=False, seed=SEED))
 
 
