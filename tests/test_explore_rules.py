@@ -191,8 +191,8 @@ def test_a_rerun_that_went_another_way_and_passed_is_not_counted(tmp_path, monke
     assert out.verdict == "fail" and out.exit_code == 1, out.reason
 
 
-def _redrive(verdict: str, clause=None, faithful=True, reason="at step 3 of 5 ($OMS,…): …"):
-    return replay_mod.Redrive(verdict, reason, clause, faithful)
+def _redrive(verdict: str, clause=None, faithful=True, reason="at step 3 of 5 ($OMS,…): …", ran=True):
+    return replay_mod.Redrive(verdict, reason, clause, faithful, ran)
 
 
 @pytest.mark.parametrize("got, counted", [
@@ -202,7 +202,7 @@ def _redrive(verdict: str, clause=None, faithful=True, reason="at step 3 of 5 ($
     (_redrive("pass"), False),
     (_redrive("pass", faithful=False), None),
     (_redrive("inconclusive"), None),
-    (_redrive("fail", CLAUSE, faithful=False, reason=f"{replay_mod.IN_RESET}: {CLAUSE}: …"), None),
+    (_redrive("fail", CLAUSE, faithful=False, reason=f"{replay_mod.IN_RESET}: {CLAUSE}: …", ran=False), None),
 ])
 def test_which_redrives_count_as_reruns(got, counted):
     assert explore_mod.counts(got, (CLAUSE, "RH-ACK-3")) is counted

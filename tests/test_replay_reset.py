@@ -35,22 +35,20 @@ def _session(name):
     line = VirtualLine(core, profile.baud)
     observer = VehicleObserver(profile, Ledger([c.id for c in vehicle_clauses()]), time_scale=K, baud=profile.baud)
     link = tester_link.TesterLink(line, profile, Recorder(None, [], [observer]), clock=line.clock)
-    return Session(link, profile, K, observer), line
-
-
+    return Session(link, profile, K, observer)
 
 
 def _left_in_servo(name):
-    ses, line = _session(name)
+    ses = _session(name)
     ses.reset(mission=True)
     sent = ses.exchange(frame("OMS,90,0,20,0.5,120"))  # servo for 120 vehicle seconds (RH-SRV-1: in a mission)
     assert sent.accepted and ses.poll().mode == "A"
     ses.ignore = frozenset({"RH-OUT-4", "RH-MSN-3"})  # found already: the confirmation ignores them
-    return ses, line
+    return ses
 
 
 def test_steps_are_not_run_when_the_reset_does_not_reach_S():
-    ses, _ = _left_in_servo("omstop-ignored-in-servo")
+    ses = _left_in_servo("omstop-ignored-in-servo")
     mark = ses.ledger.mark()
     got = redrive({"steps": STEPS, "time_scale": K}, ses)
     assert got.verdict == "inconclusive" and not got.faithful, got
@@ -60,7 +58,7 @@ def test_steps_are_not_run_when_the_reset_does_not_reach_S():
 
 
 def test_on_a_conforming_vehicle_the_same_steps_run_and_pass():
-    ses, _ = _left_in_servo(None)
+    ses = _left_in_servo(None)
     got = redrive({"steps": STEPS, "time_scale": K}, ses)
     assert got.verdict == "pass" and got.faithful, got
     assert counts(got, ("RH-ACK-3",)) is False

@@ -93,7 +93,8 @@ def run(args: argparse.Namespace) -> int:
         link = TesterLink(raw, profile, recorder)
         session = Session(link, profile, k, observer)
         try:
-            verdict, reason = redrive(doc, session)[:2]
+            got = redrive(doc, session)
+            verdict, reason = got.verdict, got.reason
         except LinkLost as e:
             verdict, reason = "inconclusive", f"link fault: {e}"
     finally:

@@ -112,7 +112,7 @@ class Expectation:
         if any(a.matches(osi) for a in self.states):
             return []
         at = f"at t={self.now:.3f} (slack {self.slack:g} s)"
-        out: list[tuple[str, str]] = []
+        out: list[Finding] = []
         cands = [a for a in self.states if a.mode == osi.mode]
         if not cands:
             return [Finding("RH-OUT-4", f"mode {osi.mode!r} {at}; a conforming vehicle reports "

@@ -187,8 +187,7 @@ def counts(got, also) -> Optional[bool]:
     already in the verified reset before the steps, the steps could not be run or judged
     (INCONCLUSIVE), or the vehicle went another way than when they were recorded and the failure
     did not come (a timer raced a line differently: the steps did not lead where they led)."""
-    from .replay import IN_RESET
-    if got.verdict == "fail" and got.clause in also and not got.reason.startswith(IN_RESET):
+    if got.verdict == "fail" and got.ran and got.clause in also:
         return True
     if got.verdict == "inconclusive" or not got.faithful:
         return None

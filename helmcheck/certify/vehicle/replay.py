@@ -55,7 +55,8 @@ FORMAT = "helmcheck-replay"
 #: slack): the RH-TIM-1 tolerance of a 30 s timer, and then some.
 LINGER_V = 3.0
 #: How a re-drive's reason begins when the vehicle failed before the steps: not a reproduction of
-#: the steps' failure (the exploration does not count it as one, :func:`.explore._confirm`).
+#: the steps' failure (its :class:`Redrive` says ``ran=False``; the exploration does not count it,
+#: :func:`.explore.counts`).
 IN_RESET = "already in the verified reset before the steps"
 #: A re-drive that finds the vehicle further than this from where the steps began drives it back
 #: there first, for at most this long in vehicle time (:func:`_return`).
@@ -76,12 +77,14 @@ class Redrive(NamedTuple):
     and the ``clause`` a failure was booked on; ``faithful``: the steps ran and the model expected
     every answer up to the verdict as it did when they were recorded (the vehicle went the
     recorded way). A pass that is not faithful says nothing of the recorded failure: the steps
-    did not lead where they led then (:func:`.explore._confirm` does not count it)."""
+    did not lead where they led then (:func:`.explore._confirm` does not count it). ``ran``: the
+    steps were sent (not after a verified reset that failed, nor one refused by bench safety)."""
 
     verdict: str
     reason: str
     clause: Optional[str]
     faithful: bool
+    ran: bool = True
 
 
 def save_replay(path: Path, clause: str, reason: str, steps: list, time_scale: float, profile: Profile,
@@ -139,6 +142,7 @@ def redrive(doc: dict, session, time_scale: Optional[float] = None) -> Redrive:
     except CaseStop:
         pass
     session.mark = session.ledger.mark()
+    reset_failed = None
     try:
         with session.not_stopping():
             session.reset(mission=False)
@@ -147,16 +151,16 @@ def redrive(doc: dict, session, time_scale: Optional[float] = None) -> Redrive:
                 session.reset(mission=False)
                 session.outwait_surface()
     except CaseStop as f:
-        # the steps were recorded from a verified reset: from anywhere else they ask something
-        # else (a vehicle left in A by a fault the run already found, whose $OMSTOP,0 does not
-        # end it, answers the steps' first $OMLOAD as one in A): they are not run
-        got = [x for x in session.failures() if x[0] not in session.ignore]
-        if got:
-            return Redrive("fail", f"{IN_RESET}: {got[0][0]}: {got[0][1]}", got[0][0], False)
-        return Redrive("inconclusive", f"the verified reset before the steps failed: {f.reason}", None, False)
+        # the steps were recorded from a verified reset (RH-MSN-3: S): from anywhere else they
+        # ask something else (a vehicle left in A by a fault the run already found, whose
+        # $OMSTOP,0 does not end it, answers the steps' first $OMLOAD as one in A): not run
+        reset_failed = f.reason
     got = [f for f in session.failures() if f[0] not in session.ignore]
     if got:  # a vehicle that breaks the profile in every reply already does in the reset
-        return Redrive("fail", f"{IN_RESET}: {got[0][0]}: {got[0][1]}", got[0][0], False)
+        return Redrive("fail", f"{IN_RESET}: {got[0][0]}: {got[0][1]}", got[0][0], False, ran=False)
+    if reset_failed is not None:
+        return Redrive("inconclusive", f"the verified reset before the steps failed: {reset_failed}", None, False,
+                       ran=False)
     session.mark = session.ledger.mark()
     shift = _shift(doc, session)
     # the line pace the sequence was recorded at: an exploration does not sit out the window of a
@@ -306,7 +310,7 @@ def _steps(doc: dict, session, time_scale: Optional[float], shift=(0.0, 0.0)) ->
                 try:
                     last = session.exchange(raw)
                 except BenchSafetyRefused as e:
-                    return Redrive("inconclusive", f"step {i + 1} was not sent: {e}", None, False)
+                    return Redrive("inconclusive", f"step {i + 1} was not sent: {e}", None, False, ran=False)
                 if at is not None and _armed(session) - armed:
                     anchor_t, anchor_at = float(st["t"]), at
             elif "wait" in st:
