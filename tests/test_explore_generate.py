@@ -14,7 +14,7 @@ from helmcheck.certify.vehicle.generate import commands, one_field_off, timeouts
 from tests.faulty_vehicles import EMU_PROFILE
 
 P = EMU_PROFILE
-TOS = timeouts(20.0, P.timeout_range)
+TOS = timeouts(13, P.timeout_range)  # the shortest timeable timeout on a line at x20
 HEX10 = re.compile(r"[0-9A-Fa-f]{10}")
 
 

@@ -66,22 +66,24 @@ def judgeable(duration: float, slack_v: float) -> bool:
     return slack_v <= 0.5 * max(duration, 1.0)
 
 
-def ack_uncertainty(resolution: float) -> float:
+def ack_uncertainty(resolution: float, jitter: float = JITTER_S) -> float:
     """Wall seconds by which the observer may misjudge the delay between two lines it stamped:
-    a timestamp step on each stamp, and :data:`JITTER_S`."""
-    return 2 * resolution + JITTER_S
+    a timestamp step on each stamp, and the host's jitter (:data:`JITTER_S`, or more where the
+    host was measured to add more: :mod:`.linebudget`)."""
+    return 2 * resolution + jitter
 
 
 def ack_allowance(ack_window_s: float, command_bytes: int, reply_bytes: int, baud: int,
-                  resolution: float = 0.0) -> float:
+                  resolution: float = 0.0, jitter: float = JITTER_S) -> float:
     """RH-ACK-2: wall seconds an ACK may come after its command was stamped (the recorder stamps
     before writing): the window, transmit time of the command and of the replies up to and with
     its ACK, and the observer's own uncertainty (:func:`ack_uncertainty`). Nothing else: an ACK
     measured later is late beyond doubt."""
-    return ack_window_s + transmit_time(command_bytes + reply_bytes, baud) + ack_uncertainty(resolution)
+    return ack_window_s + transmit_time(command_bytes + reply_bytes, baud) + ack_uncertainty(resolution, jitter)
 
 
-def ack_verdict(dt: float, allowance: float, ack_window_s: float, resolution: float) -> str:
+def ack_verdict(dt: float, allowance: float, ack_window_s: float, resolution: float,
+                jitter: float = JITTER_S) -> str:
     """RH-ACK-2 for an ACK measured ``dt`` wall seconds after its command: ``"fail"`` beyond the
     allowance; ``"pass"`` within it when the timestamps are fine enough to bound the window (a
     step of at most a tenth of it, RH-TIM-1: the vehicle gets the benefit of the doubt) or when
@@ -89,7 +91,7 @@ def ack_verdict(dt: float, allowance: float, ack_window_s: float, resolution: fl
     (coarse steps could hide an ACK past the window)."""
     if dt > allowance:
         return FAIL
-    if resolution <= ack_window_s / 10 or dt + 2 * ack_uncertainty(resolution) <= allowance:
+    if resolution <= ack_window_s / 10 or dt + 2 * ack_uncertainty(resolution, jitter) <= allowance:
         return PASS
     return INCONCLUSIVE
 

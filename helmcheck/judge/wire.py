@@ -29,6 +29,8 @@ wire-log format (``docs/contracts.md``):
 ``not tested RH-X,RH-Y: <reason>``          the tester could not exercise these clauses
 ``inconclusive RH-X,RH-Y: <reason>``        the tester exercised them but cannot judge them
 ``link: <baud> baud 8N1 <port>``            the line's settings as the tester opened it (RH-FRM-9)
+``line budget: baud … jitter … k …``        what the line costs the observer, as measured
+                                            (:mod:`.linebudget`): the host's jitter it uses
 ``plant: <Event>(<args>) at v=<seconds>``   an emulator's physics event (exact, when present)
 ``fault injected (<source>): <code>``       a safety violation raised off the wire (RH-SAF-5)
 ``lockout starts (<code>)`` / ``… ends``    the vehicle's lockout, as the vehicle knows it
@@ -61,6 +63,7 @@ from typing import Any, Optional
 from ..grammar import Decoded, decode
 from ..grammar.wirelog import FROM_VEHICLE, NOTE, TO_VEHICLE, WireEvent
 from ..profile import SAFETY_CODES
+from .linebudget import parse_budget
 
 #: Lines a judge's per-line caches keep (decoded sentences, classifications, evidence text, by
 #: the line's bytes): enough for the lines a session repeats (polls, acknowledgements), small
@@ -97,7 +100,7 @@ class Decodings:
 class Note:
     """A note a judge acts on: ``kind`` and its parts (see the module docstring)."""
 
-    kind: str  #: case | case-end | not-tested | inconclusive | link | plant | fault | lockout |
+    kind: str  #: case | case-end | not-tested | inconclusive | link | budget | plant | fault | lockout |
     #: lockout-end | scenario | silence | silence-end | reject | reject-end | operator | aborted |
     #: resumed
     case: str = ""
@@ -144,6 +147,9 @@ def parse_note(text: str) -> Optional[Note]:
     m = _LINK.match(text)
     if m:
         return Note("link", value=int(m.group(1)), text=text)
+    if text.startswith("line budget: "):
+        budget = parse_budget(text)
+        return Note("budget", value=budget, text=text) if budget is not None else None
     m = _PLANT.match(text)
     if m:
         kwargs = parse_plant(m.group(2))

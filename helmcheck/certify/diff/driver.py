@@ -78,7 +78,8 @@ def _search(opts: DiffOptions, pair: Pair, state: DiffState) -> None:
     motor = min(bench(pa)[1], bench(pb)[1])
     lo = max(pa.timeout_range[0], pb.timeout_range[0])
     hi = min(pa.timeout_range[1], pb.timeout_range[1])
-    tos = timeouts(max(pair.a.k, pair.b.k), (lo, max(lo, hi)))
+    durs = [side.session.durations(fresh=True).to for side in (pair.a, pair.b)]  # timeable on both lines
+    tos = timeouts(None if None in durs else max(durs), (lo, max(lo, hi)))
     oxflt = pa.fault_injection == "oxflt" and pb.fault_injection == "oxflt"
     factory = machine(state, min(pa.mission_waypoints, pb.mission_waypoints), speed, motor, oxflt, tos)
     if opts.seed is not None:

@@ -38,10 +38,25 @@ from hypothesis.stateful import RuleBasedStateMachine, initialize, precondition,
 
 from ..vehicle.generate import control_commands, invalid_lines, valid_commands
 from ..vehicle.flow import LinkLost
+from ..vehicle.durations import DURATION_KEYS
 from ..vehicle.interpreter import context, fill, raw_line
 from ..vehicle.session import frame
 from .pair import Pair
 from .view import Seen, differences, seen_text
+
+
+def _same_durations(ctx: dict) -> None:
+    """Both sides get the same durations — the longer of the two lines' (:mod:`..vehicle.durations`):
+    a timeout chosen for each side's own line would end at different times, a difference of the
+    tester's making, never a divergence."""
+    if len(ctx) != 2 or not all(ctx.values()):
+        return
+    a, b = ctx.values()
+    for key in DURATION_KEYS:
+        if key in a and key in b:
+            longer = max(a[key], b[key], key=float)
+            a[key] = b[key] = longer
+
 
 __all__ = ["machine", "DiffState", "Divergence", "REPOLLS", "REPOLL_V"]
 
@@ -127,6 +142,7 @@ def machine(state: DiffState, nwp: int, speed: float, motor: int, oxflt: bool, t
                 return seen
             try:
                 a, b = pair.both(one)
+                _same_durations(self.ctx)
                 self._compare(label, a, b)
             except Divergence:
                 raise

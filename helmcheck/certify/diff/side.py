@@ -73,6 +73,7 @@ class Side:
         run = self.run
         run.open()
         run.probe()
+        run.session.measure_line()  # what the line costs: the durations (:mod:`..vehicle.durations`)
         check_clock(run, True)
         ses = run.session
         ses.stop_on_fail = False  # the judge books; the diff decides what a difference is

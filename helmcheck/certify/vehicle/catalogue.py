@@ -23,11 +23,15 @@ from ...profile import Profile
 from .steps import (Burst, Case, Fault, MissionEnd, Octd, Poll, Raw, Send, SetRoundTrip, Settle, Start, Until,
                     Wait, WithSetting)
 
-__all__ = ["CASES", "select_cases", "unmet_need"]
+__all__ = ["CASES", "select_cases", "unmet_need", "line_needs"]
 
-OMS = "OMS,90,2,20,{speed},10"
-OMS0 = "OMS,90,2,20,0,10"  # speed 0: the vehicle holds its position
+# Durations are the line budget's (:mod:`.durations`): ``{to}`` a timeout the observer can time on
+# this line at this time scale, ``{to_long}`` one that outlasts several steps, and so on.
+OMS = "OMS,90,2,20,{speed},{to}"
+OMS0 = "OMS,90,2,20,0,{to}"  # speed 0: the vehicle holds its position
 OMS_DIVE = "OMS,90,{dive_depth},20,{speed},120"  # down to a depth an ascent takes a while to leave
+OMP_HOLD = "OMP,8080808080,00,{to_long}"  # neutral: holds depth, outlasts what follows (RH-RD-12)
+OMS_RESTART = "OMS,90,2,20,{speed},{to_restart}"  # restarted {gap} into it, both deadlines told apart
 FAR_OMW = "OMW,{near_lat},{lon},2,,15,{speed},0,"
 
 
@@ -124,7 +128,7 @@ CASES: tuple[Case, ...] = (
     _c("V-21", "RH-INT-1", "Each control command ends the active one",
        "A → M → mP → W → A by $OMS/$OMP/$OPK/$OMW; when the last $OMS times out the mission resumes, "
        "not an earlier control: there is no stack", "N",
-       Send(OMS0), Poll(mode="A"), Send("OMP,8080808080,00,60"), Poll(mode="M"),
+       Send(OMS0), Poll(mode="A"), Send("OMP,8080808080,00,{to_long}"), Poll(mode="M"),
        Send("OPK,{lat},{lon},5,{speed}"), Poll(mode="mP"), Send(FAR_OMW), Poll(mode="W"),
        Send(OMS0), Poll(mode="A"), Settle("remote"), Poll(mode="N|P")),
     _c("V-22", "RH-INT-2", "Control released to the mission",
@@ -151,29 +155,31 @@ CASES: tuple[Case, ...] = (
        Send("OMS,90,2,20,{speed},121", expect="$ACK,9,1,20"),
        Send("OMS,90,2,20,{speed},1.5", expect="$ACK,9,1,20"),
        Send("OMS,90,2,20,{speed_over},10", expect="$ACK,9,1,20"),
-       Poll(mode="N|P"), Send("OMS,359.9,2,20,{speed},10", expect="$ACK,9,0,0"), Poll(mode="A")),
+       Poll(mode="N|P"), Send("OMS,359.9,2,20,{speed},{to}", expect="$ACK,9,0,0"), Poll(mode="A")),
     _c("V-27", "RH-SRV-3", "A new $OMS restarts the servo timeout",
-       "mode A after acceptance; an $OMS 6 s into a 10 s timeout keeps A until 16 s", "N",
-       Send(OMS), Poll(mode="A"), Wait(6.0), Send(OMS), Wait(6.0), Poll(mode="A"),
+       "mode A after acceptance; an $OMS sent well into the timeout keeps A until the restarted timeout "
+       "ends, past the first one's end (both told apart on this line: a gap of their tolerances, the "
+       "observer's uncertainty and a report between them)", "N",
+       Send(OMS_RESTART), Poll(mode="A"), Wait("{gap}"), Send(OMS_RESTART), Poll(mode="A"),
        Settle("remote"), Poll(mode="N|P")),
     _c("V-28", "RH-SRV-4", "The servo timeout releases control",
        "with no new $OMS the vehicle leaves A when the timeout runs out, within tolerance", "N",
        Send(OMS), Poll(mode="A"), Settle("remote"), Poll(mode="N|P")),
     _c("V-29", "RH-PRM-1", "$OMP is accepted from S",
        "$OMP without a mission is accepted and the mode is M", "S",
-       Send("OMP,80808080{motor},00,10", expect="$ACK,10,0,0"), Poll(mode="M")),
+       Send("OMP,80808080{motor},00,{to}", expect="$ACK,10,0,0"), Poll(mode="M")),
     _c("V-30", "RH-PRM-2", "$OMP fields",
        "nine hex digits, a non-hex digit, reserved other than 00 and timeout 0 are rejected (21); "
        "lower-case hex is accepted and echoed in upper case", "S",
        Send("OMP,808080808,00,10", expect="$ACK,10,1,21"), Send("OMP,80808080GG,00,10", expect="$ACK,10,1,21"),
        Send("OMP,8080808080,01,10", expect="$ACK,10,1,21"), Send("OMP,8080808080,00,0", expect="$ACK,10,1,21"),
-       Poll(mode="S"), Send("OMP,7f7f7f7f80,00,10", expect="$ACK,10,0,0"), Poll(mode="M")),
+       Poll(mode="S"), Send("OMP,7f7f7f7f80,00,{to}", expect="$ACK,10,0,0"), Poll(mode="M")),
     _c("V-31", "RH-PRM-3", "$OSI echoes the commanded fins and motor",
        "after $OMP the mode is M and field 1 is the commanded bytes in upper case", "N",
-       Send("OMP,8a8a7676{motor},00,20"), Poll(mode="M")),
+       Send("OMP,8a8a7676{motor},00,{to}"), Poll(mode="M")),
     _c("V-32", "RH-PRM-4", "$OMP timeout from S returns to S, neutral",
        "when the primitive times out without a mission the mode is S with 8080808080", "S",
-       Send("OMP,8a8a7676{motor},00,10"), Poll(mode="M"), Settle("remote"), Poll(mode="S")),
+       Send("OMP,8a8a7676{motor},00,{to}"), Poll(mode="M"), Settle("remote"), Poll(mode="S")),
     _c("V-33", "RH-JW-1", "$OJW preconditions and range",
        "$OJW in S is rejected (19); past the last waypoint and below the first are rejected (19); "
        "the last waypoint is accepted", "S",
@@ -181,7 +187,7 @@ CASES: tuple[Case, ...] = (
        Send("OJW,-1", expect="$ACK,7,1,19"), Send("OJW,{wp_last}", expect="$ACK,7,0,0"), Poll()),
     _c("V-34", "RH-JW-2", "$OJW ends remote control",
        "$OJW from A, M, mP and W gives the mission toward the new next waypoint", "N",
-       Send(OMS), Send("OJW,{wp_other}"), Poll(mode_not="A"), Send("OMP,8080808080,00,20"),
+       Send(OMS), Send("OJW,{wp_other}"), Poll(mode_not="A"), Send("OMP,8080808080,00,{to}"),
        Send("OJW,0"), Poll(mode_not="M"), Send("OPK,{lat},{lon},5,{speed}"), Send("OJW,{wp_other}"),
        Poll(mode_not="mP"), Send(FAR_OMW), Send("OJW,0"), Poll(mode_not="W")),
     _c("V-35", "RH-JW-2", "$OJW ends a mission park",
@@ -205,9 +211,10 @@ CASES: tuple[Case, ...] = (
        Send(OMS0), Poll(), Send("OPK,{stn_lat},{lon},2,{speed}"), Poll(mode="mP"),
        Until("the $OPK countdown", mode="mP", park_below=120, budget_v=400.0), Poll(mode="mP")),
     _c("V-38", "RH-PK-3", "The mission resumes when the park time is up",
-       "a 1-minute $OPK park at the vehicle's position ends in the mission within tolerance", "N",
-       Send(OMS0), Poll(), Send("OPK,{lat},{lon},1,{speed}"),
-       Until("the $OPK countdown", mode="mP", park_below=60, budget_v=60.0),
+       "an $OPK park at the vehicle's position (1 minute, or the shortest the observer can time on this "
+       "line) ends in the mission within tolerance", "N",
+       Send(OMS0), Poll(), Send("OPK,{lat},{lon},{opk_min},{speed}"),
+       Until("the $OPK countdown", mode="mP", park_below="{opk_s}", budget_v=60.0),
        Settle("opk"), Poll(mode="N|P")),
     _c("V-39", "RH-OMW-1", "$OMW only while a mission runs",
        "$OMW in S is rejected (36); in N it is accepted and the mode is W", "S",
@@ -248,7 +255,7 @@ CASES: tuple[Case, ...] = (
     _c("V-46", "RH-MSN-3", "$OMSTOP from any mode",
        "$OMSTOP in N, A and M gives S with neutral fins and motor", "N",
        Send(OMS), Send("OMSTOP,0"), Poll(mode="S"), Start(),
-       Send("OMP,8a8a7676{motor},00,30"), Send("OMSTOP,0"), Poll(mode="S")),
+       Send("OMP,8a8a7676{motor},00,{to}"), Send("OMSTOP,0"), Poll(mode="S")),
     _c("V-47", "RH-MSN-4", "The mission ends at its last waypoint",
        "the profile's end_mission, started by name, ends in S after its last waypoint (and its park)",
        "S", Start(which="end_mission"), MissionEnd(), needs=("end_mission",)),
@@ -299,21 +306,22 @@ CASES: tuple[Case, ...] = (
        "code; the vehicle's own rule (or a sensor an operator trips) shows its code in field 8", "N",
        Fault("Sle"), Poll(), needs=("violation",)),
     _c("V-58", "RH-SAF-1", "The lockout refuses everything but $OSD for lockout_s",
-       "field 8 shows the code; $OMS, $OMSTOP, $ODVL get 26, $OSD is served; the refusal ends after "
-       "the lockout within tolerance", "N",
-       Fault("Sle"), Poll(), Send(OMS, expect="$ACK,9,1,26"),
-       Send("OMSTOP,0", expect="$ACK,1,1,26"), Send("ODVL,0,0,5", expect="$ACK,15,1,26"),
-       Send("OSD,S,G"), Settle("lockout", probe="ORWSET,Sle,R"), needs=("violation",)),
+       "field 8 shows the code; $OMS, $OMSTOP, $ODVL get 26, $OSD is served (written in one burst right "
+       "after the violation, so they arrive inside the lockout on any line); the refusal ends after the "
+       "lockout within tolerance", "N",
+       Fault("Sle", then=("OSD,S", OMS, "OMSTOP,0", "ODVL,0,0,5", "OSD,S,G")),
+       Settle("lockout", probe="ORWSET,Sle,R"), needs=("violation", "lockout")),
     _c("V-59", "RH-SAF-2", "Commands during the lockout have no effect afterwards",
        "an $OMP refused during the lockout does not take effect when it ends", "N",
-       Fault("Sop"), Send("OMP,8080808080,00,60", expect="$ACK,10,1,26"),
-       Settle("lockout", probe="ORWSET,Sle,R"), Poll(mode_not="M"), needs=("violation",)),
+       Fault("Sop", then=("OMP,8080808080,00,{to_long}",)),
+       Settle("lockout", probe="ORWSET,Sle,R"), Poll(mode_not="M"), needs=("violation", "lockout")),
     _c("V-60", "RH-SAF-3", "After the lockout only $OMP is released until the surface",
-       "brought under water by a servo dive first; after the lockout (its end shown by a command only "
-       "the lockout refuses), while still under water, $OMS is refused (26) and $OMP is accepted", "N",
-       Send(OMS_DIVE), Until("under water", mode="A", submerged=True, depth_at_least=5.0, budget_v=300.0), Fault("Sed"),
-       Settle("lockout", probe="ORWSET,Sle,R"), Poll(submerged=True), Send(OMS),
-       Send("OMP,8080808080,00,5", expect="$ACK,10,0,0"), Poll(mode="M"), needs=("violation",)),
+       "brought under water by a servo dive first; the lockout's end is found with an $OMP (refused "
+       "only by the lockout: the first one accepted after it holds the depth, RH-RD-12), then, still "
+       "under water, $OMS is refused (26)", "N",
+       Send(OMS_DIVE), Until("under water", mode="A", submerged=True, depth_at_least="{dive_at}", budget_v=300.0),
+       Fault("Sed"), Settle("lockout", probe=OMP_HOLD), Poll(mode="M", submerged=True),
+       Send(OMS, expect="$ACK,9,1,26"), Poll(mode="M"), needs=("violation",)),
     _c("V-61", "RH-SAF-4", "At the surface the SafetyAction runs",
        "with SafetyAction park the vehicle parks at the surface: mode P, P0, the code kept", "N",
        Fault("Sfp"), Settle("lockout"),
@@ -329,11 +337,11 @@ CASES: tuple[Case, ...] = (
        needs=("violation", "srp_mission", "srp_field", "cmd:ORWSET")),
     # --- §8 time ---------------------------------------------------------------------------------
     _c("V-62", "RH-TIM-1 RH-TIM-2", "Durations hold at the declared time scale",
-       "a 30 s servo timeout and a 10 s primitive timeout end within max(0.5 s, 5 %) plus the "
+       "a servo timeout of 30 s or more and a primitive timeout end within max(0.5 s, 5 %) plus the "
        "measured slack, at the declared time scale k (30 s: a clock 30 % off is told apart from the "
        "slack at k = 25)", "N",
-       Send("OMS,90,2,20,{speed},30"), Settle("remote"), Poll(mode="N|P"),
-       Send("OMP,8080808080,00,10"), Settle("remote"), Poll(mode="N|P")),
+       Send("OMS,90,2,20,{speed},{to_tim}"), Settle("remote"), Poll(mode="N|P"),
+       Send("OMP,8080808080,00,{to}"), Settle("remote"), Poll(mode="N|P")),
 )
 
 
@@ -344,8 +352,14 @@ def select_cases(patterns: Optional[list[str]], profile: Profile) -> list[Case]:
     return [c for c in CASES if any(fnmatchcase(cid, p) for cid in c.clauses for p in patterns)]
 
 
-def unmet_need(case: Case, profile: Profile) -> Optional[str]:
-    """Why the profile does not let this case run, or ``None``."""
+def unmet_need(case: Case, profile: Profile, durations=None) -> Optional[str]:
+    """Why the profile — or, given the line's :class:`~.durations.Durations`, the line at the run's
+    time scale — does not let this case run, or ``None``."""
+    if durations is not None:
+        for need in line_needs(case):
+            why = durations.unmet(need)
+            if why:
+                return why
     for need in case.needs:
         kind, _, arg = need.partition(":")
         if kind == "oxflt" and profile.fault_injection != "oxflt":
@@ -366,6 +380,8 @@ def unmet_need(case: Case, profile: Profile) -> Optional[str]:
             return f"the profile's $OSI has {profile.osi_fields} fields: none shows whether the SRP runs"
         if kind == "cmd" and arg not in profile.commands:
             return f"the profile does not claim ${arg}"
+        if kind == "lockout":
+            continue  # the line's (line_needs)
     cmds = {b.body.split(",")[0] for b in _sends(case.steps)}
     missing = sorted(c for c in cmds if c in s.__dict__ and c not in profile.commands and c != "OSD")
     if missing:
@@ -373,6 +389,24 @@ def unmet_need(case: Case, profile: Profile) -> Optional[str]:
     if case.start in ("N", "P") and "OMSTART" not in profile.commands:
         return "the case starts from a running mission, and the profile does not claim $OMSTART"
     return None
+
+
+#: Duration templates (:mod:`.durations`) whose timer a case's ``Settle`` times: each must be
+#: timeable on the line, else the case is NOT-TESTED before it runs.
+_TIMED_KEYS = {"to": "timer:to", "to_tim": "timer:to_tim", "to_restart": "timer:to_restart", "opk_min": "timer:opk"}
+
+
+def line_needs(case: Case) -> list[str]:
+    """What the line must allow for ``case``: a timeable duration for every timer it sets going and
+    then times (a ``Settle`` of a remote control or an ``$OPK``), and ``lockout`` where its commands
+    must reach the vehicle inside a lockout (:meth:`.durations.Durations.unmet`)."""
+    out = [n for n in case.needs if n == "lockout"]
+    if any(isinstance(st, Settle) and st.timer in ("remote", "opk") for st in case.steps):
+        for st in _sends(case.steps):
+            for key, need in _TIMED_KEYS.items():
+                if "{" + key + "}" in st.body and need not in out:
+                    out.append(need)
+    return out
 
 
 def _sends(steps) -> list:

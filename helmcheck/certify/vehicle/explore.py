@@ -241,7 +241,7 @@ def explore(run) -> None:
     state = _State(run, budget)
     state.examples = examples
     state.progress = run.progress
-    tos = timeouts(run.session.k, p.timeout_range)
+    tos = timeouts(run.session.durations(fresh=True).to, p.timeout_range)  # timeable on this line
     kinds = (machine(state, p, tos, deep=False), machine(state, p, tos, deep=True))
     db = DirectoryBasedExampleDatabase(str(run.dir / ".hypothesis"))
     session = run.session

@@ -13,7 +13,10 @@ vehicle's habits:
   every error code of every command (:data:`helmcheck.model.transitions.ERRORS`, err 1, 17, 26,
   40) is one draw away;
 * :func:`control_commands` — the four remote controls (RH-INT-1), drawn more often, with
-  timeouts the observer can time at the time scale (:func:`timeouts`);
+  timeouts, ``$OPK`` minutes and queued-waypoint parks the observer can time on the line at the
+  time scale (:func:`timeouts`; the ``{opk_min}`` and ``{qpark}`` templates, filled from the run's
+  :mod:`.durations` when a line is sent): an accepted duration shorter than that is never drawn,
+  so no observation is booked that the observer could not time;
 * :func:`invalid_lines` — one mutation of a valid line (:data:`.steps.RAW_KINDS`, every kind)
   or an unknown ID.
 
@@ -29,9 +32,10 @@ is drawn only where the bench allows it.
 
 from __future__ import annotations
 
+from typing import Optional
+
 from hypothesis import strategies as st
 
-from ...judge.timing import JITTER_S
 from ...profile import Profile
 from .steps import RAW_KINDS
 
@@ -39,20 +43,21 @@ __all__ = ["commands", "FAMILIES", "EXPLORE_WRITES", "control_commands", "invali
            "TIMEOUT_CHOICES", "bench_speed", "bench_motor"]
 
 #: Remote-control timeouts the exploration draws from (seconds), before :func:`timeouts` keeps those
-#: the observer can time at the time scale.
-TIMEOUT_CHOICES = (2, 3, 5, 8, 12, 20, 30)
+#: the observer can time on the line at the time scale.
+TIMEOUT_CHOICES = (2, 3, 5, 8, 12, 20, 30, 45, 60, 90)
 
 
-def timeouts(k: float, timeout_range=(1, 120)):
-    """The timeouts an exploration sends at time scale ``k``: those whose RH-TIM-1 judgement the
-    observer's own uncertainty cannot spoil (k × its jitter and a pty's transmit time, twice over
-    for margin, within half the duration: :func:`~helmcheck.judge.timing.judgeable`), within the
-    profile's ``timeout_range``. A case that cannot time its own timeout is the tester's defect."""
+def timeouts(shortest: Optional[int], timeout_range=(1, 120)):
+    """The timeouts an exploration sends: the shortest the observer can time on this line at this
+    time scale (``shortest``, :attr:`.durations.Durations.to`) and the longer of
+    :data:`TIMEOUT_CHOICES`, within the profile's ``timeout_range`` — at most five. ``None`` (no
+    timeout the profile allows can be timed here): nothing is drawn (a control with a timeout is
+    left out of the exploration rather than booked where it cannot be timed)."""
     lo, hi = int(timeout_range[0]), int(timeout_range[1])
-    shortest = 4.0 * k * (JITTER_S + 0.01)
-    keep = [d for d in TIMEOUT_CHOICES if lo <= d <= hi and d >= shortest]
-    if not keep:
-        keep = [max(lo, min(hi, int(shortest) + 1))]
+    if shortest is None:
+        return st.nothing()
+    shortest = int(shortest)
+    keep = sorted({shortest} | {d for d in TIMEOUT_CHOICES if max(lo, shortest) <= d <= hi})
     return st.sampled_from(keep[:5])
 
 
@@ -113,11 +118,12 @@ def _ojw(p: Profile):
 
 def _opk(spd):
     where = st.sampled_from(["{lat},{lon}", "{stn_lat},{lon}", "{far_lat},{lon}", "91,{lon}"])
-    return st.builds(lambda w, m, v: f"OPK,{w},{m},{v}", where, st.sampled_from(["0", "1", "2", "1440", "1441"]), spd)
+    return st.builds(lambda w, m, v: f"OPK,{w},{m},{v}", where,
+                     st.sampled_from(["0", "{opk_min}", "{opk_min}", "1440", "1441"]), spd)
 
 
 def _omw(p: Profile, spd):
-    park = st.sampled_from(["0", "0", "5", "86400", "86401"])
+    park = st.sampled_from(["0", "0", "{qpark}", "86400", "86401"])
     depth = st.sampled_from(["2", "2", "0", "100", "101"])
     where = st.sampled_from(["{near_lat},{lon}", "{near_lat},{near_lon}", "{stn_lat},{lon}", "91,{lon}"])
     full = st.builds(lambda w, d, v, k: f"OMW,{w},{d},,15,{v},{k},", where, depth, spd, park)
@@ -217,10 +223,10 @@ def one_field_off(p: Profile, tos) -> st.SearchStrategy[str]:
                         [["808080808", "80808080800", "8080G08080", "7f7f808080"], ["01", "10"], t_edges]),
         "OJW": st.sampled_from([b - 1, b, last, last + 1, last + 1, b + 1 if last > b else b]).map(
             lambda n: f"OJW,{n}"),
-        "OPK": _one_off("OPK,{},{},{},{}", [st.just("{lat}"), st.just("{lon}"), st.sampled_from(["1", "2"]), spd],
+        "OPK": _one_off("OPK,{},{},{},{}", [st.just("{lat}"), st.just("{lon}"), st.just("{opk_min}"), spd],
                         [["{stn_lat}", "{far_lat}", "91", "-91"], ["181", "-181"], ["0", "1440", "1441"], ["0"]]),
         "OMW": _one_off("OMW,{},{},{},,15,{},{},", [st.just("{near_lat}"), st.just("{lon}"), st.just("2"), spd,
-                                                   st.sampled_from(["0", "5"])],
+                                                   st.sampled_from(["0", "{qpark}"])],
                         [["91", "-91"], ["181"], ["-100", "100", "-101", "101"], ["0"], ["86400", "86401"]]),
         "ODVL": _one_off("ODVL,{},{},{}", [st.just("0.5"), st.just("0"), tos],
                          [["5", "-5", "5.1", "-5.1"], ["5", "-5", "5.1", "-5.1"], ["0", str(hi), str(hi + 1)]]),
@@ -254,7 +260,7 @@ def commands(p: Profile, tos, family: str = "") -> st.SearchStrategy[str]:
     return st.one_of(*claimed) if claimed else st.just("OSD,S")
 
 
-def valid_commands(nwp: int, speed: float, motor: int, oxflt: bool, tos=timeouts(1.0)):
+def valid_commands(nwp: int, speed: float, motor: int, oxflt: bool, tos=timeouts(10)):
     """Bodies of well-formed commands a vehicle accepts somewhere, bench-safe (the older, plain
     vocabulary: kept for drivers that want only well-formed lines)."""
     spd = _num(0, speed)
@@ -265,28 +271,29 @@ def valid_commands(nwp: int, speed: float, motor: int, oxflt: bool, tos=timeouts
                   spd, tos),
         st.builds(lambda a, b, m, t: f"OMP,{a}{a}{b}{b}{m},00,{t}", hexb, hexb, mot, tos),
         st.builds(lambda n: f"OJW,{n}", st.integers(0, nwp)),
-        st.builds(lambda m, v: f"OPK,{{lat}},{{lon}},{m},{v}", st.integers(1, 2), spd),
-        st.builds(lambda v, pk: f"OMW,{{near_lat}},{{lon}},2,,15,{v},{pk},", spd, st.sampled_from([0, 5])),
+        st.builds(lambda v: f"OPK,{{lat}},{{lon}},{{opk_min}},{v}", spd),
+        st.builds(lambda v, pk: f"OMW,{{near_lat}},{{lon}},2,,15,{v},{pk},", spd, st.sampled_from(["0", "{qpark}"])),
         st.sampled_from(["OMW,Clr", "OMW,CLEAR", "OMW,stop", "OMSTOP,0", "OMSTART,0,0,0,0,{mission},",
                          "OMLOAD,{mission},0", "OMSTART,0", "OLOGD,1,2", "ORWSET,Sle,R", "OLOGL,x,y",
                          "OPOS,{lat},{lon},0.5,,", "ODVL,0.5,0,3", "OSD,G,C,S,P,,,,", "OSD,S,S", "OSD,S,Q"]),
     )
 
 
-def control_commands(speed: float, motor: int, tos=timeouts(1.0)):
+def control_commands(speed: float, motor: int, tos=timeouts(10)):
     """The remote-control commands (RH-INT-1), drawn more often than the rest."""
     spd = _num(0, speed)
     mot = st.integers(0x80, max(0x80, motor)).map(lambda b: f"{b:02X}")
     return st.one_of(
         st.builds(lambda v, t: f"OMS,90,2,20,{v},{t}", spd, tos),
         st.builds(lambda m, t: f"OMP,80808080{m},00,{t}", mot, tos),
-        st.builds(lambda v: f"OPK,{{lat}},{{lon}},1,{v}", spd),
-        st.builds(lambda v, pk: f"OMW,{{near_lat}},{{lon}},2,,15,{v},{pk},", spd, st.sampled_from([0, 0, 5])),
+        st.builds(lambda v: f"OPK,{{lat}},{{lon}},{{opk_min}},{v}", spd),
+        st.builds(lambda v, pk: f"OMW,{{near_lat}},{{lon}},2,,15,{v},{pk},", spd,
+                  st.sampled_from(["0", "0", "{qpark}"])),
     )
 
 
 #: Bodies a mutation is applied to: a request, a state change, a remote control.
-_MUTATED = ("OMSTOP,0", "OMS,90,2,20,0,10", "OJW,{wp_other}", "OSD,S", "OSD,G,S", "OPOS,{lat},{lon},0,,")
+_MUTATED = ("OMSTOP,0", "OMS,90,2,20,0,{to}", "OJW,{wp_other}", "OSD,S", "OSD,G,S", "OPOS,{lat},{lon},0,,")
 
 
 def invalid_lines(group: str = ""):

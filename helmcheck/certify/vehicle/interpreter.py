@@ -49,6 +49,7 @@ def context(session: Session) -> dict:
            "dive_depth": f"{min(p.max_depth / 2, 10.0 if p.depth_unit == 'm' else 33.0):g}"}
     _position(ctx, lat, lon)
     _other(session, ctx)
+    ctx.update(session.durations().context())
     return ctx
 
 
@@ -92,6 +93,13 @@ def _claimed_probe(session: Session, probe: Optional[str]) -> Optional[str]:
 
 def fill(text: str, ctx: dict) -> str:
     return text.format(**ctx) if "{" in text else text
+
+
+def number(value, ctx: dict) -> Optional[float]:
+    """A step's number, or the number a template in it names (``"{gap}"``)."""
+    if value is None or isinstance(value, (int, float)):
+        return value
+    return float(fill(value, ctx))
 
 
 def raw_line(kind: str, body: str, profile: Profile) -> bytes:
@@ -205,7 +213,7 @@ def run_step(session: Session, st, ctx: dict) -> None:
     elif isinstance(st, Poll):
         osi = session.poll()
         _here(session, ctx)
-        if not _condition(session, osi, st.mode, st.mode_not, st.park_below, st.submerged):
+        if not _condition(session, osi, st.mode, st.mode_not, number(st.park_below, ctx), st.submerged):
             if st.submerged is not None:
                 raise _not_reached(session, f"the vehicle reports depth {osi.depth} m where the case needs it "
                                             f"{'under water' if st.submerged else 'at the surface'}")
@@ -213,16 +221,16 @@ def run_step(session: Session, st, ctx: dict) -> None:
             raise _not_reached(session, f"the vehicle reports {osi.mode} P{osi.park_time} where the case "
                                         f"needs {want}")
     elif isinstance(st, Wait):
-        session.wait(st.vehicle_s, frame(fill(st.probe, ctx)) if st.probe else None)
+        session.wait(number(st.vehicle_s, ctx), frame(fill(st.probe, ctx)) if st.probe else None)
     elif isinstance(st, Settle):
         probe = _claimed_probe(session, st.probe)
         session.settle(st.timer, frame(fill(probe, ctx)) if probe else None, session.case_clauses[0])
         _here(session, ctx)
     elif isinstance(st, Until):
-        _until(session, st)
+        _until(session, st, ctx)
         _here(session, ctx)
     elif isinstance(st, Fault):
-        _violation(session, st)
+        _violation(session, st, ctx)
     elif isinstance(st, Start):
         p = session.profile
         name = getattr(p, st.which)
@@ -246,15 +254,17 @@ def run_step(session: Session, st, ctx: dict) -> None:
         raise TypeError(st)
 
 
-def _until(session: Session, st: Until) -> None:
+def _until(session: Session, st: Until, ctx: dict) -> None:
     fix = session.profile.gps_fix_depth_m
     srp = None if st.srp_active is None else ("True" if st.srp_active else "False")
+    at_least = number(st.depth_at_least, ctx)
+    park_below = number(st.park_below, ctx)
 
     def pred(o: s.OSI) -> bool:
         flag = o.srp_active if session.profile.protocol == "rh5" else o.battery
-        need = None if st.depth_at_least is None else min(st.depth_at_least, session.profile.max_depth / 4)
+        need = None if at_least is None else min(at_least, session.profile.max_depth / 4)
         deep = need is None or (o.depth is not None and float(o.depth) >= need)
-        return (deep and _condition(session, o, st.mode, None, st.park_below, st.submerged)
+        return (deep and _condition(session, o, st.mode, None, park_below, st.submerged)
                 and (not st.surface or (o.depth is not None and float(o.depth) <= fix))
                 and (srp is None or flag == srp))
     session.until(st.what, pred, st.budget_v, session.case_clauses[0])
@@ -327,7 +337,7 @@ def _set_round_trip(session: Session, st: SetRoundTrip) -> None:
 OPERATOR_WAIT_S = 120.0
 
 
-def _violation(session: Session, st: Fault) -> None:
+def _violation(session: Session, st: Fault, ctx: dict) -> None:
     """RH-SAF-5: raise a safety violation the way the profile says (``violation_trigger``).
 
     ``oxflt``: send ``$OXFLT,<code>`` (no ACK). ``mission-rule``: the case runs the profile's
@@ -339,9 +349,21 @@ def _violation(session: Session, st: Fault) -> None:
     """
     p = session.profile
     trig = p.trigger
+    then = [frame(fill(body, ctx)) for body in st.then]
     if trig == "oxflt" or "oxflt" in session.case_needs:
-        session.exchange(frame(f"OXFLT,{st.code}"))
+        if then:
+            session.burst([frame(f"OXFLT,{st.code}"), *then])
+        else:
+            session.exchange(frame(f"OXFLT,{st.code}"))
         return
+    _raised(session, st, trig)
+    if then:
+        session.burst(then)
+
+
+def _raised(session: Session, st: Fault, trig: str) -> None:
+    """Wait for a violation the vehicle raises itself (``mission-rule``, ``operator``)."""
+    p = session.profile
     shown = lambda o: o.error_state not in ("N", "")  # noqa: E731
     if trig == "mission-rule":
         started = session.mission_started_at if session.mission_started_at is not None else session.now()
@@ -366,7 +388,7 @@ def _violation(session: Session, st: Fault) -> None:
 
 def run_case(session: Session, case: Case) -> tuple[str, str]:
     """Run one case: its outcome for the report's case list, and why."""
-    why = unmet_need(case, session.profile)
+    why = unmet_need(case, session.profile, session.durations(fresh=True))
     if why:
         session.tester("not-tested", case.clauses, f"{case.id}: {why}")
         return "not-tested", why

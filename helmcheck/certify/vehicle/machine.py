@@ -85,7 +85,8 @@ def machine(state, p, tos, deep: bool = True):
     oxflt = p.fault_injection == "oxflt"
     claimed = set(p.commands)
     short = st.sampled_from(list(tos.elements)[:2]) if hasattr(tos, "elements") else tos  # episodes wait these out
-    hi_to = max(tos.elements) if hasattr(tos, "elements") else 30  # a steer that lasts (:meth:`steer_then_read`)
+    # a steer that lasts (:meth:`steer_then_read`)
+    hi_to = max(tos.elements) if hasattr(tos, "elements") else int(p.timeout_range[1])
 
     def send(raw: bytes):
         """One line, exchanged, its model coverage counted."""
@@ -459,7 +460,7 @@ def machine(state, p, tos, deep: bool = True):
             self._guard(go)
 
         @precondition(lambda self: deep and self.mission and "OMW" in claimed)
-        @rule(parks=st.lists(st.sampled_from(["0", "0", "5"]), min_size=1, max_size=3),
+        @rule(parks=st.lists(st.sampled_from(["0", "0", "{qpark}"]), min_size=1, max_size=3),
               then=st.sampled_from(["", "", "OMW,Clr", "OMS", "OJW,{wp_other}"]))
         def queue(self, parks, then):
             """A queue of waypoints 15 m apart (RH-OMW-2): followed to its end (RH-OMW-4, a park on a
@@ -469,10 +470,10 @@ def machine(state, p, tos, deep: bool = True):
             def go():
                 for i, park in enumerate(parks):
                     lat = float(self.ctx["lat"]) + 15.0 * (i + 1) / 111320.0
-                    send(frame(fill(f"OMW,{lat:.6f},{{lon}},2,,15,{speed:g},{park},", self.ctx)))
+                    send(frame(fill(f"OMW,{lat:.6f},{{lon}},2,,15,{speed:g},{park},", self.ctx)))  # park: a template
                 session.poll()
                 if then:
-                    body = fill("OMS,90,2,20,0,{t}" if then == "OMS" else then, {**self.ctx, "t": "5"})
+                    body = fill("OMS,90,2,20,0,{to}" if then == "OMS" else then, self.ctx)
                     send(frame(body))
                     self._settle_next()
                 end = session.now() + QUEUE_WITHIN_V / session.k

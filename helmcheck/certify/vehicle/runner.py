@@ -342,6 +342,7 @@ def certify(opts: Options) -> Outcome:
         try:
             run.open()
             run.probe()
+            run.session.measure_line()  # what the line costs: the durations the cases choose
             check_clock(run, opts.clock_check)
             run.run_cases(cases)
             if explore_now and run.aborted is None:

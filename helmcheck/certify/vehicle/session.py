@@ -35,8 +35,10 @@ from ...judge.timing import ack_allowance, ack_give_up_after, tolerance
 from ...judge.vehicle import Sent, VehicleObserver
 from ...judge.wire import case_end_note, case_note, tester_note
 from ...profile import Profile
+from .durations import Durations, derive
 from .flow import CaseStop, LinkSilent
 from .link import TesterLink
+from .linemeter import LINK_PROBES, LineMeter
 
 __all__ = ["Session", "frame"]
 
@@ -83,6 +85,38 @@ class Session:
         self.operator: Optional[Callable[[str], None]] = None
         #: keeps what the vehicle was found in and puts it back (:mod:`.restore`); None: not kept
         self.custodian = None
+        #: what the line costs (:mod:`.linemeter`), and the durations chosen from it (:mod:`.durations`)
+        self.meter = LineMeter(self.k, profile.baud, profile.ack_window_s)
+        self._durations: Optional[Durations] = None
+
+    # ================================================================ the line budget
+    def measure_line(self) -> None:
+        """The link check's measurement (:mod:`.linemeter`): the host's jitter, then
+        :data:`~.linemeter.LINK_PROBES` ``$OSD,S`` round trips; writes the ``line budget:`` note."""
+        self.meter.measure_host()
+        body = "OSD,S" if "S" in self.profile.osd_letters else "OSD"  # no letters: ACK alone (RH-RD-7)
+        with self.not_stopping():  # what the judge finds in them is booked; the run goes on
+            for _ in range(LINK_PROBES):
+                self.exchange(frame(body))
+        self.meter.measured = True
+        self.durations(fresh=True)
+
+    def durations(self, fresh: bool = False) -> Durations:
+        """The durations the line allows (:mod:`.durations`), chosen again when ``fresh`` (a case or
+        a sequence starts) from the latencies measured so far; a budget that moved is noted."""
+        if fresh or self._durations is None:
+            changed = self.meter.changed()
+            if changed is not None and self.meter.measured:
+                self.note(changed.note())
+            self._durations = derive(self.profile, self.meter.budget())
+        return self._durations
+
+    def _sample(self, sent: Sent) -> None:
+        if sent.ack is not None and sent.t_ack is not None and not sent.branched:
+            replies = self.obs.vbytes - sent.vbytes0
+            self.meter.sample(sent.t, len(sent.raw), sent.t_ack, replies)
+            if sent.osi is not None:
+                self.meter.saw_osi(replies - 15)
 
     # ================================================================ helpers
     def now(self) -> float:
@@ -156,7 +190,7 @@ class Session:
             if rx is None:
                 break
         if sent.done:
-            self.forced_wait += 0.0
+            self._sample(sent)
             self._trace({"expect": _brief(sent.expected)})
             self.check()
             return sent
@@ -261,6 +295,9 @@ class Session:
         while any(not x.done for x in sents):
             if self.link.next(hard) is None:
                 break
+        for x in sents:
+            if x.done:
+                self._sample(x)
         if any(not x.done for x in sents):
             self._probe(hard)
         self.check()
@@ -330,15 +367,22 @@ class Session:
             self.link.sleep(min(self.poll_gap * 4, max(0.0, due_wall - close - self.now())))
             self.poll() if probe is None else self.exchange(probe)
         answered = None
+        osi = None
+        # the lockout's end is shown by the probe (a command only the lockout refuses): a report
+        # between two probes would only space them further apart on a slow line
+        by_probe = name == "lockout" and probe is not None
         while True:
             if probe is not None:
                 answered = self.exchange(probe)
-            osi = self.poll()
+            over = by_probe and answered is not None and answered.ack is not None and answered.ack.err != 26
+            if not by_probe or over or self.now() - t0 > cap:
+                osi = self.poll()
             st = self.obs.state()
             armed = st.timers.armed(name)
-            left = (osi.mode != before) if name != "lockout" else (st.phase != phase_before)
-            if name == "lockout" and probe is not None:
-                left = left and answered is not None and answered.ack is not None and answered.ack.err != 26
+            if name != "lockout":
+                left = osi is not None and osi.mode != before
+            else:
+                left = st.phase != phase_before and (over or not by_probe)
             if not armed and left and self.now() > due_wall:
                 break
             if self.now() - t0 > cap:

@@ -6,7 +6,9 @@ judges every reply and report. Where a step names a state (``Poll(mode="A")``) i
 vehicle that is elsewhere (the observer found nothing wrong) means the case could not exercise
 the clause on this vehicle: INCONCLUSIVE with that reason, never PASS.
 
-Templates in step text: ``{mission}`` the profile's mission, ``{speed}`` a speed within the
+Templates in step text (and in the numbers a step takes as text, ``Wait("{gap}")``): the durations
+the line budget allows (``{to}``, ``{to_long}``, ``{to_tim}``, ``{to_restart}``, ``{gap}``,
+``{opk_min}``, ``{opk_s}``, ``{dive_depth}``, ``{dive_at}``: :mod:`.durations`), ``{mission}`` the profile's mission, ``{speed}`` a speed within the
 bench-safety limit, ``{motor}`` a motor byte within it, ``{lat}``/``{lon}`` the vehicle's last
 reported position, ``{near_lat}``/``{near_lon}`` a point ~110 m north/east of it, ``{far_lat}`` one
 ~111 km north, ``{km_lat}`` one ~1.1 km north, ``{wp_last}``/``{wp_bad}`` the last and one-past-the-last waypoint number,
@@ -65,15 +67,16 @@ class Poll:
 
     mode: Optional[str] = None
     mode_not: Optional[str] = None
-    park_below: Optional[int] = None
+    park_below: Optional[int | str] = None
     submerged: Optional[bool] = None
 
 
 @dataclass(frozen=True)
 class Wait:
-    """Let protocol time pass (vehicle seconds), polling; ``probe`` is sent each round."""
+    """Let protocol time pass (vehicle seconds, or a template such as ``"{gap}"``), polling;
+    ``probe`` is sent each round."""
 
-    vehicle_s: float
+    vehicle_s: float | str
     probe: Optional[str] = None
 
 
@@ -91,19 +94,23 @@ class Until:
 
     what: str
     mode: Optional[str] = None
-    park_below: Optional[int] = None
+    park_below: Optional[int | str] = None
     budget_v: float = 600.0
     surface: bool = False
     srp_active: Optional[bool] = None
     submerged: Optional[bool] = None  #: True: until the depth is below the GPS-fix depth
-    depth_at_least: Optional[float] = None  #: until ``$OSI`` field 15 shows at least this depth
+    depth_at_least: Optional[float | str] = None  #: until ``$OSI`` field 15 shows at least this depth
 
 
 @dataclass(frozen=True)
 class Fault:
-    """``$OXFLT,<code>``: raise a safety violation (RH-SAF-5); no ACK is due."""
+    """Raise a safety violation the profile's way (RH-SAF-5: ``$OXFLT,<code>``, no ACK is due; a
+    mission's own rule; an operator). ``then``: commands written in one burst right after it (with
+    the ``$OXFLT``, in the same write), so that they reach the vehicle inside the lockout on any
+    line and at any time scale the line budget allows (RH-SAF-1)."""
 
     code: str = "Sle"
+    then: tuple = ()
 
 
 @dataclass(frozen=True)

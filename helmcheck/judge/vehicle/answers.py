@@ -22,7 +22,7 @@ from __future__ import annotations
 from ...grammar import sentences as s
 from ...grammar.wirelog import escape
 from ..ledger import Evidence
-from ..timing import JITTER_S, ack_allowance, ack_uncertainty, ack_verdict, transmit_time
+from ..timing import ack_allowance, ack_uncertainty, ack_verdict, transmit_time
 from .blame import command_clauses, looked_up, passable
 from .sent import Sent, brief, names, text_of
 
@@ -126,21 +126,36 @@ class Answers:
             return False  # perhaps a waiting command's own ACK, malformed
         return self._discard_answered(ack_type, escape(raw.rstrip(b"\r\n")), None, evd)
 
+    def _bound_oxflt(self, p: Sent, t_reply: float) -> None:
+        """An ``$OXFLT`` raises its violation when the vehicle processes it (RH-SAF-5), which no
+        answer shows: some time after it was sent and before the vehicle answers a line sent after
+        it (RH-ACK-6: arrival order). The mirror applied it at the send; from the first such
+        answer on, every candidate carries that window as uncertainty on the timers the
+        violation started (the lockout, RH-SAF-1), as for an unseen event (:mod:`.closure`)."""
+        if self.oxflt_open is None or p.seq < self.oxflt_open[1]:
+            return
+        t0 = self.oxflt_open[0]
+        self.oxflt_open = None
+        lo, hi = self.v(t0), self.v(max(t0, t_reply))
+        for c in self.beliefs.cands:
+            c.extra_v = max(c.extra_v, hi - lo)
+            c.window = (lo, hi)
+
     def _answered(self, p: Sent, a: s.ACK, t: float, evd: Evidence, late: bool) -> None:
         p.state, p.ack, p.t_ack = "answered", a, t
         ev = [p.ev, evd]
         replies = self.vbytes - p.vbytes0
         window = self.profile.ack_window_s
-        allowance = ack_allowance(window, len(p.raw), replies, self.baud, self.res)
+        allowance = ack_allowance(window, len(p.raw), replies, self.baud, self.res, self.jitter)
         dt = t - p.t
-        verdict = "fail" if late else ack_verdict(dt, allowance, window, self.res)
+        verdict = "fail" if late else ack_verdict(dt, allowance, window, self.res, self.jitter)
         if late and p.late_booked:
             pass  # RH-ACK-2 was booked when the give-up deadline passed
         elif verdict == "fail":
             self.book("fail", ("RH-ACK-2",), f"$ACK,{a.type} came {dt:.2f} s after {text_of(p)}; allowed "
                                              f"{allowance:.2f} s: the {window:g} s window, "
                                              f"{transmit_time(len(p.raw) + replies, self.baud):.3f} s of transmit "
-                                             f"time, {ack_uncertainty(self.res):.3f} s of observer "
+                                             f"time, {ack_uncertainty(self.res, self.jitter):.3f} s of observer "
                                              f"uncertainty", ev, at=p)
         elif verdict == "inconclusive":
             self.ledger.inconclusive("RH-ACK-2", f"an $ACK came {dt:.2f} s after its command: timestamps step "
@@ -159,7 +174,9 @@ class Answers:
         # RH-RD-15: the command took effect the instant its ACK went out, which its arrival bounds
         # (less the replies' transmit time), however long the vehicle took to answer
         took = min(dt, transmit_time(replies, self.baud))
-        res = self.beliefs.command(p.kind.item, self.k * t, self.k * (took + JITTER_S + self.res), observed)
+        self._bound_oxflt(p, t - took)
+        res = self.beliefs.command(p.kind.item, self.k * (t - took), self.k * (took + self.jitter + self.res),
+                                   observed)
         p.expected = res.expected
         want = next((r for r in res.expected if isinstance(r, s.ACK)), None)
         p.negative = want is not None and want.status == 1
@@ -285,6 +302,7 @@ class Answers:
         # the report shows the state the instant it was sent (RH-OUT-4), which its arrival bounds
         # less its own transmit time (RH-RD-15: the $OSD is processed as its ACK goes out)
         t_from = max(p.t, t - transmit_time(len(evd.text) + 2, self.baud))
+        self._bound_oxflt(p, t_from)
         res = self.beliefs.osi(osi, self.v(t_from), self.v(t), self.slack_v())
         if res.findings:
             named = tuple(dict.fromkeys(c for c, _ in res.findings if c != "RH-OUT-4"))  # a field's own clause

@@ -93,8 +93,10 @@ class Beliefs:
         self.cands: list[Candidate] = [Candidate(VehicleModel(profile, catalog))]
         #: why the vehicle's state is not known (findings are INCONCLUSIVE until it is again)
         self.desync = "the record begins with the vehicle's state unknown"
-        #: vehicle seconds: the longest command round trip since the state was last known — a
-        #: timer armed by a command started somewhere in that round trip (RH-RD-15)
+        #: vehicle seconds: the widest window in which a command that may arm a timer went into
+        #: effect since the state was last known (RH-RD-15: its ACK going out, which the ACK's
+        #: arrival less the replies' transmit time bounds). An ``$OSD`` arms nothing, so its data's
+        #: transmit time does not widen the timing of anything.
         self.arm_v = 0.0
         #: the last ``$OSI`` and the vehicle second it arrived (its depth is read only when needed)
         self.last_osi: Optional[tuple[s.OSI, float]] = None
@@ -107,7 +109,8 @@ class Beliefs:
     def command(self, item, v: float, slack_v: float, observed: list) -> CommandResult:
         """Feed an answered command (module docstring); ``observed`` is the vehicle's replies."""
         desync = self.desync
-        self.arm_v = max(self.arm_v, slack_v)
+        if type(item) is not s.OSD:
+            self.arm_v = max(self.arm_v, slack_v)
         if type(item) is s.OSD:
             result = self._poll(item, v, slack_v, observed, desync)
             if result is not None:

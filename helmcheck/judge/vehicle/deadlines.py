@@ -36,7 +36,7 @@ class Deadlines:
         for p in self.pending:
             if t - p.t <= window:
                 continue  # inside the bare window: inside every allowance (ack_allowance ≥ the window)
-            allowance = ack_allowance(window, len(p.raw), self.vbytes - p.vbytes0, self.baud, self.res)
+            allowance = ack_allowance(window, len(p.raw), self.vbytes - p.vbytes0, self.baud, self.res, self.jitter)
             if t - p.t > ack_give_up_after(allowance):
                 if over is None:
                     over = []
@@ -49,7 +49,7 @@ class Deadlines:
             self._give_up(t)
 
     def _silent_over(self, q: Sent, t: float) -> bool:
-        allowance = ack_allowance(self.profile.ack_window_s, len(q.raw), 0, self.baud, self.res)
+        allowance = ack_allowance(self.profile.ack_window_s, len(q.raw), 0, self.baud, self.res, self.jitter)
         return t - q.t > allowance
 
     def _silence_kept(self, q: Sent) -> None:

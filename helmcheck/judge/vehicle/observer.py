@@ -70,6 +70,7 @@ class VehicleObserver(Answers, Deadlines):
         self.ledger = ledger
         self.k = float(time_scale)
         self.res = resolution
+        self.jitter = JITTER_S  #: the host's jitter: more where a ``line budget:`` note measured more
         self.baud = baud if baud is not None else profile.baud
         self.missions = GivenMissions(catalog) if catalog is not None else KnownMissions(profile)
         self.beliefs = Beliefs(profile, self.missions, self.k)
@@ -82,6 +83,9 @@ class VehicleObserver(Answers, Deadlines):
         self.dead: list[Sent] = []  #: missing while the vehicle said nothing at all (yet)
         self.quiet: list[Sent] = []  #: discarded lines waiting for proof the vehicle listens
         self.last_osd: Optional[Sent] = None
+        #: (wall time, line number) of an ``$OXFLT`` whose violation no later reply has bounded yet
+        #: (answers.py)
+        self.oxflt_open: Optional[tuple[float, int]] = None
         self.mission_shown: list[tuple] = []  #: $OMSTARTs the reports to come judge (answers.py)
         self.sent: deque[Sent] = deque(maxlen=256)
         self.seq = 0
@@ -116,7 +120,7 @@ class VehicleObserver(Answers, Deadlines):
 
     def slack_v(self) -> float:
         """What every observation of this record cannot see: jitter and the timestamp step."""
-        return self.k * (JITTER_S + self.res)
+        return self.k * (self.jitter + self.res)
 
     def book(self, verdict: str, candidates: tuple[str, ...], reason: str, evidence=(),
              at: Optional["Sent"] = None) -> None:
@@ -214,6 +218,8 @@ class VehicleObserver(Answers, Deadlines):
                     self.ledger.not_tested(cid, n.text, self.case)
                 else:
                     self.ledger.inconclusive(cid, n.text, [Evidence(ev.t, "!", ev.note, ev.lineno)], self.case)
+        elif n.kind == "budget":
+            self.jitter = max(JITTER_S, n.value.jitter_s)
         elif n.kind == "link":
             self.link_baud = n.value
             self.baud = n.value  # the line's rate as the tester opened it: what transmit times use
@@ -272,6 +278,7 @@ class VehicleObserver(Answers, Deadlines):
             sent.state = "silent"
             self.silent.append(sent)
             self.beliefs.command(k.item, self.v(ev.t), self.slack_v(), [])
+            self.oxflt_open = (ev.t, sent.seq)  # when it took effect: known at the next reply (answers.py)
             self.checks.oxflt_sent(k.item.code, ev.t)  # type: ignore[union-attr]
             self.event(ev.t, "lockout", f"$OXFLT,{k.item.code} sent")  # type: ignore[union-attr]
         else:

@@ -52,7 +52,7 @@ from ...grammar import sentences as s
 from ...model.geo import KNOT_MPS, distance_m
 from ...model.plant import NEUTRAL
 from ...model.timers import tolerance
-from ..timing import JITTER_S, PLANT_REACT_S
+from ..timing import PLANT_REACT_S
 from .closure import VERTICAL_MPS, osi_depth_m, osi_numbers
 from .queuetarget import QueueTarget
 
@@ -388,7 +388,7 @@ class OsiChecks:
             park.on = hi  # seen on station: the count must run from here on (RH-PK-2)
         if park.on is not None and not park.failed:
             waited = lo - park.on
-            allow = PLANT_REACT_S + tolerance(PLANT_REACT_S) + o.k * (JITTER_S + o.res)
+            allow = PLANT_REACT_S + tolerance(PLANT_REACT_S) + o.k * (o.jitter + o.res)
             ran = max(0, counted) + 1.0  # the most field 10 can have run (it is rounded up)
             if waited - ran - max(0.5, 0.05 * ran) > allow:
                 park.failed = True
@@ -438,7 +438,7 @@ class OsiChecks:
             self.watch = (key, o.v(t))
             return
         waited = v - self.watch[1]
-        allow = PLANT_REACT_S + tolerance(PLANT_REACT_S) + o.k * (JITTER_S + o.res) + o.beliefs.primary.extra_v
+        allow = PLANT_REACT_S + tolerance(PLANT_REACT_S) + o.k * (o.jitter + o.res) + o.beliefs.primary.extra_v
         if waited > allow:
             self.watch = None
             o.book("fail", clause, f"{what} for {waited:.1f} s of vehicle time (a vehicle acts within "

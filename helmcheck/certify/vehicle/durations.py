@@ -1,0 +1,148 @@
+"""The durations a case or an exploration draw uses, chosen from the line budget.
+
+Every duration the tester sets going — a servo or primitive timeout, an ``$OPK`` park, the wait
+between two ``$OMS`` that restart a timeout, the depth a dive must reach so that the vehicle is
+still under water when the lockout is over — is chosen here from the run's
+:class:`~helmcheck.judge.linebudget.LineBudget`, inside the profile's ranges (``timeout_range``,
+RH-PK-1's minutes). The rule is the same everywhere: the shortest duration the observer can time
+on this line at this time scale (RH-TIM-1, RH-TIM-2) and that outlasts the report confirming it
+took effect. Where no allowed duration is long enough, :meth:`Durations.unmet` says so with the
+time scale or baud that would do, and the case is NOT-TESTED before it runs — never INCONCLUSIVE
+after the fact (a case that cannot time its own timer is the tester's defect).
+
+The keys :meth:`Durations.context` adds to a case's templates (:mod:`.interpreter`):
+
+==============  ==============================================================================
+``to``          a servo / primitive timeout the observer times (RH-SRV-4, RH-PRM-4)
+``to_long``     a control that must outlast several steps (at least 60 s and three ``to``)
+``to_tim``      RH-TIM-2's long timeout (at least 30 s: a clock 30 % off is told apart)
+``to_restart``  a timeout restarted ``gap`` into it, both deadlines told apart (RH-SRV-3)
+``gap``         vehicle seconds between the two ``$OMS`` of ``to_restart``
+``opk_min``     ``$OPK`` minutes whose countdown is timed (RH-PK-3); ``opk_s`` the seconds
+``qpark``       a park time on a queued ``$OMW`` waypoint the observer can time (RH-OMW-4)
+``dive_depth``  the depth of the dive before a violation (10 m, at most half the depth range)
+``dive_at``     the depth at which the dive counts as under way (four fifths of it)
+==============  ==============================================================================
+
+Decisions (the profile is silent): a dive goes to 10 m (at the bench speed it takes a while); the
+case that needs the vehicle under water after a lockout sends the ``$OMP`` that holds its depth
+(RH-RD-12) as the probe that finds the lockout's end, so no ascent rate is assumed; a lockout's
+commands go in one burst after the violation, and need the lockout to last the burst's
+processing with the observer's margin.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Optional
+
+from ...judge.linebudget import MARGIN, LineBudget
+from ...model.timers import tolerance
+from ...profile import Profile
+
+__all__ = ["Durations", "derive", "BURST_BYTES", "DURATION_KEYS"]
+
+#: The template keys :meth:`Durations.context` fills.
+DURATION_KEYS = ("to", "to_long", "to_tim", "to_restart", "gap", "opk_min", "opk_s", "qpark", "dive_depth",
+                 "dive_at")
+
+#: Bytes of the burst of commands a lockout case sends after the violation.
+BURST_BYTES = 90
+
+
+@dataclass(frozen=True)
+class Durations:
+    """The tester's durations on one line (module docstring); ``None``: none can be timed."""
+
+    budget: LineBudget
+    lo: int
+    hi: int
+    to: Optional[int]
+    to_long: Optional[int]
+    to_tim: Optional[int]
+    to_restart: Optional[int]
+    gap: float
+    opk_min: Optional[int]
+    qpark: Optional[int]
+    lockout_ok: bool
+    lockout_s: float
+    seen_by_poll: bool  #: the violation is seen by a poll first (not ``$OXFLT``, RH-SAF-5)
+    dive_depth: float
+    depth_unit: str
+
+    def context(self) -> dict[str, str]:
+        ctx = {"gap": f"{self.gap:.1f}", "dive_depth": f"{self.dive_depth:g}",
+               "dive_at": f"{0.8 * self.dive_depth:g}"}
+        for key in ("to", "to_long", "to_tim", "to_restart"):
+            ctx[key] = str(getattr(self, key) or self.hi)
+        m = self.opk_min or 1440
+        ctx.update(opk_min=str(m), opk_s=str(60 * m), qpark=str(self.qpark or 86400))
+        return ctx
+
+    def unmet(self, need: str) -> Optional[str]:
+        """Why a case needing ``need`` (``timer:to``, ``timer:opk``, ``lockout`` …) cannot be run
+        on this line, or ``None``."""
+        kind, _, arg = need.partition(":")
+        b = self.budget
+        if kind == "timer":
+            value = self.opk_min if arg == "opk" else getattr(self, arg, None)
+            if value is not None:
+                return None
+            what = {"to": "remote-control timeout", "to_long": "remote-control timeout",
+                    "to_tim": "timeout of 30 s or more", "to_restart": "timeout long enough to be restarted "
+                    "and have both deadlines told apart", "opk": "$OPK park"}.get(arg, arg)
+            hi = 1440 * 60 if arg == "opk" else self.hi
+            return (f"no {what} the profile allows (up to {hi} s) can be timed on this line at time scale "
+                    f"{b.k:g} (RH-TIM-1: {b.describe()}); run at {b.advice(self.lo, hi)}")
+        if kind == "lockout" and not self.lockout_ok:
+            return (f"the {self.lockout_s:g} s lockout ends before the commands sent into it can be "
+                    f"answered on this line at time scale {b.k:g} (RH-SAF-1: {b.describe()}); run at "
+                    f"{_lockout_advice(b, self.lockout_s, self.seen_by_poll)}")
+        return None
+
+
+def _lockout_fits(b: LineBudget, lockout_s: float, seen_by_poll: bool = False) -> bool:
+    """Do the commands of a lockout case, one burst written right after the violation (or after the
+    poll that saw a violation the vehicle raised itself), reach the vehicle inside the lockout?"""
+    need = b.command_v + b.k * b.tx(BURST_BYTES) + MARGIN * b.observe_v + (b.poll_v if seen_by_poll else 0.0)
+    return need + tolerance(lockout_s) <= lockout_s
+
+
+def _lockout_advice(b: LineBudget, lockout_s: float, seen_by_poll: bool) -> str:
+    k = b.k
+    while k > 1:
+        k = math.floor(k) - 1 if k > 2 else 1
+        if _lockout_fits(b.at(k=k), lockout_s, seen_by_poll):
+            return f"--time-scale {k:g}"
+    return "a vehicle that answers sooner"
+
+
+def derive(profile: Profile, budget: LineBudget) -> Durations:
+    """The durations for ``profile`` on the line ``budget`` describes."""
+    lo, hi = int(profile.timeout_range[0]), int(profile.timeout_range[1])
+    b = budget
+    to = b.shortest(lo, hi)
+    to_long = b.shortest(lo, hi, at_least=max(60.0, 3 * (to or hi))) if to is not None else None
+    if to_long is None and to is not None:
+        to_long = hi
+    to_tim = b.shortest(lo, hi, at_least=30.0)
+    to_restart = None
+    gap = 0.0
+    if to is not None:
+        for d in range(to, hi + 1):
+            g = b.gap_v(d)
+            if d - tolerance(d) - MARGIN * b.observe_v >= b.hold_v + g + b.command_v and b.timeable(d):
+                to_restart, gap = d, g
+                break
+        if to_restart is None:
+            gap = b.gap_v(hi)
+    opk = b.shortest(60, 1440 * 60, unseen_start=True)
+    opk_min = None if opk is None else int(math.ceil(opk / 60))
+    qpark = b.shortest(1, 86400, hold=False, unseen_start=True)
+    depth_m = min(profile.max_depth_m / 2, 10.0)
+    depth = float(math.floor(depth_m if profile.depth_unit == "m" else depth_m / 0.3048))
+    by_poll = profile.trigger != "oxflt"
+    return Durations(b, lo, hi, to, to_long, to_tim, to_restart, round(gap, 1), opk_min, qpark,
+                     _lockout_fits(b, profile.lockout_s, by_poll), profile.lockout_s, by_poll, depth,
+                     profile.depth_unit)
