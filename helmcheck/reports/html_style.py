@@ -15,7 +15,7 @@ _CSS = """
 --inc:#8250df;--inc-bg:#fbefff;--nt:#57606a;--nt-bg:#f6f8fa;--line:#d0d7de}
 *{box-sizing:border-box}
 body{font:14px/1.45 system-ui,-apple-system,"Segoe UI",Roboto,sans-serif;color:#1f2328;margin:0 auto;
-max-width:1180px;padding:16px 24px 48px}
+max-width:1180px;padding:16px 24px 48px;overflow-wrap:break-word}
 h1{font-size:22px;margin:8px 0 12px}h2{font-size:18px;margin:28px 0 8px;border-bottom:1px solid var(--line);
 padding-bottom:4px}h3{font-size:15px;margin:18px 0 6px}
 table{border-collapse:collapse;width:100%;margin:6px 0}th,td{border:1px solid var(--line);padding:4px 8px;
