@@ -1,11 +1,13 @@
 """The HTML reports' stylesheet and Content-Security-Policy: the inline CSS (screen and print) of
 :mod:`~helmcheck.reports.html`, and the policy that forbids scripts and fetches.
 
-Layout rules the stylesheet keeps: nothing is wider than the window from 1280 px down to a
-phone (tables wrap their cells, the clause matrix has fixed column widths and turns into one
-card per clause below 900 px, wire excerpts wrap and scroll inside their own box); folded
-sections (``details.fold``) show their title and gist; printed, every fold is open and the
-certificate is alone on the first page.
+Layout rules the stylesheet keeps: nothing is wider than the window, at 1280 px and at 800 px
+(tests/test_report_layout_browser.py): every long word wraps, tables wrap their cells, the
+clause matrix has fixed column widths and turns into one card per clause below 900 px, wire
+excerpts wrap and a long one scrolls down inside its own box. Folded sections
+(``details.fold``) show their title and gist. Printed, every fold is open (the run box keeps
+its facts and leaves the coverage note to the coverage section) and the certificate is alone
+on the first page.
 """
 
 _CSP = "default-src 'none'; style-src 'unsafe-inline'; img-src data:; form-action 'none'; base-uri 'none'"
@@ -69,7 +71,9 @@ details.replay>summary{cursor:pointer;margin:6px 0 2px}
 .digest{font-family:ui-monospace,Menlo,Consolas,monospace;font-size:12.5px;background:#f6f8fa;
 border:1px solid var(--line);border-radius:6px;padding:8px 12px;word-break:break-all}
 .digest b{font-family:system-ui,sans-serif}
-table.counts{table-layout:fixed}.counts td{text-align:center;font-weight:700}.counts th{text-align:center}
+table.counts{margin:0}.counts td{text-align:center;font-weight:700;font-size:16px}
+.counts th{text-align:center;font-size:11.5px;padding:4px 4px;white-space:nowrap}
+.counts-box{border:1px solid var(--line);border-radius:6px;padding:8px 12px}.counts-box h2{margin:0 0 6px}
 .finding{border:1px solid var(--line);border-left:6px solid;border-radius:6px;padding:4px 14px 10px;margin:12px 0;
 background:#fff;color:#1f2328}
 .finding.v-fail{border-left-color:var(--fail)}.finding.v-non-strict{border-left-color:var(--ns)}
@@ -98,7 +102,8 @@ background:repeating-linear-gradient(135deg,#f6f8fa,#f6f8fa 14px,#eaeef2 14px,#e
 table.ident{width:100%;min-width:0;margin:0;table-layout:fixed}table.ident th{width:12.5em;font-weight:600}
 table.ident td,table.ident th{padding:2px 8px}table.ident td{overflow-wrap:anywhere}
 td.missing{color:var(--fail);font-style:italic}
-.seal,.who{border:1px solid var(--line);border-radius:6px;padding:8px 12px;font-size:13px}
+.seal,.who,.when{border:1px solid var(--line);border-radius:6px;padding:8px 12px;font-size:13px}
+.side{display:grid;gap:14px}.when p{margin:2px 0}.when p.note{margin:6px 0 2px;font-size:12.5px}
 .seal .digest{margin:4px 0;padding:4px 8px;font-size:11.5px}
 .sig-ok{color:var(--pass);font-weight:700}.sig-none{color:var(--ns);font-weight:700}
 .pass-evidence{border-left:4px solid var(--pass);padding:1px 12px;margin:3px 0;font-size:13px}
@@ -133,6 +138,7 @@ details:not(.events)::details-content{content-visibility:visible;display:content
 details>summary::before{content:none!important}details.more>summary{font-size:0;margin:0}
 details.more>summary::after{content:", ";font-size:11.5px}
 nav.contents{display:none}pre.wire{max-height:none;overflow:visible}
+#coverage-beside{display:none}
 pre{white-space:pre-wrap}
 footer{break-before:avoid}
 }
