@@ -57,6 +57,9 @@ def test_model_coverage_says_what_it_means_for_a_certificate(tmp_path):
     assert "each of the 60 claimed clauses" in note
     assert "model-coverage-note" in [a.get("id") for a in page.find("p", inside="coverage")]
     assert "not part of the verdict" in page.text_of("coverage") and "30 of 91" in page.text_of("coverage")
+    beside = page.text_of("coverage-beside")  # on the first page, beside the digest
+    assert "model rows 30 of 91 (33.0 %)" in beside and note in beside
+    assert "coverage-beside" in [a.get("id") for a in page.find("p", inside="certificate-page")]
     render_all(d, formats=("md",))
     md = (d / "report.md").read_text(encoding="utf-8")
     line = next(ln for ln in md.splitlines() if ln.startswith("Exploration's model coverage"))
