@@ -28,7 +28,7 @@ DEMO = ROOT / "reports" / "demo"
 FIXTURES = Path(__file__).parent / "fixtures" / "reports"
 HEIGHT = 800
 
-pytestmark = needs_chromium
+pytestmark = [needs_chromium, pytest.mark.xdist_group("report-layout-browser")]  # one worker measures each page once
 
 _MEASURE = r"""
 const doc = document.documentElement;
