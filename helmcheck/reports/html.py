@@ -69,7 +69,7 @@ def render_html(run: Run, comparison_html: str | None = None) -> str:
                  open_=not r["restore"].get("verified"))] if isinstance(r.get("restore"), Mapping) else []),
         _section("matrix", f"Clauses ({len(rows)})", _matrix(run)),
         _fold("evidence", "Evidence for passing clauses", _pass_evidence(run),
-              _e(f"{passed} passing clause(s), each with the exchange that decided it")),
+              _e(f"the wire evidence of {passed} passing clause(s)")),
         _fold("implementation", "Implementation", _identity(run), _implementation_gist(run),
               open_=_name_mismatch(run)),
         _fold("run", "Run", _run_facts(run), _run_gist(run)),

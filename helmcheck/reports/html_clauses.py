@@ -45,18 +45,19 @@ def _cases_cell(cases: list[str]) -> str:
     if not cases:
         return '<td class="cases"><span class="muted">—</span></td>'
     shown, rest = (cases, []) if len(cases) <= CASES_SHOWN + 1 else (cases[:CASES_SHOWN], cases[CASES_SHOWN:])
+
     def names(part: list[str]) -> str:
         return ", ".join(f'<span class="case">{_e(c)}</span>' for c in part)
 
     out = names(shown)
     if rest:
         out += f'<details class="more"><summary>+{len(rest)} more</summary>{names(rest)}</details>'
-
     return f'<td class="cases mono">{out}</td>'
 
 
 def _matrix(run: Run) -> str:
-    """One fold per section of the reference profile, open when a clause in it did not pass."""
+    """One fold per section of the reference profile, open when a clause in it failed or was
+    inconclusive (:data:`_ATTENTION`)."""
     out = []
     cols = "".join(f'<col class="c-{cls}">' for cls, _ in _COLUMNS)
     head = "".join(f"<th>{title}</th>" for _, title in _COLUMNS)
