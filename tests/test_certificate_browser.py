@@ -6,16 +6,15 @@ Content-Security-Policy meta removed and a script added that writes the
 prints the result. The fold is the page area of a 1280×800 window as the browser reports it
 (``innerHeight``; Chromium leaves room for its toolbar in ``--dump-dom`` mode, so it may be less
 than 800). A screenshot at the same size is taken too and its PNG size checked. The module is
-skipped when ``/usr/bin/chromium`` is not installed.
+skipped, with a line naming the Debian package, where Chromium is not installed
+(:mod:`tests.browser`).
 """
 
 from __future__ import annotations
 
 import json
-import re
 import shutil
 import struct
-import subprocess
 from pathlib import Path
 
 import pytest
@@ -26,31 +25,19 @@ from helmcheck.reports.identity import Declared
 from helmcheck.reports.render import render_all
 from helmcheck.reports.results import load_results
 from helmcheck.reports.signing import generate_keypair, load_signing_key
+from tests.browser import chromium, measure, needs_chromium
 
-CHROMIUM = Path("/usr/bin/chromium")
 FIXTURES = Path(__file__).parent / "fixtures" / "reports"
 WIDTH, HEIGHT = 1280, 800
 PARTS = ("verdict", "scope", "identity", "signature", "digest")
 
-pytestmark = pytest.mark.skipif(not CHROMIUM.exists(), reason="chromium is not installed at /usr/bin/chromium")
+pytestmark = needs_chromium
 
-_MEASURE = """<pre id="rects"></pre><script>
-const out = {viewport: [window.innerWidth, window.innerHeight]};
+_MEASURE = """out.viewport = [window.innerWidth, window.innerHeight];
 for (const id of %s) {
   const el = document.getElementById(id);
   if (el) { const r = el.getBoundingClientRect(); out[id] = [r.left, r.top, r.right, r.bottom]; }
-}
-document.getElementById("rects").textContent = JSON.stringify(out);
-</script></body>"""
-
-
-def _chromium(tmp_path: Path, *args: str) -> subprocess.CompletedProcess:
-    return subprocess.run(
-        [str(CHROMIUM), "--headless", "--no-sandbox", "--disable-gpu", "--no-first-run",
-         "--disable-background-networking", "--disable-component-update", "--disable-sync",
-         f"--user-data-dir={tmp_path / 'chromium-profile'}", f"--window-size={WIDTH},{HEIGHT}",
-         "--hide-scrollbars", *args],
-        capture_output=True, text=True, timeout=90)
+}"""
 
 
 def _run_dir(tmp_path: Path, name: str, declared: Declared, signed: bool) -> Path:
@@ -67,15 +54,7 @@ def _run_dir(tmp_path: Path, name: str, declared: Declared, signed: bool) -> Pat
 
 
 def _measure(tmp_path: Path, report: Path) -> dict:
-    html = report.read_text(encoding="utf-8")
-    html = re.sub(r'<meta http-equiv="Content-Security-Policy"[^>]*>', "", html)
-    page = report.with_name("measure.html")
-    page.write_text(html.replace("</body>", _MEASURE % json.dumps(PARTS)), encoding="utf-8")
-    proc = _chromium(tmp_path, "--dump-dom", page.as_uri())
-    assert proc.returncode == 0, proc.stderr[-2000:]
-    m = re.search(r'<pre id="rects">(.*?)</pre>', proc.stdout, re.S)
-    assert m and m.group(1), proc.stdout[-2000:]
-    return json.loads(m.group(1).replace("&quot;", '"'))
+    return measure(report, _MEASURE % json.dumps(PARTS), WIDTH, HEIGHT, "--hide-scrollbars")
 
 
 @pytest.mark.unverifiable  # hand-made results fixtures, not runs
@@ -101,7 +80,8 @@ def test_verdict_scope_and_identity_are_above_the_fold(tmp_path, name, declared,
 def test_screenshot_is_taken_at_the_viewport_size(tmp_path):
     d = _run_dir(tmp_path, "pass_run", Declared(operator="J. Doe"), True)
     shot = tmp_path / "certificate.png"
-    proc = _chromium(tmp_path, f"--screenshot={shot}", (d / "report.html").as_uri())
+    proc = chromium(tmp_path / "chromium-profile", WIDTH, HEIGHT, "--hide-scrollbars", f"--screenshot={shot}",
+                    (d / "report.html").as_uri())
     assert proc.returncode == 0 and shot.exists(), proc.stderr[-2000:]
     head = shot.read_bytes()[:24]
     assert head[:8] == b"\x89PNG\r\n\x1a\n"

@@ -14,6 +14,7 @@ import pytest
 from helmcheck.reports.digest import digest_dir
 from helmcheck.reports.render import render_all
 from helmcheck.reports.results import finish, write_results_atomic
+from tests.browser import CHROMIUM, needs_chromium
 
 FIXTURES = Path(__file__).parent / "fixtures" / "reports"
 HOSTILE = "<script>alert(1)</script>"
@@ -233,10 +234,7 @@ def test_same_directory_renders_the_same_bytes(tmp_path):
     assert (d / "report.html").read_text(encoding="utf-8") == raw
 
 
-CHROMIUM = next((p for p in ("/usr/bin/chromium", shutil.which("chromium") or "") if p and Path(p).exists()), None)
-
-
-@pytest.mark.skipif(CHROMIUM is None, reason="chromium is not installed")
+@needs_chromium
 def test_a_real_browser_sees_every_clause_and_no_script(tmp_path):
     d, _, _, doc = render(tmp_path, "fail_run")
     proc = subprocess.run(

@@ -18,8 +18,9 @@ observation of one clause:
 
 The one combining rule (TTCN-3, "first fail wins"): ``fail``/``non-strict`` > ``inconclusive`` >
 ``pass`` > ``not-tested``. The reason shown is the first one at the winning level, with the
-counts; evidence is bounded (:data:`MAX_EVIDENCE` excerpts, :data:`MAX_LINES` offending log line
-numbers per clause), so a ledger stays small whatever the length of the run.
+counts; evidence is bounded (:data:`MAX_EVIDENCE` excerpts, :data:`MAX_LINES` distinct offending
+log line numbers per clause, in the order first met), so a ledger stays small whatever the length
+of the run.
 """
 
 from __future__ import annotations
@@ -130,7 +131,7 @@ class Ledger:
         if not lv.reason and reason:
             lv.reason = reason() if callable(reason) else reason
         ev = list(evidence)
-        if ev and len(lv.lines) < MAX_LINES and ev[-1].lineno:
+        if ev and len(lv.lines) < MAX_LINES and ev[-1].lineno and ev[-1].lineno not in lv.lines:
             lv.lines.append(ev[-1].lineno)  # evidence runs in time order: the last line is the offending one
         if not lv.evidence and ev:
             lv.evidence = ev[:MAX_EVIDENCE]
@@ -286,14 +287,14 @@ class Ledger:
         if lv[FAIL].count:
             f = lv[FAIL]
             verdict = FAIL if level == "MUST" else NON_STRICT
-            reason = (f"{f.count} violation(s) in {judged} observation(s){_where(f.lines, f.count)}; "
+            reason = (f"{f.count} violation(s) in {judged} observation(s){_where(f.lines)}; "
                       f"first: {f.reason}")
             out = ClauseVerdict(cid, verdict, reason, level, cases, tuple(f.evidence), tuple(f.lines),
                                 f.count, judged)
         elif lv[INCONCLUSIVE].count:
             i = lv[INCONCLUSIVE]
             reason = (f"{i.count} of {judged} observation(s) could not be judged"
-                      f"{_where(i.lines, i.count)}: {i.reason}")
+                      f"{_where(i.lines)}: {i.reason}")
             out = ClauseVerdict(cid, INCONCLUSIVE, reason, level, cases, tuple(i.evidence),
                                 tuple(i.lines), 0, judged)
         elif lv[PASS].count:
@@ -324,12 +325,15 @@ class Ledger:
         return [v.as_entry() for v in self.verdicts()]
 
 
-def _where(lines: list[int], n: int) -> str:
+def _where(lines: list[int]) -> str:
+    """`` (wire-log lines 12, 40 and 3 more)``: the distinct offending lines kept, the first ten
+    named (several findings on one line name it once; past :data:`MAX_LINES` none are kept)."""
     if not lines:
         return ""
     shown = ", ".join(map(str, lines[:10]))
-    more = f" and {n - min(len(lines), 10)} more" if n > min(len(lines), 10) else ""
-    return f" (wire-log line {shown}{more})"
+    rest = len(lines) - 10
+    more = "" if rest <= 0 else f" and {'at least ' if len(lines) >= MAX_LINES else ''}{rest} more"
+    return f" (wire-log line{'s' if len(lines) > 1 else ''} {shown}{more})"
 
 
 def combine(verdicts: Iterable[str]) -> Optional[str]:

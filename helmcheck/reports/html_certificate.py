@@ -1,5 +1,6 @@
 """The HTML report's first page, the certificate: verdict banner and scope, what was tested, the
-digest and the signature, clause counts.
+digest and the signature, when and how the run ran (with the exploration's model coverage and
+what it means for the verdict), clause counts.
 """
 
 from __future__ import annotations
@@ -7,10 +8,11 @@ from __future__ import annotations
 from typing import Mapping
 
 from ..judge.verdict import Verdict
-from .html_markup import _e, _section
+from .html_coverage import exploration_coverage
+from .html_markup import _e
 from .identity import identity_rows
 from .rundir import Run
-from .scope import scope_of
+from .scope import model_coverage_note, scope_of
 from .view import VERDICT_LABEL, counts
 
 
@@ -62,6 +64,22 @@ def _seal(run: Run) -> str:
     return f'<div class="seal"><h2>Digest and signature</h2>{signed}{_digest(run, "digest")}</div>'
 
 
+def _run_box(run: Run) -> str:
+    """When and how the run ran, on one line; a vehicle run's model coverage with its note."""
+    r = run.results
+    settings = r.get("settings") or {}
+    facts = [f"started {r['started']}",
+             "" if r["duration_s"] is None else f"{r['duration_s']:.1f} s",
+             "" if settings.get("time_scale") is None else f"time scale {settings['time_scale']:g}",
+             "" if r["seed"] is None else f"seed {r['seed']}",
+             "" if not (r.get("profile") or {}).get("name") else f"profile {r['profile']['name']}"]
+    cov = exploration_coverage(run).get("rows")
+    note = (f'<p class="note" id="coverage-beside">Exploration: model rows {_e(cov.get("covered"))} of '
+            f'{_e(cov.get("of"))} ({_e(cov.get("percent"))} %). {_e(model_coverage_note(r))}</p>' if cov else "")
+    return (f'<div class="when"><h2>Run</h2><p id="run-summary">{_e(" · ".join(f for f in facts if f))}</p>'
+            f"{note}</div>")
+
+
 def _certificate_page(run: Run) -> str:
     """Everything that belongs on the first page: verdict, scope, identity, digest, signature."""
     r = run.results
@@ -73,8 +91,9 @@ def _certificate_page(run: Run) -> str:
         '<div id="certificate-page">',
         f"<h1>{_e(heading)}</h1>",
         _banner(run),
-        f'<div class="cert" id="certificate">{_identity_table(run)}{_seal(run)}</div>',
-        _section("summary", "Summary", _counts(run)),
+        f'<div class="cert" id="certificate"><div class="side">{_identity_table(run)}'
+        f'<section id="summary" class="counts-box"><h2>Clauses</h2>{_counts(run)}</section></div>'
+        f'<div class="side">{_seal(run)}{_run_box(run)}</div></div>',
         "</div>",
     ])
 

@@ -1,14 +1,18 @@
 """The HTML report's model coverage (modes, transitions, interrupt pairs; the exploration's own
 coverage of the model's rows, interrupt pairs, timer boundaries and error codes, with what stayed
-uncovered) and the event summary and event table that go with the mode timeline.
+uncovered, listed in natural order: row 2 before row 10) beside the sentence saying what model
+coverage means for the verdict (:func:`~helmcheck.reports.scope.model_coverage_note`), and the
+event summary and event table that go with the mode timeline.
 """
 
 from __future__ import annotations
 
+import re
 from typing import Any, Mapping
 
 from .html_markup import _e
 from .rundir import Run
+from .scope import model_coverage_note
 from .timeline import MODE_ORDER, event_counts
 
 _REMOTE_MODES = ("A", "M", "mP", "W")
@@ -22,20 +26,24 @@ def _coverage(run: Run) -> str:
     out = [f'<h3>Modes reached ({len(reached & set(modes))} of {len(modes)})</h3><p id="modes">{chips}</p>']
     out.append(f'<h3>Transitions exercised ({len(cov["transitions"])})</h3>')
     if cov["transitions"]:
-        rows = "".join(f"<tr><td>{_e(a)}</td><td>{_e(b)}</td><td><code>{_e(via)}</code></td></tr>"
-                       for a, b, via in cov["transitions"])
-        out.append(f'<table class="transitions"><thead><tr><th>From</th><th>To</th><th>Via</th></tr></thead>'
-                   f"<tbody>{rows}</tbody></table>")
+        items = "".join(f'<li><b>{_e(a)}</b> → <b>{_e(b)}</b> <span class="muted">via</span> <code>{_e(via)}</code></li>'
+                        for a, b, via in cov["transitions"])
+        out.append(f'<ul class="transitions">{items}</ul>')
     else:
         out.append('<p class="muted">none recorded</p>')
     pairs = {tuple(p) for p in cov["interrupt_pairs"]}
-    axis = list(_REMOTE_MODES) + sorted({m for p in pairs for m in p} - set(_REMOTE_MODES))
+    # Rows: the active control modes. Columns: what interrupted them — modes (a square matrix)
+    # or, as a vehicle run records them, the interrupting commands.
+    actives = list(_REMOTE_MODES) + sorted({p[0] for p in pairs} - set(_REMOTE_MODES))
+    news = {p[1] for p in pairs}
+    others = sorted(news - set(_REMOTE_MODES))
+    cols = [m for m in _REMOTE_MODES if m in news or not others] + others
     out.append(f"<h3>Interrupt pairs exercised ({len(pairs)}) — RH-INT-1</h3>")
-    head = "".join(f"<th>{_e(m)}</th>" for m in axis)
+    head = "".join(f"<th>{_e(m)}</th>" for m in cols)
     body = []
-    for active in axis:
+    for active in actives:
         cells = []
-        for new in axis:
+        for new in cols:
             hit = (active, new) in pairs
             cls = "hit" if hit else ("self" if active == new else "")
             cells.append(f'<td class="{cls}">{"✓" if hit else ""}</td>')
@@ -46,23 +54,50 @@ def _coverage(run: Run) -> str:
     return "\n".join(out)
 
 
+def natural_key(text: object) -> tuple:
+    """Sort key that orders the numbers inside a text by value: ``row 2`` before ``row 10``."""
+    return tuple((0, int(part), "") if part.isdigit() else (1, 0, part)
+                 for part in re.split(r"(\d+)", str(text)) if part)
+
+
+def exploration_coverage(run: Run) -> dict[str, Mapping[str, Any]]:
+    """``stats.explore.model_coverage`` of a vehicle run (empty when the run recorded none)."""
+    mc = ((run.results.get("stats") or {}).get("explore") or {}).get("model_coverage")
+    if not isinstance(mc, dict):
+        return {}
+    return {name: d for name, d in mc.items() if isinstance(d, dict)}
+
+
 def _exploration_coverage(run: Run) -> str:
     """The exploration's model coverage (``stats.explore.model_coverage``), beside the clauses."""
-    mc = ((run.results.get("stats") or {}).get("explore") or {}).get("model_coverage")
-    if not isinstance(mc, dict) or not mc:
+    mc = exploration_coverage(run)
+    if not mc:
         return ""
     rows = []
     for name, d in mc.items():
-        if not isinstance(d, dict):
-            continue
-        missing = d.get("uncovered") or []
-        more = (f"<details><summary>{len(missing)} uncovered</summary><ul>"
+        missing = sorted((str(x) for x in d.get("uncovered") or []), key=natural_key)
+        more = (f'<details><summary>{len(missing)} uncovered</summary><ul class="uncovered">'
                 + "".join(f"<li><code>{_e(x)}</code></li>" for x in missing) + "</ul></details>") if missing else "—"
         rows.append(f"<tr><td>{_e(name.replace('_', ' '))}</td><td>{_e(d.get('covered'))} of {_e(d.get('of'))}"
                     f" ({_e(d.get('percent'))} %)</td><td>{more}</td></tr>")
     return ('<h3 id="exploration-coverage">What the exploration reached of the model</h3>'
+            f'<p class="note" id="model-coverage-note">{_e(model_coverage_note(run.results))}</p>'
             '<table class="exploration-coverage"><thead><tr><th>dimension</th><th>covered</th>'
             f"<th>uncovered</th></tr></thead><tbody>{''.join(rows)}</tbody></table>")
+
+
+def _coverage_gist(run: Run) -> str:
+    """One line for the folded coverage section: modes, transitions, pairs, the exploration's rows."""
+    cov = run.results["coverage"]
+    reached = set(cov["modes"])
+    modes = set(MODE_ORDER) | reached
+    parts = [f"{len(reached)} of {len(modes)} modes", f"{len(cov['transitions'])} transitions",
+             f"{len({tuple(p) for p in cov['interrupt_pairs']})} interrupt pairs"]
+    rows = exploration_coverage(run).get("rows")
+    if rows:
+        parts.append(f"exploration: model rows {rows.get('covered')} of {rows.get('of')} "
+                     f"({rows.get('percent')} %), not part of the verdict")
+    return _e(" · ".join(parts))
 
 
 def _events_table(run: Run) -> str:
@@ -72,7 +107,7 @@ def _events_table(run: Run) -> str:
     rows = "".join(f'<tr><td class="mono">{ev["t"]:.3f}</td><td>{_e(_kind(ev))}</td>'
                    f'<td class="mono">{_e(ev["label"])}</td></tr>' for ev in events[:2000])
     more = f'<p class="muted">… {len(events) - 2000} more events in results.json</p>' if len(events) > 2000 else ""
-    return (f"<details><summary>Events ({len(events)})</summary><table><thead><tr><th>t (s)</th>"
+    return (f'<details class="events"><summary>Events ({len(events)}; not printed)</summary><table><thead><tr><th>t (s)</th>'
             f"<th>kind</th><th>label</th></tr></thead><tbody>{rows}</tbody></table>{more}</details>")
 
 

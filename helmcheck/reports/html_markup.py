@@ -1,5 +1,6 @@
 """Markup helpers for the HTML report: escaping, profile Markdown to HTML, key/value tables,
-verdict cells and the section wrapper.
+verdict cells, and the two section wrappers: a plain section and a fold (a ``<details>`` whose
+summary line carries the title and a one-line digest of what is inside).
 """
 
 from __future__ import annotations
@@ -19,20 +20,22 @@ def _e(value: object) -> str:
 
 
 def md_inline(markdown: str) -> str:
-    """Profile Markdown (``code``, **bold**, *italic*) to escaped HTML."""
+    """Profile Markdown (``code``, **bold**, *italic*) to escaped HTML; emphasis may hold code."""
     parts = markdown.split("`")
+    codes: list[str] = []
     out = []
     for i, part in enumerate(parts):
         if i % 2 and i < len(parts) - 1:
-            out.append(f"<code>{_e(part)}</code>")
+            codes.append(f"<code>{_e(part)}</code>")
+            out.append(f"\x00{len(codes) - 1}\x00")  # escaped text never holds NUL (printable())
             continue
         if i % 2:  # an unmatched backtick: keep it literally
             part = "`" + part
-        text = _e(part)
-        text = re.sub(r"\*\*(.+?)\*\*", r"<strong>\1</strong>", text)
-        text = re.sub(r"(?<![\w*])\*(?!\s)(.+?)(?<!\s)\*(?![\w*])", r"<em>\1</em>", text)
-        out.append(text)
-    return "".join(out)
+        out.append(_e(part))
+    text = "".join(out)
+    text = re.sub(r"\*\*(.+?)\*\*", r"<strong>\1</strong>", text)
+    text = re.sub(r"(?<![\w*])\*(?!\s)(.+?)(?<!\s)\*(?![\w*])", r"<em>\1</em>", text)
+    return re.sub("\x00(\\d+)\x00", lambda m: codes[int(m.group(1))], text)
 
 
 def _kv_table(rows: Iterable[tuple[str, Any]], cls: str = "kv") -> str:
@@ -70,3 +73,13 @@ def _verdict_cell(verdict: str) -> str:
 
 def _section(anchor: str, title: str, body: str) -> str:
     return f'<section id="{anchor}">\n<h2>{_e(title)}</h2>\n{body}\n</section>'
+
+
+def _fold(anchor: str, title: str, body: str, gist: str = "", open_: bool = False) -> str:
+    """A section folded behind its title (open when *open_*): *gist* (escaped HTML) is shown
+    beside the title while it is folded, so a reader knows what is inside without opening it.
+    A link into a folded section opens it (browsers expand a ``<details>`` holding the target)."""
+    gist_html = f' <span class="gist">{gist}</span>' if gist else ""
+    return (f'<details class="fold" id="{anchor}"{" open" if open_ else ""}>\n'
+            f'<summary><h2>{_e(title)}</h2>{gist_html}</summary>\n'
+            f'<div class="fold-body">\n{body}\n</div>\n</details>')

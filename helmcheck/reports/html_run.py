@@ -74,6 +74,14 @@ def _process(run: Run) -> str:
     return "\n".join(out)
 
 
+def restore_headline(rec: Mapping) -> str:
+    """The restore in one sentence (the section's first line, and its gist while folded)."""
+    ok = bool(rec.get("verified"))
+    return ("Every setting the run changed was written back and read again as found; the vehicle "
+            "was stopped." if ok and rec.get("attempted") else
+            "Nothing needed restoring." if ok else "The vehicle was NOT verified as restored.")
+
+
 def _restore(run: Run) -> str:
     """The vehicle left as found: each setting before and after, the mode, what to do by hand."""
     rec = run.results.get("restore")
@@ -82,11 +90,10 @@ def _restore(run: Run) -> str:
     ok = bool(rec.get("verified"))
     found = rec.get("found") or {}
     left = rec.get("left") or {}
-    head = ("Every setting the run changed was written back and read again as found; the vehicle "
-            "was stopped." if ok and rec.get("attempted") else
-            "Nothing needed restoring." if ok else "The vehicle was NOT verified as restored.")
+    head = restore_headline(rec)
     out = [f'<div class="finding {"v-pass" if ok else "v-fail"}" id="restore-status"><p>{_e(head)}</p>']
-    rows = [("found in mode", found.get("mode")), ("found running", found.get("mission")),
+    # The mission is what the first $OSI named (field 12): in S it is loaded, not running.
+    rows = [("found in mode", found.get("mode")), ("mission named in its first $OSI", found.get("mission")),
             ("left in mode", left.get("mode")), ("note", left.get("note"))]
     out.append(_kv_table([(k, v) for k, v in rows if v is not None]))
     settings = rec.get("settings") or []

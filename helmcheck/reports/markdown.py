@@ -3,10 +3,11 @@
 A headline that leads with the scope ("PASS — partial: 4 of 60 claimed clauses judged; not a
 certificate", :func:`helmcheck.reports.scope.headline`) and why clauses were not judged, a
 PARTIAL warning if the run was interrupted, what was tested (identity), a counts table, the
-clauses that did not pass with their reasons (worst first), every passing clause with its first
-evidence line, real ACK errors counted apart from the tester's negative tests, and the digest and
-signature. Strings from the results file or the device are escaped for GitHub-flavoured Markdown,
-including the HTML it renders: ``<``, ``>`` and ``&`` become entities and Markdown punctuation is
+exploration's model coverage with what it means for the verdict, the clauses that did not pass
+with their reasons (worst first), every passing clause with its first evidence line, real ACK
+errors counted apart from the tester's negative tests, and the digest and signature. Strings
+from the results file or the device are escaped for GitHub-flavoured Markdown, including the
+HTML it renders: ``<``, ``>`` and ``&`` become entities and Markdown punctuation is
 backslash-escaped.
 """
 
@@ -16,7 +17,7 @@ import re
 
 from .identity import identity_rows
 from .rundir import Run
-from .scope import headline, scope_of
+from .scope import headline, model_coverage_note, scope_of
 from .text import printable
 from .timeline import event_counts
 from .verdicts import describe_process
@@ -118,7 +119,7 @@ def render_markdown(run: Run, comparison_md: str | None = None) -> str:
     if isinstance(mc, dict) and mc:
         out.append("Exploration's model coverage: " + "; ".join(
             f"{md_escape(k.replace('_', ' '))} {d.get('covered')}/{d.get('of')}" for k, d in mc.items()
-            if isinstance(d, dict)) + ".")
+            if isinstance(d, dict)) + ". " + md_escape(model_coverage_note(r)))
         out.append("")
 
     rows = non_pass_rows(r)

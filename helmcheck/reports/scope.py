@@ -18,6 +18,11 @@ A verdict says how the judged clauses went; the scope says how much was judged. 
   (``RH-SAF-1..5 not tested: …``). A run that judged everything and failed is a certificate
   too: a certificate of non-conformance.
 
+**Model coverage is not scope.** What a vehicle run's exploration reached of the reference model
+(``stats.explore.model_coverage``: rows, interrupt pairs, timer boundaries, error codes) measures
+the random search on top of the fixed cases; no verdict and no certificate depends on it. Every
+rendering that shows it says so beside it (:func:`model_coverage_note`).
+
 Nothing here reads files: the scope is a pure function of the results document (its role, its
 clause verdicts, ``partial``), so ``helmcheck verify`` can recompute it from re-judged verdicts
 and the schema validator can check a recorded ``certificate`` flag.
@@ -34,7 +39,7 @@ from helmcheck.clauses import backseat_clauses, catalogue, vehicle_clauses
 from ..judge.verdict import Verdict
 from .view import VERDICT_LABEL
 
-__all__ = ["JUDGED", "Gap", "Scope", "claimed_clauses", "scope_of", "headline", "id_ranges"]
+__all__ = ["JUDGED", "Gap", "Scope", "claimed_clauses", "scope_of", "headline", "id_ranges", "model_coverage_note"]
 
 JUDGED = (Verdict.PASS, Verdict.NON_STRICT, Verdict.FAIL)
 _GAPS_SHOWN = 4
@@ -130,6 +135,18 @@ def headline(results: Mapping[str, Any]) -> str:
     :attr:`Scope.statement`): the first line of every rendering."""
     verdict = results.get("verdict")
     return f"{VERDICT_LABEL.get(verdict, str(verdict).upper())} — {scope_of(results).statement}"
+
+
+def model_coverage_note(results: Mapping[str, Any]) -> str:
+    """The one sentence shown beside the exploration's model coverage: what it means for the
+    verdict (nothing) and what the verdict rests on instead (module docstring)."""
+    scope = scope_of(results)
+    rests = (f"which for this certificate rests on the clause verdicts: each of the {len(scope.claimed)} "
+             "claimed clauses judged on the exchanges that exercised it" if scope.certificate else
+             "which rests on the clause verdicts alone")
+    return ("Model coverage is how much of the reference model the exploration's random sequences "
+            "reached within their budget (the fixed test cases are not counted); it is not part of "
+            f"the verdict, {rests}.")
 
 
 def id_ranges(ids: Iterable[str]) -> str:

@@ -93,7 +93,8 @@ class Custodian:
 
     # ------------------------------------------------------------------ found
     def found(self, osi: Any) -> None:
-        """The first ``$OSI`` of the run: the mode (and mission) the vehicle was found in."""
+        """The first ``$OSI`` of the run: the mode the vehicle was found in and the mission its
+        field 12 names (loaded in ``S``, running otherwise: the record keeps the name as reported)."""
         if self.found_mode is None and osi is not None:
             self.found_mode = osi.mode
             self.found_mission = getattr(osi, "mission_name", None) or None

@@ -56,7 +56,7 @@ def save(run, final: bool = False) -> None:
     r["events"] = list(obs.events)
     modes = sorted({m for _, m in obs.timeline})
     pairs = [list(p) for p in sorted(obs.interrupt_pairs)]
-    steps = [[a, "observed", b] for (_, a), (_, b) in zip(obs.timeline, obs.timeline[1:]) if a != b]
+    steps = [[a, b, "observed"] for (_, a), (_, b) in zip(obs.timeline, obs.timeline[1:]) if a != b]
     r["coverage"] = {"modes": modes, "transitions": [list(x) for x in sorted({tuple(s) for s in steps})],
                      "interrupt_pairs": pairs}
     if obs.last_osi is not None and obs.last_osi.vehicle_name:
