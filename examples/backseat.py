@@ -15,7 +15,9 @@ The loop, for as long as the port is open (Ctrl-C ends it):
    ``--steer`` seconds, sending the next ``$OMS`` after a third of its timeout, so control never
    lapses (RH-BS-6).
 3. Release: send no more ``$OMS``. When the timeout runs out the vehicle hands control back to
-   the mission (RH-SRV-4, RH-INT-2). After ``--release`` seconds, steer again (step 2).
+   the mission (RH-SRV-4, RH-INT-2). After ``--release`` seconds, steer again (step 2). The
+   release lasts well over twice the timeout, so that the next ``$OMS`` takes control anew and
+   does not read as a refresh that came too late (RH-BS-6).
 
 Throughout it asks for the vehicle's state (``$OSD,S``, answered by ``$OSI``) every second:
 at least every 5 s is the rule (RH-BS-8). And it follows the other rules of the reference
@@ -224,8 +226,8 @@ def main(argv: list[str] | None = None, backseat: type[Backseat] = Backseat) -> 
     p.add_argument("--baud", type=int, default=19200)
     p.add_argument("--time-scale", type=float, default=1.0, help="the vehicle's clock runs K times faster")
     p.add_argument("--mission", default="conformance.mis", help="the mission to start, by name")
-    p.add_argument("--steer", type=float, default=8.0, help="seconds of servo control each time")
-    p.add_argument("--release", type=float, default=4.0, help="seconds the mission has the helm between")
+    p.add_argument("--steer", type=float, default=10.0, help="seconds of servo control each time")
+    p.add_argument("--release", type=float, default=10.0, help="seconds the mission has the helm between")
     args = p.parse_args(argv)
     try:
         port = open_port(args.port, args.baud)

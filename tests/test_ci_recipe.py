@@ -1,5 +1,5 @@
 """The CI recipe (README, *Run it in your CI*) and the example workflow
-(``docs/ci/backseat-conformance.yml``) use only options helmcheck and its pytest plugin have.
+(``examples/ci/backseat-conformance.yml``) use only options helmcheck and its pytest plugin have.
 
 Every ``helmcheck …`` and ``pytest …`` command line in them is parsed with the real parsers, so
 a renamed or removed option breaks this test rather than a team's pipeline.
@@ -22,7 +22,7 @@ from helmcheck.commands import matrix_cmd
 from helmcheck.line.launcher import build_argv
 
 ROOT = Path(__file__).resolve().parent.parent
-WORKFLOW = ROOT / "docs" / "ci" / "backseat-conformance.yml"
+WORKFLOW = ROOT / "examples" / "ci" / "backseat-conformance.yml"
 
 
 def _workflow_commands() -> list[str]:
