@@ -4,7 +4,7 @@ package index).
 
 The step ``python -m pip install "$HELMCHECK"`` runs as written, in ``bash``, with the
 workflow's own ``HELMCHECK`` (``helmcheck @ git+URL@REF``) pointed at this checkout's repository
-and commit (``git+file://…@<sha>``): the requirement's form, pip's git checkout and the build
+and commit (``git+file://localhost/…@<sha>``): the requirement's form, pip's git checkout and the build
 are all real. The installed ``helmcheck`` must then start. It downloads nothing new where pip's
 cache holds the dependencies, but takes about a minute (a new environment, an isolated build):
 ``HELMCHECK_INSTALL_TEST=1`` runs it.
@@ -45,7 +45,7 @@ def test_the_install_step_as_written_installs_a_working_helmcheck(tmp_path):
     sha = subprocess.run(["git", "rev-parse", "HEAD"], cwd=ROOT, check=True, capture_output=True,
                          text=True).stdout.strip()
     m = GIT_REQ.search(WORKFLOW.read_text(encoding="utf-8"))
-    requirement = f"{m.group(1)}file://{ROOT}@{sha}"
+    requirement = f"{m.group(1)}file://localhost{ROOT}@{sha}"  # a host: older pips refuse git+file:///
     venv = tmp_path / "venv"
     subprocess.run([sys.executable, "-m", "venv", str(venv)], check=True)
     env = {k: v for k, v in os.environ.items() if not k.startswith(("PYTEST_", "PYTHON"))}
