@@ -64,8 +64,9 @@ def checksum(body: str) -> str:
 
 
 def open_port(url: str, baud: int, wait_s: float = 10.0) -> serial.Serial:
-    """Open the port, retrying for a few seconds (a TCP serial server may not listen yet)."""
-    deadline = time.monotonic() + wait_s
+    """Open the port; a network one (``socket://…``) is retried for a few seconds, as the
+    serial server may not listen yet."""
+    deadline = time.monotonic() + (wait_s if "://" in url else 0.0)
     while True:
         try:
             return serial.serial_for_url(url, baudrate=baud, timeout=0.05)
