@@ -39,8 +39,12 @@ explore-reach: $(STAMP)
 bench: $(STAMP)
 	$(PY) benchmarks/run_all.py
 
+# The generated pages (helmcheck docs), then the site from docs/ into site/ (not tracked), strict:
+# a broken link or anchor fails. Open site/index.html.
 docs: $(STAMP)
 	$(PY) -m helmcheck docs
+	NO_MKDOCS_2_WARNING=1 $(PY) -m mkdocs build --strict --quiet
+	@echo "site: site/index.html"
 
 clean:
-	rm -rf $(VENV) .pytest_cache .hypothesis
+	rm -rf $(VENV) .pytest_cache .hypothesis site

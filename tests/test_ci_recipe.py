@@ -1,5 +1,5 @@
-"""The CI recipe (README, *Run it in your CI*) and the example workflow
-(``docs/ci/backseat-conformance.yml``) use only options helmcheck and its pytest plugin have.
+"""The CI recipe (``docs/guide/ci.md``, and the README's *Run it in CI*) and the example workflow
+(``examples/ci/backseat-conformance.yml``) use only options helmcheck and its pytest plugin have.
 
 Every ``helmcheck …`` and ``pytest …`` command line in them is parsed with the real parsers, so
 a renamed or removed option breaks this test rather than a team's pipeline.
@@ -22,7 +22,7 @@ from helmcheck.commands import matrix_cmd
 from helmcheck.line.launcher import build_argv
 
 ROOT = Path(__file__).resolve().parent.parent
-WORKFLOW = ROOT / "docs" / "ci" / "backseat-conformance.yml"
+WORKFLOW = ROOT / "examples" / "ci" / "backseat-conformance.yml"
 
 
 def _workflow_commands() -> list[str]:
@@ -50,9 +50,9 @@ def _workflow_commands() -> list[str]:
 
 
 def _readme_commands() -> list[str]:
-    text = (ROOT / "README.md").read_text()
-    section = text.split("## Run it in your CI", 1)[1].split("\n## ", 1)[0]
-    blocks = re.findall(r"```sh\n(.*?)```", section, re.S)
+    guide = (ROOT / "docs" / "guide" / "ci.md").read_text()
+    readme = (ROOT / "README.md").read_text().split("### Run it in CI", 1)[1].split("\n### ", 1)[0]
+    blocks = re.findall(r"```sh\n(.*?)```", guide + readme, re.S)
     return [line.strip() for b in blocks for line in b.replace("\\\n", " ").splitlines() if line.strip()]
 
 

@@ -3,7 +3,7 @@ served behind real ptys:
 
 * a failure the exploration found is re-driven after shrinking, from a verified reset, until two
   re-runs count (a re-drive that went another way than recorded and passed does not): 2 of 2 is
-  FAIL, 0 or 1 of 2 is INCONCLUSIVE with the count as the reason (README, "Certify vehicle");
+  FAIL, 0 or 1 of 2 is INCONCLUSIVE with the count as the reason (docs/exploration.md);
 * what hypothesis ends with on a vehicle's failure — also a flaky one, which hypothesis reports as
   ``FlakyFailure`` — is a finding; anything else (a bug in helmcheck) is a tester error, which
   ends the run with exit 2 and its traceback in ``tester-error.txt`` beside ``results.json``.

@@ -6,7 +6,7 @@ conforming counterpart that passes the same clause:
 
 * a command accepted with a field out of its range — whether the grammar (ten hex digits, an
   integer timeout) or the range check finds it — is booked on the clause that sets the range
-  (README, "Error clauses"), not only on RH-ACK-3;
+  (docs/choices.md, "Error clauses"), not only on RH-ACK-3;
 * an ``$OPK`` park that counts down before the vehicle is on station is RH-PK-2's FAIL, judged from
   what each report shows (field 7, the distance; field 10, the park time), even where the mirror
   has lost the vehicle's state; a vehicle that arrived between two reports and drifted a little

@@ -64,6 +64,7 @@ TOP_LEVEL = {
     "profile_toml": "foundation",  # the TOML emitter; imports profile
     "profile_template": "foundation",  # the `profile init` template; imports profile, profile_toml
     "clauses": "foundation",  # the clause catalogue; standard library and the spec package data
+    "reference_docs": "foundation",  # the site's generated reference pages; imports profile*, clauses
     "outputs": "reports",  # report directories and output files; imports failures, reports.atomic
     "demo": "certify",  # `python -m helmcheck.demo`; imports the emulator and the vehicle certifier
     "pytest_plugin": "commands",  # the pytest11 entry point; runs the certifiers through their library entries

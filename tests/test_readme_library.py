@@ -1,4 +1,4 @@
-"""The README's "From Python" example names entries that exist, with the options it uses.
+"""The "From Python" example (``docs/guide/python.md``) names entries that exist, with the options it uses.
 
 The example is not run (it would need a vehicle on /dev/ttyUSB0 and a backseat binary); its
 imports are executed and each ``Options(...)`` call in it is built for real, so a renamed entry
@@ -11,20 +11,19 @@ import ast
 import re
 from pathlib import Path
 
-README = Path(__file__).resolve().parents[1] / "README.md"
+PAGE = Path(__file__).resolve().parents[1] / "docs" / "guide" / "python.md"
 
 
 def _example() -> str:
-    text = README.read_text(encoding="utf-8")
-    section = text.split("### From Python", 1)[1]
-    return re.search(r"```python\n(.*?)```", section, re.S).group(1)
+    text = PAGE.read_text(encoding="utf-8")
+    return re.search(r"```python\n(.*?)```", text, re.S).group(1)
 
 
 def test_the_example_imports_and_builds_its_options(tmp_path):
     tree = ast.parse(_example())
     ns: dict = {}
     imports = [n for n in tree.body if isinstance(n, (ast.Import, ast.ImportFrom))]
-    exec(compile(ast.Module(body=imports, type_ignores=[]), "README", "exec"), ns)
+    exec(compile(ast.Module(body=imports, type_ignores=[]), "python.md", "exec"), ns)
     from helmcheck.profile import DEFAULT
 
     built = 0

@@ -2,16 +2,24 @@
 
 The grammar reference comes from ``remote_helm.lark``, and so do the fast path's tables
 (``helmcheck/grammar/derived.py``, :mod:`helmcheck.grammar.derive`); the model's transition
-table and state diagram come from ``helmcheck/model/transitions.py``. Nothing in ``docs/`` is
-written by hand except ``contracts.md``. Each file is written atomically; one that cannot be written is exit 2
-naming it. ``--check`` exits 1 when a checked-in copy is stale.
+table and state diagram come from ``helmcheck/model/transitions.py``; the documentation site's
+reference pages (every profile key, the clause catalogue, the reference profile:
+``docs/reference/``, :mod:`helmcheck.reference_docs`) from the ``Profile`` dataclass and the
+shipped reference profile; ``examples/emulator.toml`` is what ``helmcheck profile init
+--emulator`` writes. The other pages of ``docs/`` are written by hand. Each file is written
+atomically; one that cannot be written is exit 2 naming it. ``--check`` exits 1 when a
+checked-in copy is stale.
 """
 
 from __future__ import annotations
 
 import argparse
+from pathlib import Path
 
 from .. import exitcodes
+
+#: The emulator's profile written out in full, as ``helmcheck profile init --emulator`` writes it.
+EMULATOR_EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "emulator.toml"
 
 
 def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
@@ -22,22 +30,52 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     return p
 
 
-def run(args: argparse.Namespace) -> int:
-    from ..failures import OutputLost
+def emulator_example() -> str:
+    """The text of ``examples/emulator.toml``: the built-in emulator's profile, every key."""
+    from ..profile_template import render
+    from .profile_cmd import _emulator_values
+
+    return render(_emulator_values(), emulator=True)
+
+
+def targets() -> dict[Path, str]:
+    """Every generated file and its text."""
+    from .. import reference_docs
     from ..grammar import derive
     from ..grammar import docs as grammar_docs
     from ..model import docs as model_docs
+
+    out = {grammar_docs.DOCS_FILE: grammar_docs.render_markdown(), derive.TABLE_FILE: derive.render_table()}
+    out.update({model_docs.DOCS_DIR / name: text for name, text in model_docs.render_all().items()})
+    out.update(reference_docs.render_all())
+    out[EMULATOR_EXAMPLE] = emulator_example()
+    return out
+
+
+def stale() -> list[str]:
+    """The generated files whose checked-in copy differs (paths relative to the checkout)."""
+    root = EMULATOR_EXAMPLE.parents[1]
+    out = []
+    for path, text in targets().items():
+        try:
+            current = path.read_text(encoding="utf-8")
+        except OSError:
+            current = None
+        if current != text:
+            out.append(str(path.relative_to(root)))
+    return out
+
+
+def run(args: argparse.Namespace) -> int:
+    from ..failures import OutputLost
     from ..reports.atomic import write_text_atomic
 
     if args.check:
-        stale = ((["docs/grammar.md"] if grammar_docs.stale() else [])
-                 + (["helmcheck/grammar/derived.py"] if derive.stale() else []) + list(model_docs.stale()))
-        for name in stale:
+        names = stale()
+        for name in names:
             print(f"stale: {name} (run 'helmcheck docs')")
-        return exitcodes.NONCONFORMANT if stale else exitcodes.OK
-    targets = {grammar_docs.DOCS_FILE: grammar_docs.render_markdown(), derive.TABLE_FILE: derive.render_table()}
-    targets.update({model_docs.DOCS_DIR / name: text for name, text in model_docs.render_all().items()})
-    for path, text in targets.items():
+        return exitcodes.NONCONFORMANT if names else exitcodes.OK
+    for path, text in targets().items():
         try:
             path.parent.mkdir(parents=True, exist_ok=True)
             write_text_atomic(path, text)
