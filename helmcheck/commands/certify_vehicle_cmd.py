@@ -140,6 +140,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                       help="with --plan: one JSON object (cases, total_wall_s, total_vehicle_s, assumptions)")
     plan.add_argument("--missions", metavar="DIR",
                       help="with --plan: the vehicle's mission files (default: the emulator's built-in ones)")
+    plan.add_argument("--latency", metavar="SECONDS", type=float,
+                      help="with --plan: how long the vehicle takes to answer a line (default 0.05; the run "
+                           "itself measures it): the durations the cases choose follow from it")
 
 
 def run(args: argparse.Namespace) -> int:  # noqa: C901 - argument checks, then one call
@@ -163,7 +166,7 @@ def run(args: argparse.Namespace) -> int:  # noqa: C901 - argument checks, then 
             raise UsageError(f"--baud must be one of {', '.join(map(str, BAUD_RATES))}")
         profile = profile.replace(baud=args.baud)
     profile = profile.replace(time_scale=float(k))
-    if args.plan or args.json or args.missions is not None:
+    if args.plan or args.json or args.missions is not None or args.latency is not None:
         return _plan(args, profile, k)
     if args.exec_cmd is not None:
         from ..line.launcher import check_command
@@ -304,17 +307,24 @@ def _plan(args: argparse.Namespace, profile, k: float) -> int:
     """``--plan``: the estimate (:mod:`helmcheck.certify.vehicle.plan`) on standard output; no port, no file touched."""
     import json
 
+    from ..certify.vehicle.plan import as_json, estimate, render_text
+    from ..judge.linebudget import ASSUMED_LATENCY_S
+
     if not args.plan:
-        raise UsageError(f"{'--json' if args.json else '--missions'} goes with --plan")
+        given = "--json" if args.json else ("--missions" if args.missions is not None else "--latency")
+        raise UsageError(f"{given} goes with --plan")
+    latency = ASSUMED_LATENCY_S if args.latency is None else args.latency
+    if not 0.0 <= latency <= profile.ack_window_s:
+        raise UsageError(f"--latency {args.latency:g}: a conforming vehicle answers within the ACK window, "
+                         f"0 to {profile.ack_window_s:g} s (RH-ACK-2)")
     select = _selection(args)
     missions = None
     if args.missions is not None:
         missions = Path(args.missions)
         if not missions.is_dir():
             raise UsageError(f"--missions: {args.missions} is not a directory")
-    from ..certify.vehicle.plan import estimate, render_text, as_json
     plan = estimate(profile, k, select=select, examples=args.examples,
-                    hypothesis_profile=_hypothesis_profile(args, k), missions_dir=missions)
+                    hypothesis_profile=_hypothesis_profile(args, k), missions_dir=missions, latency_s=latency)
     if args.json:
         print(json.dumps(as_json(plan), indent=1))
     else:

@@ -17,8 +17,13 @@ A profile whose safety violations an operator raises (``violation_trigger = "ope
 planned with someone at the terminal who trips the sensor :data:`OPERATOR_REACTION_S` after
 being told.
 
-The estimate assumes the vehicle behaves like the reference model: a vehicle that answers more
-slowly, runs a longer mission or surfaces more slowly takes longer. It uses the profile's
+The estimate assumes the vehicle behaves like the reference model and answers each line
+``latency_s`` after its last byte (``--latency``, default :data:`~helmcheck.judge.linebudget.ASSUMED_LATENCY_S`):
+a vehicle that answers more slowly, runs a longer mission or surfaces more slowly takes longer.
+The line budget the run measures at its link check is here that assumption
+(:mod:`helmcheck.judge.linebudget`): the durations the cases choose follow from it, and a case no
+allowed duration lets the observer time on that line at that time scale is "not run", with the
+time scale or baud that would let it run. It uses the profile's
 missions from ``--missions DIR`` when given, else the emulator's built-in ones; a profile mission
 found in neither is stood in for by the built-in mission of the same role, and the plan says so.
 
@@ -45,8 +50,9 @@ from .flow import LinkLost
 from .interpreter import OPERATOR_WAIT_S, run_case
 from .link import TesterLink
 from .restore import Custodian, written_settings
+from ...judge.linebudget import ASSUMED_LATENCY_S
 from .session import Session, frame
-from .virtual import VEHICLE_DELAY_S, VirtualLine
+from .virtual import VirtualLine
 
 __all__ = ["Plan", "PlanLine", "estimate", "render_text", "as_json", "PlanError", "OPERATOR_REACTION_S"]
 
@@ -95,6 +101,9 @@ class Plan:
     lines: list[PlanLine] = field(default_factory=list)
     missions: dict = field(default_factory=dict)
     assumptions: list[str] = field(default_factory=list)
+    latency_s: float = ASSUMED_LATENCY_S
+    line: dict = field(default_factory=dict)  #: the line budget (``LineBudget.as_dict``)
+    durations: dict = field(default_factory=dict)  #: the durations chosen from it (``Durations.context``)
 
     @property
     def total_wall_s(self) -> float:
@@ -143,7 +152,7 @@ class _PlanCatalog:
 
 def estimate(profile: Profile, time_scale: float, *, select: Optional[list] = None,
              examples: Optional[int] = None, hypothesis_profile: str = "fast",
-             missions_dir: Optional[Path] = None) -> Plan:
+             missions_dir: Optional[Path] = None, latency_s: float = ASSUMED_LATENCY_S) -> Plan:
     """Time the run's phases at ``time_scale`` (module docstring): the link check, the selected
     cases, the exploration's budget and the restore, in the runner's order."""
     from ...emulator.core import EmulatorCore
@@ -152,7 +161,7 @@ def estimate(profile: Profile, time_scale: float, *, select: Optional[list] = No
     profile = profile.replace(time_scale=k)
     catalog = _PlanCatalog(profile, missions_dir)
     core = EmulatorCore(profile, catalog, start=0.0, time_scale=k, baud=profile.baud)
-    line = VirtualLine(core, profile.baud)
+    line = VirtualLine(core, profile.baud, vehicle_delay_s=latency_s)
     ledger = Ledger([c.id for c in vehicle_clauses()])
     observer = VehicleObserver(profile, ledger, time_scale=k, baud=profile.baud)
     recorder = Recorder(None, [], [observer])
@@ -164,7 +173,7 @@ def estimate(profile: Profile, time_scale: float, *, select: Optional[list] = No
     if profile.trigger == "operator":
         session.operator = _operator(line, core)
     plan = Plan(profile=profile.name, protocol=profile.protocol, time_scale=k, baud=profile.baud,
-                select=list(select or []))
+                select=list(select or []), latency_s=latency_s)
 
     def timed(fn) -> tuple[float, float]:
         t0, w0 = link.now(), session.forced_wait
@@ -173,8 +182,11 @@ def estimate(profile: Profile, time_scale: float, *, select: Optional[list] = No
 
     try:
         wall, _ = timed(lambda: _link_check(session, custodian))
-        plan.lines.append(PlanLine("link", "setup", "check that the vehicle answers ($OSD,S)", wall,
-                                   round(wall * k, 3)))
+        plan.lines.append(PlanLine("link", "setup", "check that the vehicle answers ($OSD,S), measure the line",
+                                   wall, round(wall * k, 3)))
+        durations = session.durations()
+        plan.line = durations.budget.as_dict()
+        plan.durations = durations.context()
         for case in cases:
             got: list = []
             wall, wait = timed(lambda: got.append(run_case(session, case)))
@@ -229,6 +241,7 @@ def _link_check(session: Session, custodian: Custodian) -> None:
                 if obs.last_osi is not None and obs.last_osi.mode == "S":
                     with session.not_stopping():
                         custodian.survey(session)
+                session.measure_line(host=False)
                 return
     raise PlanError("the reference vehicle did not answer $OSD,S in the virtual run")
 
@@ -253,7 +266,8 @@ def _assumptions(plan: Plan, profile: Profile, catalog: _PlanCatalog, missions_d
            "these times come from: the cases were run on it in virtual time; a vehicle slower to answer, "
            "with longer missions or slower to surface takes longer",
            f"the line: {plan.baud} baud 8N1 both ways (every byte's transmit time), the vehicle acting "
-           f"{VEHICLE_DELAY_S * 1000:g} ms after a line's last byte; the tester's own computing time is not "
+           f"{plan.latency_s * 1000:g} ms after a line's last byte (--latency; the run measures it at its link "
+           f"check and chooses its durations from what it measures); the tester's own computing time is not "
            f"counted"]
     if missions_dir is not None:
         out.append(f"the missions: {missions_dir} (--missions), then the emulator's built-in ones")
@@ -311,8 +325,13 @@ def render_text(plan: Plan) -> str:
         out.append(f"Of the {timed_wall:.1f} s besides the exploration, {plan.wait_s:.1f} s wait out protocol "
                    f"durations (they shrink as --time-scale grows); the rest is exchanges, line time and ACK "
                    f"windows (they do not).")
+    if plan.line:
+        d = plan.durations
+        out.append(f"Line: {plan.line['describe']}.")
+        out.append(f"  Durations chosen on it: timeouts {d['to']} s (restarted: {d['to_restart']} s, long: "
+                   f"{d['to_long']} s), $OPK {d['opk_min']} min, park on a queued waypoint {d['qpark']} s.")
     for reason, ids in not_run.items():
-        out.append(f"Not run (the profile does not let them): {', '.join(ids)}: {reason}")
+        out.append(f"Not run (the profile or the line does not let them): {', '.join(ids)}: {reason}")
     for x in plan.lines:
         if x.outcome == "stopped":
             out.append(f"{x.id}: {x.note}")
@@ -328,5 +347,6 @@ def as_json(plan: Plan) -> dict:
             "cases": [x.as_dict() for x in plan.lines],
             "total_wall_s": plan.total_wall_s, "total_vehicle_s": plan.total_vehicle_s,
             "protocol_wait_s": plan.wait_s,
-            "line": {"baud": plan.baud, "bits_per_byte": BITS_PER_BYTE, "vehicle_delay_s": VEHICLE_DELAY_S},
+            "line": {"baud": plan.baud, "bits_per_byte": BITS_PER_BYTE, "vehicle_delay_s": plan.latency_s,
+                     "budget": plan.line, "durations": plan.durations},
             "missions": plan.missions, "assumptions": plan.assumptions}

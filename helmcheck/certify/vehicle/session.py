@@ -90,10 +90,12 @@ class Session:
         self._durations: Optional[Durations] = None
 
     # ================================================================ the line budget
-    def measure_line(self) -> None:
-        """The link check's measurement (:mod:`.linemeter`): the host's jitter, then
-        :data:`~.linemeter.LINK_PROBES` ``$OSD,S`` round trips; writes the ``line budget:`` note."""
-        self.meter.measure_host()
+    def measure_line(self, host: bool = True) -> None:
+        """The link check's measurement (:mod:`.linemeter`): the host's jitter (not on a line in
+        virtual time: ``host`` false), then :data:`~.linemeter.LINK_PROBES` ``$OSD,S`` round trips;
+        writes the ``line budget:`` note."""
+        if host:
+            self.meter.measure_host()
         body = "OSD,S" if "S" in self.profile.osd_letters else "OSD"  # no letters: ACK alone (RH-RD-7)
         with self.not_stopping():  # what the judge finds in them is booked; the run goes on
             for _ in range(LINK_PROBES):
@@ -115,8 +117,9 @@ class Session:
         if sent.ack is not None and sent.t_ack is not None and not sent.branched:
             replies = self.obs.vbytes - sent.vbytes0
             self.meter.sample(sent.t, len(sent.raw), sent.t_ack, replies)
-            if sent.osi is not None:
-                self.meter.saw_osi(replies - 15)
+            for _, cls, evd in sent.data:
+                if cls == "OSI":
+                    self.meter.saw_osi(len(evd.text) + 2)
 
     # ================================================================ helpers
     def now(self) -> float:
