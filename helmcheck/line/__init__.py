@@ -8,6 +8,9 @@
 * :mod:`.pty_link`, :mod:`.serial_link`, :mod:`.tcp_link` — the pseudo-terminal, the serial
   device (pyserial) and the TCP client and server links;
 * :mod:`.pacer` — :class:`~helmcheck.line.pacer.LinePacer`, a UART's capacity at a baud rate;
+* :mod:`.relay` — :class:`~helmcheck.line.relay.Relay`, the I/O thread between two links that
+  reads both with one clock and forwards every byte in line (``helmcheck monitor --between``) or
+  only reads (``--tap``);
 * :mod:`.recorder` — every event of a live run to the wire log (by the one wire-log writer,
   :mod:`helmcheck.grammar.wirelog`) and to the judges, identically;
 * :mod:`.launcher` — start, watch and stop the implementation under test (``--exec CMD``);

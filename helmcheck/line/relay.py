@@ -1,7 +1,8 @@
-"""The monitor's I/O core (:class:`Relay`): one thread that reads both sides of a live line with
-one clock, forwards every byte in line, and hands a copy of each chunk on.
+"""The relay between two links (:class:`Relay`): one thread that reads both sides of a live line
+with one clock, forwards every byte in line, and hands a copy of each chunk on. It is the I/O
+core of ``helmcheck monitor``.
 
-It owns the bytes on the wire while ``helmcheck monitor`` runs, and nothing above them: no
+It owns the bytes on the wire while it runs, and nothing above them: no
 framing, no judging, no log format (the callback does that). Two modes:
 
 * **in line** (``forward=True``, ``--between``): every chunk read from one side is written to
@@ -45,7 +46,7 @@ import time
 from typing import Callable, Optional
 
 from ..grammar.wirelog import FROM_VEHICLE, TO_VEHICLE
-from ..line.link import Link, LinkClosed
+from .link import Link, LinkClosed
 
 __all__ = ["Relay", "SIDES"]
 
