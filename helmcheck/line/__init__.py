@@ -11,6 +11,12 @@
 * :mod:`.relay` — :class:`~helmcheck.line.relay.Relay`, the I/O thread between two links that
   reads both with one clock and forwards every byte in line (``helmcheck monitor --between``) or
   only reads (``--tap``);
+* the line-fault relay, which spoils the line on purpose: :mod:`.impair_spec` (the ``--impair``
+  text read into settings), :mod:`.impair` (the sans-IO schedule: what comes out when, and the
+  notes), :mod:`.uart` (a bit stream re-sampled by a receiver at another baud),
+  :mod:`.relaylog` (its wire log), :mod:`.faultrelay` (the ports, links and cuts around a
+  :class:`~.relay.Relay` with the schedule as its stage: ``helmcheck relay``) and
+  :mod:`.faultline` (:func:`~.faultline.impaired_line`, a vehicle behind a bad line for a test);
 * :mod:`.recorder` — every event of a live run to the wire log (by the one wire-log writer,
   :mod:`helmcheck.grammar.wirelog`) and to the judges, identically;
 * :mod:`.launcher` — start, watch and stop the implementation under test (``--exec CMD``);
