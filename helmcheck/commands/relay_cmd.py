@@ -26,7 +26,7 @@ import math
 import sys
 import time
 
-from ..failures import LinkFault, OutputLost, PathError, UsageError
+from ..failures import LinkFault, OutputLost, PathError, UsageError, describe_interrupt
 
 DESCRIPTION = ("Relay every byte between two ports through a line that fails the way real ones do — paced at a "
                "baud rate, bits flipped, bytes lost, noise, late lines, a stall, a cable pulled out and pushed "
@@ -128,13 +128,14 @@ def run(args: argparse.Namespace) -> int:
     print(f"helmcheck relay: backseat {relay.port_of('backseat')}, vehicle {relay.port_of('vehicle')}; impair "
           f"{faults.text or '(none)'!r}, seed {faults.seed}"
           + (f"; wire log {args.wire_log}" if args.wire_log else ""), file=sys.stderr, flush=True)
-    ended = ""
+    ended = "the relay ended"
     try:
         ended = _wait(relay, args.duration)
-    except KeyboardInterrupt:
-        ended = "stopped"
+    except KeyboardInterrupt as e:
+        ended = describe_interrupt(e)
     finally:
-        relay.stop()
+        relay.stop(ended)
+    print(f"helmcheck relay: stopped: {ended}", file=sys.stderr)
     stats = relay.stats["faults"]
     for d, name in ((">", "to the vehicle"), ("<", "from the vehicle")):
         s = stats.get(d, {})
@@ -159,5 +160,5 @@ def _wait(relay, duration) -> str:
         if not r.is_alive():
             return "both sides closed"
         if duration is not None and time.monotonic() - t0 >= duration:
-            return "duration reached"
+            return f"--duration {duration:g} s reached"
         time.sleep(0.05)

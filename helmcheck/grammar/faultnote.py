@@ -13,8 +13,9 @@ the relay wrote, by the same rule. The wire-log record itself is :mod:`.wirelog`
 
 Format: ``line fault DIR KIND: DETAIL`` — ``DIR`` is :data:`TO_VEHICLE` (``>``),
 :data:`FROM_VEHICLE` (``<``) or :data:`BOTH` (``<>``, the line as a whole: a cut); ``KIND`` is
-one of :data:`KINDS`; ``DETAIL`` is free text for people (byte numbers count from 0 in that
-direction's stream as the sender sent it). Pure text: no clock, no I/O.
+one of :data:`KINDS`; ``DETAIL`` is free text for people on one line (byte numbers count from
+0 in that direction's stream as the sender sent it; bytes quoted are escaped as the wire log
+escapes them, a space as ``\x20``). Pure text: no clock, no I/O.
 """
 
 from __future__ import annotations
@@ -54,7 +55,7 @@ def fault_note(direction: str, kind: str, detail: str) -> str:
         raise ValueError(f"a line fault's direction is one of {_DIRS}, not {direction!r}")
     if kind not in KINDS:
         raise ValueError(f"a line fault's kind is one of {KINDS}, not {kind!r}")
-    return f"{PREFIX} {direction} {kind}: {' '.join(detail.split())}"
+    return f"{PREFIX} {direction} {kind}: {detail.replace(chr(10), ' ').replace(chr(13), ' ')}"
 
 
 def read_fault_note(text: str) -> Optional[FaultNote]:

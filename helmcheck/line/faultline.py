@@ -51,19 +51,7 @@ def read_notes(path: Path | str) -> list[tuple[float, str]]:
 
 
 def _faults(notes: list[tuple[float, str]]) -> list[tuple[float, FaultNote]]:
-    out = []
-    for t, text in notes:
-        f = read_fault_note(text)
-        if f is not None:
-            out.append((t, f))
-    return out
-
-
-class _Thread(FaultRelay):
-    """:class:`~.faultrelay.FaultRelay` with the reading methods of :class:`RelayProcess`."""
-
-    def fault_notes(self) -> list[tuple[float, FaultNote]]:
-        return _faults(self.notes())
+    return [(t, f) for t, f in ((t, read_fault_note(text)) for t, text in notes) if f is not None]
 
 
 class RelayProcess:
@@ -144,7 +132,7 @@ class RelayProcess:
 def impaired_line(vehicle: str, faults: LineFaults | str = "", *, link: Optional[str | Path] = None,
                   wire_log: Optional[str | Path] = None, seed: Optional[int] = None, baud: int = 19200,
                   cut_side: str = "backseat", process: bool = False,
-                  realtime: bool = True) -> Iterator["_Thread | RelayProcess"]:
+                  realtime: bool = True) -> Iterator["FaultRelay | RelayProcess"]:
     """Put the vehicle at port ``vehicle`` behind a line spoiled by ``faults`` (module docstring)."""
     tmp = None
     if wire_log is None:
@@ -163,7 +151,7 @@ def impaired_line(vehicle: str, faults: LineFaults | str = "", *, link: Optional
             finally:
                 proc.stop()
         else:
-            with _Thread("pty", vehicle, faults, link=link, wire_log=wire_log, seed=seed, baud=baud,
+            with FaultRelay("pty", vehicle, faults, link=link, wire_log=wire_log, seed=seed, baud=baud,
                          cut_side=cut_side, realtime=realtime) as relay:
                 yield relay
     finally:

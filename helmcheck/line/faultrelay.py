@@ -32,6 +32,7 @@ from pathlib import Path
 from typing import Callable, Optional
 
 from .. import __version__
+from ..grammar.faultnote import FaultNote, read_fault_note
 from .impair import ImpairedLine
 from .impair_spec import LineFaults, parse_impairment
 from .link import Link
@@ -181,13 +182,14 @@ class FaultRelay:
         link = self.links[side]
         return f"{self.names[side]} ({link})" if link is not None else self.names[side]
 
-    def stop(self, timeout: float = 2.0) -> None:
-        """End the relay, close both sides, remove the links, close the log."""
+    def stop(self, why: str = "", timeout: float = 2.0) -> None:
+        """End the relay, close both sides, remove the links, close the log (its last note says
+        ``why`` when given)."""
         if self.relay is not None:
             self.relay.stop(timeout)
         self._close_sides()
         if self.log is not None:
-            self.log.note(self.clock(), "relay stopped")
+            self.log.note(self.clock(), f"relay stopped{': ' + why if why else ''}")
             self.log.close()
 
     def _close_sides(self) -> None:
@@ -226,6 +228,10 @@ class FaultRelay:
     def notes(self) -> list[tuple[float, str]]:
         """Every note so far: (seconds since the start, text)."""
         return [(t - self.t0, text) for t, text in list(self.log.notes)] if self.log is not None else []
+
+    def fault_notes(self) -> list[tuple[float, FaultNote]]:
+        """The line-fault notes so far, read back: (seconds since the start, note)."""
+        return [(t, f) for t, f in ((t, read_fault_note(text)) for t, text in self.notes()) if f is not None]
 
     @property
     def stats(self) -> dict:

@@ -84,6 +84,8 @@ class _Direction:
             return random.Random(f"helmcheck-line-fault/{seed}/{d}/{kind}")
 
         self._r_drop, self._r_flip, self._r_noise = rng("drop"), rng("flip"), rng("noise")
+        self._r_burst = rng("noise-bytes")  # a burst's length and bytes: apart, so where bursts fall
+        # depends on noise= alone
         self._r_jitter, self._r_line = rng("jitter"), rng("line-jitter")
         self.next_drop = _gap(self._r_drop, f.drop)
         self.next_flip = _gap(self._r_flip, f.flip)  # a bit number: 8 per byte
@@ -154,10 +156,10 @@ class _Direction:
         if i == self.next_noise:
             self.next_noise = i + 1 + _gap(self._r_noise, f.noise)
             lo, hi = f.noise_len
-            burst = bytes(self._r_noise.getrandbits(8) for _ in range(self._r_noise.randint(lo, hi)))
+            burst = bytes(self._r_burst.getrandbits(8) for _ in range(self._r_burst.randint(lo, hi)))
             self.stats["noise_bursts"] += 1
             self.stats["noise_bytes"] += len(burst)
-            shown = escape(burst[:_NOISE_SHOWN]) + ("…" if len(burst) > _NOISE_SHOWN else "")
+            shown = escape(burst[:_NOISE_SHOWN]).replace(" ", "\\x20") + ("…" if len(burst) > _NOISE_SHOWN else "")
             first = True
             for nb in burst:
                 self._uart(r, nb, note=("noise", f"{len(burst)} bytes before byte {i}: {shown}") if first else None)
@@ -184,12 +186,14 @@ class _Direction:
     def _uart(self, r: float, b: int, *, note: Optional[tuple[str, str]] = None, lost: bool = False) -> None:
         tk = self.ticks
         length = tk.tx_frame if tk is not None else 0
-        s = self._tick_of(r)
+        s = r0 = self._tick_of(r)
         if s < self.free:
             s = self.free
-        for k, (a, e) in enumerate(self.stalls):
+        for a, e in self.stalls:
             if s < e and (s + length > a if length else s >= a):
                 s = e
+        for k, (a, e) in enumerate(self.stalls):
+            if r0 < e <= s:  # it waited for this stall's end (in it, or behind bytes that did)
                 self.held[k] += 1
                 self.stats["stalled"] += 1
         self.free = s + length
@@ -320,15 +324,22 @@ class ImpairedLine:
         for dirn in self.dirs.values():
             dirn.advance(now)
         out: list[Action] = []
+        run: list[bytes] = []  # the bytes of out[-1] while it is a run of bytes one way
         heap = self._heap
         while heap and heap[0][0] <= now:
             t, seq, a = heapq.heappop(heap)
             if a.kind == "later":
                 a = self._ended_note(a, seq)
-            if a.kind == BYTES and out and out[-1].kind == BYTES and out[-1].direction == a.direction:
-                out[-1] = out[-1]._replace(data=out[-1].data + a.data, t=a.t)
-            else:
-                out.append(a)
+            if a.kind == BYTES and run and out[-1].direction == a.direction:
+                run.append(a.data)
+                out[-1] = out[-1]._replace(t=a.t)
+                continue
+            if run:
+                out[-1] = out[-1]._replace(data=b"".join(run))
+            run = [a.data] if a.kind == BYTES else []
+            out.append(a)
+        if run:
+            out[-1] = out[-1]._replace(data=b"".join(run))
         return out
 
     def next_due(self) -> Optional[float]:
