@@ -20,6 +20,7 @@ import sys
 import termios
 import time
 import tty
+from pathlib import Path
 
 import pytest
 from hypothesis import given, settings
@@ -658,3 +659,60 @@ def test_the_schedule_and_its_parts_are_sans_io():
             elif isinstance(node, ast.ImportFrom) and node.level == 0 and node.module:
                 names = [node.module.split(".")[0]]
             assert not forbidden & set(names), (rel, names)
+
+
+# ============================================================================ real vehicles behind the relay
+SIM = Path(__file__).resolve().parents[2] / "shared" / "third-party" / "uvc_sim.py"
+
+
+def test_the_emulator_behind_a_slow_line_answers_as_late_as_the_line_makes_it(tmp_path):
+    """The reference emulator's pty behind baud=19200 and every vehicle line held 0.6 s: its
+    ACK to an $OSD,S comes at least 0.6 s after the poll went out, and the answers are whole."""
+    from helmcheck.emulator.process import EmulatorProcess, HelmClient
+    from helmcheck.grammar import sentences as s
+    from helmcheck.line.transport import open_link
+
+    with EmulatorProcess() as emu, impaired_line(emu.port, "baud=19200,<line-delay=0.6",
+                                                 link=tmp_path / "vehicle") as line:
+        link = open_link(line.port, role="client", baud=19200)
+        try:
+            client = HelmClient(link)
+            t0 = time.monotonic()
+            replies = client.request("OSD,S", 8, timeout=5.0)
+            took = time.monotonic() - t0
+            assert isinstance(replies[-1], s.ACK) and any(isinstance(r, s.OSI) for r in replies)
+            assert took >= 0.6 + transmit_time(len(b"$OSD,S*27\r\n$ACK,8,0,0*5D\r\n"), 19200)
+            assert took < 3.0
+        finally:
+            link.close()
+
+
+@pytest.mark.skipif(not SIM.is_file(), reason=f"the independent simulator is not there: {SIM}")
+def test_an_independent_simulator_behind_a_cut_answers_again_under_the_same_link(tmp_path):
+    """uvc_sim.py (written apart from helmcheck) behind cut=0.6s@0.8: the tester's port, opened
+    by its link, answers; dies with the cut; and, opened again by the same link, answers again."""
+    from helmcheck.emulator.process import HelmClient
+    from helmcheck.line.transport import open_link
+
+    proc = subprocess.Popen([sys.executable, str(SIM)], stdout=subprocess.PIPE, stderr=subprocess.DEVNULL,
+                            stdin=subprocess.DEVNULL, start_new_session=True)
+    try:
+        assert select.select([proc.stdout], [], [], 20.0)[0]
+        port = proc.stdout.readline().decode().strip().removeprefix("port: ")
+        with impaired_line(port, "cut=0.6s@0.8", link=tmp_path / "vehicle") as line:
+            link = open_link(line.port, role="client", baud=19200)
+            client = HelmClient(link)
+            assert client.ack("OSD,S", 8, timeout=3.0).type == 8
+            time.sleep(max(0.0, line.t0 + 1.0 - time.monotonic()))
+            with pytest.raises(OSError):  # unplugged: the port the tester has is gone (EIO)
+                client.ack("OSD,S", 8, timeout=0.3)
+            link.close()
+            time.sleep(max(0.0, line.t0 + 1.45 - time.monotonic()))
+            link = open_link(line.port, role="client", baud=19200)
+            try:
+                assert HelmClient(link).ack("OSD,S", 8, timeout=3.0).type == 8
+            finally:
+                link.close()
+    finally:
+        os.killpg(proc.pid, signal.SIGTERM)
+        proc.wait(10)
