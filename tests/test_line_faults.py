@@ -31,7 +31,7 @@ from helmcheck.grammar.wirelog import FROM_VEHICLE, TO_VEHICLE, transmit_time
 from helmcheck.line.faultline import impaired_line
 from helmcheck.line.faultrelay import FaultRelay
 from helmcheck.line.impair import BYTES, NOTE, ImpairedLine
-from helmcheck.line.impair_spec import ImpairError, Window, parse_impairment
+from helmcheck.line.impair_spec import ITEMS, ImpairError, Window, parse_impairment
 from helmcheck.line.pty_link import PtyLink
 from helmcheck.line.uart import reframe
 
@@ -716,3 +716,13 @@ def test_an_independent_simulator_behind_a_cut_answers_again_under_the_same_link
     finally:
         os.killpg(proc.pid, signal.SIGTERM)
         proc.wait(10)
+
+
+def test_the_docs_page_is_the_one_the_code_makes():
+    from helmcheck.line import faultdocs
+
+    assert not faultdocs.stale(), "docs/line-faults.md is stale: run 'helmcheck docs'"
+    text = faultdocs.render_markdown()
+    for item in ITEMS:
+        assert f"`{item.key}={item.value}`" in text
+    assert "! line fault <> cut: over after 1 s: lost" in text  # a real run's notes, not typed in

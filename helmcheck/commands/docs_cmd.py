@@ -2,7 +2,8 @@
 
 The grammar reference comes from ``remote_helm.lark``, and so do the fast path's tables
 (``helmcheck/grammar/derived.py``, :mod:`helmcheck.grammar.derive`); the model's transition
-table and state diagram come from ``helmcheck/model/transitions.py``. Nothing in ``docs/`` is
+table and state diagram come from ``helmcheck/model/transitions.py``; the line-fault relay's
+page (``docs/line-faults.md``) from :mod:`helmcheck.line.faultdocs`. Nothing in ``docs/`` is
 written by hand except ``contracts.md``. Each file is written atomically; one that cannot be written is exit 2
 naming it. ``--check`` exits 1 when a checked-in copy is stale.
 """
@@ -26,16 +27,19 @@ def run(args: argparse.Namespace) -> int:
     from ..failures import OutputLost
     from ..grammar import derive
     from ..grammar import docs as grammar_docs
+    from ..line import faultdocs as fault_docs
     from ..model import docs as model_docs
     from ..reports.atomic import write_text_atomic
 
     if args.check:
         stale = ((["docs/grammar.md"] if grammar_docs.stale() else [])
-                 + (["helmcheck/grammar/derived.py"] if derive.stale() else []) + list(model_docs.stale()))
+                 + (["helmcheck/grammar/derived.py"] if derive.stale() else []) + list(model_docs.stale())
+                 + (["docs/line-faults.md"] if fault_docs.stale() else []))
         for name in stale:
             print(f"stale: {name} (run 'helmcheck docs')")
         return exitcodes.NONCONFORMANT if stale else exitcodes.OK
-    targets = {grammar_docs.DOCS_FILE: grammar_docs.render_markdown(), derive.TABLE_FILE: derive.render_table()}
+    targets = {grammar_docs.DOCS_FILE: grammar_docs.render_markdown(), derive.TABLE_FILE: derive.render_table(),
+               fault_docs.DOCS_FILE: fault_docs.render_markdown()}
     targets.update({model_docs.DOCS_DIR / name: text for name, text in model_docs.render_all().items()})
     for path, text in targets.items():
         try:

@@ -122,9 +122,10 @@ def run(args: argparse.Namespace) -> int:
         relay.start()
     except FileExistsError as e:
         raise PathError(f"--link: {e}") from None
-    except (OSError, ValueError) as e:
-        why = getattr(e, "strerror", None) or str(e)
-        raise PathError(f"cannot open {getattr(e, 'filename', None) or ' / '.join(args.between)}: {why}") from None
+    except OSError as e:
+        if e.filename is None:
+            raise
+        raise PathError(f"cannot open {e.filename}: {e.strerror or e}") from None
     print(f"helmcheck relay: backseat {relay.port_of('backseat')}, vehicle {relay.port_of('vehicle')}; impair "
           f"{faults.text or '(none)'!r}, seed {faults.seed}"
           + (f"; wire log {args.wire_log}" if args.wire_log else ""), file=sys.stderr, flush=True)

@@ -17,6 +17,7 @@
   :mod:`.relaylog` (its wire log), :mod:`.faultrelay` (the ports, links and cuts around a
   :class:`~.relay.Relay` with the schedule as its stage: ``helmcheck relay``) and
   :mod:`.faultline` (:func:`~.faultline.impaired_line`, a vehicle behind a bad line for a test);
+  :mod:`.faultdocs` makes its page, ``docs/line-faults.md``;
 * :mod:`.baudguess` — which common baud rate would make a garbled capture sentences (sans-IO);
 * :mod:`.counters` — a serial port's error counters from the kernel (``TIOCGICOUNT``), or why
   there are none (a pty, a socket);

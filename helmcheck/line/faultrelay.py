@@ -136,28 +136,39 @@ class FaultRelay:
             return PtyLink(self.baud)
         return open_link(spec, role="client", baud=self.baud)
 
-    def _plugged(self, side: str, link: Link) -> None:
+    def _plugged(self, side: str, link: Link, announce: bool = True) -> None:
         """A side (re)opened: its name, its link, the owner told."""
         self.sides[side] = link
         self.names[side] = link.name
         if self.specs[side].kind == "pty":
             if self.links[side] is not None:
                 point_link(self.links[side], link.name)
-            if self.on_port is not None:
+            if announce and self.on_port is not None:
                 self.on_port(side, link.name)
 
     # ------------------------------------------------------------------ start, stop
     def start(self) -> "FaultRelay":
+        """Open both sides, the links and the log, and start the relay. A side that cannot be
+        opened raises ``OSError`` whose ``filename`` is its port and ``strerror`` why."""
         try:
             for side in SIDES:
-                link = self._open(side)
+                try:
+                    link = self._open(side)
+                except (OSError, ValueError) as e:
+                    text = self.specs[side].text
+                    why = getattr(e, "strerror", None) or str(e)
+                    why = why[len(text) + 2:] if why.startswith(text + ": ") else why
+                    raise OSError(getattr(e, "errno", None) or 0, why, text) from None
                 if isinstance(link, TcpServerLink):  # port 0: the port it got is the one to listen on again
                     self.specs[side] = parse_port_spec(link.name)
-                self._plugged(side, link)
+                self._plugged(side, link, announce=False)
             stream = open(self.wire_log, "w", encoding="utf-8") if self.wire_log is not None else None
         except BaseException:
             self._close_sides()
             raise
+        for side in SIDES:
+            if self.specs[side].kind == "pty" and self.on_port is not None:
+                self.on_port(side, self.names[side])
         self.t0 = self.clock()
         started = datetime.now(timezone.utc).strftime("%Y-%m-%dT%H:%M:%S.%fZ")
         line_baud = self.faults.to_vehicle.baud or self.baud

@@ -162,7 +162,8 @@ class _Direction:
             shown = escape(burst[:_NOISE_SHOWN]).replace(" ", "\\x20") + ("…" if len(burst) > _NOISE_SHOWN else "")
             first = True
             for nb in burst:
-                self._uart(r, nb, note=("noise", f"{len(burst)} bytes before byte {i}: {shown}") if first else None)
+                self._uart(r, nb, note=("noise", f"{len(burst)} byte{'s' if len(burst) > 1 else ''} before byte {i}: "
+                                                    f"{shown}") if first else None)
                 first = False
         dropped = i == self.next_drop
         if dropped:
