@@ -18,6 +18,7 @@ import socket
 import subprocess
 import sys
 import termios
+import threading
 import time
 import tty
 from pathlib import Path
@@ -95,6 +96,17 @@ def read_for(fd: int, n: int, timeout: float) -> list[tuple[float, bytes]]:
             got.append((time.monotonic(), data))
             total += len(data)
     return got
+
+
+def write_all(fd: int, data: bytes, chunk: int = 4096) -> None:
+    """Write every byte to a non-blocking descriptor, ``chunk`` bytes at a time at most."""
+    view = memoryview(data)
+    while view:
+        select.select([], [fd], [], 1.0)
+        try:
+            view = view[os.write(fd, view[:chunk]):]
+        except BlockingIOError:
+            pass
 
 
 def link_read(link: PtyLink, n: int, timeout: float) -> list[tuple[float, bytes]]:
@@ -568,14 +580,7 @@ def test_relay_same_seed_same_bytes_as_the_schedule_on_real_ptys():
             with FaultRelay("pty", vehicle.name, spec, realtime=False) as relay:
                 fd = open_peer(relay.port)
                 try:
-                    for i in range(0, len(sent), chunking):
-                        view = sent[i:i + chunking]
-                        while view:
-                            select.select([], [fd], [], 1.0)
-                            try:
-                                view = view[os.write(fd, view):]
-                            except BlockingIOError:
-                                pass
+                    write_all(fd, sent, chunking)
                     n = len(delivered(want, TO_VEHICLE))
                     outs.append(b"".join(d for _, d in link_read(vehicle, n, 5.0)))
                 finally:
@@ -726,3 +731,88 @@ def test_the_docs_page_is_the_one_the_code_makes():
     for item in ITEMS:
         assert f"`{item.key}={item.value}`" in text
     assert "! line fault <> cut: over after 1 s: lost" in text  # a real run's notes, not typed in
+
+
+# ============================================================================ soak (HELMCHECK_LINE_SOAK=1)
+@pytest.mark.skipif(not SOAK, reason="a long run on a real relay: HELMCHECK_LINE_SOAK=1")
+def test_soak_a_real_relay_in_its_own_process_gives_the_schedule_s_bytes_and_rates(tmp_path):
+    """Two megabytes through ``helmcheck relay`` in a process of its own: the bytes out are the
+    schedule's for the same bytes, byte for byte, and the faults its notes count are within the
+    binomial bounds."""
+    p = 1e-3
+    spec = f"drop={p},flip={p},noise={p},noise-len=1-6,seed=21"
+    rng = random.Random(21)
+    n = 2_000_000
+    sent = bytes(rng.getrandbits(8) for _ in range(n))
+    _, want = run_schedule(spec, [(0.0, TO_VEHICLE, sent)])
+    vehicle = PtyLink(19200)
+    try:
+        with impaired_line(vehicle.name, spec, wire_log=tmp_path / "relay.log", process=True) as line:
+            fd = open_peer(line.port)
+            try:
+                got: list = []
+                reader = threading.Thread(target=lambda: got.extend(link_read(vehicle, len(delivered(want, TO_VEHICLE)),
+                                                                              120.0)))
+                reader.start()
+                write_all(fd, sent)
+                reader.join()
+            finally:
+                os.close(fd)
+            time.sleep(0.3)
+            kinds = [f.kind for _, f in line.fault_notes()]
+        assert b"".join(d for _, d in got) == delivered(want, TO_VEHICLE)
+        lo, hi = binomial_bounds(n, p)
+        assert lo <= kinds.count("drop") <= hi and lo <= kinds.count("noise") <= hi
+    finally:
+        vehicle.close()
+
+
+@pytest.mark.skipif(not SOAK, reason="a long run on a real relay: HELMCHECK_LINE_SOAK=1")
+@pytest.mark.parametrize("baud", [9600, 19200, 115200])
+def test_soak_pacing_over_ten_seconds_holds_the_rate(baud):
+    vehicle = PtyLink(baud)
+    try:
+        with impaired_line(vehicle.name, f"baud={baud}", process=True) as line:
+            fd = open_peer(line.port)
+            try:
+                bt = transmit_time(1, baud)
+                n = int(10 / bt)
+                data = bytes(0x41 + i % 26 for i in range(n))
+
+                writer = threading.Thread(target=write_all, args=(fd, data, 512))
+                t0 = time.monotonic()
+                writer.start()
+                got = link_read(vehicle, n, 30.0)
+                writer.join()
+            finally:
+                os.close(fd)
+        assert sum(len(d) for _, d in got) == n
+        span = got[-1][0] - t0
+        assert n * bt * (1 - 1e-3) <= span <= n * bt * 1.01, span
+    finally:
+        vehicle.close()
+
+
+def test_cli_relay_a_side_that_fails_during_the_run_is_a_link_fault_2(tmp_path):
+    vehicle = PtyLink(19200)
+    proc = subprocess.Popen([sys.executable, "-m", "helmcheck", "relay", "--between", "pty", vehicle.name,
+                             "--wire-log", str(tmp_path / "w.log")],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, stdin=subprocess.DEVNULL, text=True)
+    try:
+        assert proc.stdout.readline().startswith("port: /dev/pts/")
+        vehicle.close()  # the vehicle's device goes away for good
+        assert proc.wait(10) == 2
+        err = proc.stderr.read()
+        assert "helmcheck relay: link fault: the vehicle side closed" in err and "Traceback" not in err
+        assert "! relay: the vehicle side: closed" in (tmp_path / "w.log").read_text()
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+
+
+def test_cli_relay_a_wire_log_that_cannot_be_written_is_2(capsys):
+    from helmcheck.cli import main
+
+    assert main(["relay", "--between", "pty", "pty", "--wire-log", "/dev/full", "--duration", "0.2"]) == 2
+    assert "cannot write /dev/full: No space left on device" in capsys.readouterr().err

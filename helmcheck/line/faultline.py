@@ -14,10 +14,12 @@ or in a process of its own (``process=True``: ``helmcheck relay``, so that this 
 work never holds a byte back; it costs the interpreter's start, about half a second). Either
 way the timing is real: bytes are delivered when the schedule says, by the clock.
 
-The object yielded has ``port``, ``wire_log`` (the relay's log; a temporary file when none was
-asked for), :meth:`notes` (every note so far: seconds since the relay started, text) and
-:meth:`fault_notes` (the line-fault notes, read back by
-:func:`helmcheck.grammar.faultnote.read_fault_note`).
+The object yielded has ``port``, ``t0`` (when the relay started, on the monotonic clock: the
+windows of ``stall`` and ``cut`` count from it), ``wire_log`` (the relay's log; a temporary file
+when none was asked for), :meth:`notes` (every note so far: seconds since the relay started,
+text) and :meth:`fault_notes` (the line-fault notes, read back by
+:func:`helmcheck.grammar.faultnote.read_fault_note`). ``realtime`` (the thread asks for
+real-time priority where allowed) is the thread's; a process asks for it always.
 """
 
 from __future__ import annotations
@@ -78,6 +80,18 @@ class RelayProcess:
     @property
     def port(self) -> str:
         return str(self.link) if self.link is not None else self.pty
+
+    @property
+    def t0(self) -> float:
+        """When the relay started, on this machine's monotonic clock (the log's time 0; the
+        windows of ``stall`` and ``cut`` count from it), read from its wire log's header."""
+        with open(self.wire_log, "rb") as f:  # type: ignore[arg-type]
+            for line in f:
+                if line.startswith(b"# clock monotonic "):
+                    return float(line.split()[3])
+                if not line.startswith(b"#"):
+                    break
+        raise RuntimeError(f"{self.wire_log} does not say when the relay started")
 
     def start(self) -> "RelayProcess":
         self.proc = subprocess.Popen(self.argv, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
