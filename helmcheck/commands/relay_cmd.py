@@ -141,8 +141,9 @@ def run(args: argparse.Namespace) -> int:
     for d, name in ((">", "to the vehicle"), ("<", "from the vehicle")):
         s = stats.get(d, {})
         print(f"helmcheck relay: {name}: {s.get('in', 0)} bytes in, {s.get('out', 0)} out; dropped "
-              f"{s.get('dropped', 0)}, bits flipped {s.get('flipped_bits', 0)}, noise bursts {s.get('noise_bursts', 0)}, "
-              f"held by stalls {s.get('stalled', 0)}, lost in cuts {s.get('cut', 0)}", file=sys.stderr)
+              f"{s.get('dropped', 0)}, bits flipped {s.get('flipped_bits', 0)}, noise bursts "
+              f"{s.get('noise_bursts', 0)}, held by stalls {s.get('stalled', 0)}, lost in cuts {s.get('cut', 0)}",
+              file=sys.stderr)
     if relay.log is not None and relay.log.write_error:
         raise OutputLost(f"cannot write {args.wire_log}: {relay.log.write_error}")
     if ended.startswith("link fault"):

@@ -217,6 +217,9 @@ class FaultRelay:
         self.stop()
 
     # ------------------------------------------------------------------ while it runs (the relay's thread)
+    def _note(self, text: str) -> None:
+        self.log.note(self.clock(), text)  # type: ignore[union-attr]
+
     def _event(self, t: float, kind: str, side: str) -> None:
         if kind in ("unplugged", "replugged"):
             return  # noted by _unplug/_replug, with the ports' names
@@ -227,12 +230,12 @@ class FaultRelay:
         path = self.links[side]
         if path is not None:
             _unlink(path)
-        self.log.note(self.clock(), f"relay: the {side} side's port {self._shown(side)} unplugged")  # type: ignore[union-attr]
+        self._note(f"relay: the {side} side's port {self._shown(side)} unplugged")
 
     def _replug(self, side: str) -> Optional[Link]:
         link = self._open(side)
         self._plugged(side, link)
-        self.log.note(self.clock(), f"relay: the {side} side's port is back: {self._shown(side)}")  # type: ignore[union-attr]
+        self._note(f"relay: the {side} side's port is back: {self._shown(side)}")
         return link
 
     # ------------------------------------------------------------------ what it did

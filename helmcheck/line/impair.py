@@ -260,7 +260,8 @@ class _Direction:
             timing.append(f"every line held {f.line_delay:g} s after its last byte"
                           + (f" and a further 0 to {f.line_jitter:g} s" if f.line_jitter else ""))
         if f.delay or f.jitter:
-            timing.append(f"every byte {f.delay:g} s late" + (f" and a further 0 to {f.jitter:g} s" if f.jitter else ""))
+            timing.append(f"every byte {f.delay:g} s late"
+                          + (f" and a further 0 to {f.jitter:g} s" if f.jitter else ""))
         if timing:
             out.append(("timing", "; ".join(timing)))
         if f.reframed:
