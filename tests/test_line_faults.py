@@ -610,6 +610,9 @@ def test_cli_relay_prints_the_port_first_and_again_after_a_cut_under_its_link(tm
         assert not os.path.lexists(link)
         log = (tmp_path / "w.log").read_text()
         assert "! line fault <> cut: 0.4 s from 0.6 s" in log and "! relay stopped" in log
+        from helmcheck.grammar.wirelog import read_records
+
+        assert len(list(read_records((tmp_path / "w.log").read_bytes().splitlines()))) >= 6  # a wire log as any other
         assert "stopped" in proc.stderr.read()
     finally:
         if proc.poll() is None:

@@ -76,6 +76,9 @@ REPLUG_RETRY_S = 0.25
 #: scheduling). One wake a byte would cost a third of a CPU at 115200 baud both ways; a USB
 #: serial adapter delivers in chunks of a millisecond or more anyway.
 PACE_TICK_S = 0.001
+#: With a stage, the most read from a side at a time: the stage handles bytes one by one, so a
+#: long burst taken at once would hold back what falls due meanwhile (about 4 ms a kilobyte).
+STAGE_READ = 256
 #: The interpreter's thread switch interval while a relay runs (Python's default is 5 ms): another
 #: thread holding the interpreter lock hands it over within this, so a byte read waits on it at
 #: most this long before it is forwarded.
@@ -241,7 +244,7 @@ class Relay(threading.Thread):
     def _read(self, side: str) -> None:
         link = self.links[side]
         try:
-            events = link.poll()
+            events = link.poll() if self.stage is None else link.poll(STAGE_READ)
         except LinkClosed:
             self._gone(side)
             return
