@@ -820,3 +820,25 @@ def test_cli_relay_a_wire_log_that_cannot_be_written_is_2(capsys):
 
     assert main(["relay", "--between", "pty", "pty", "--wire-log", "/dev/full", "--duration", "0.2"]) == 2
     assert "cannot write /dev/full: No space left on device" in capsys.readouterr().err
+
+
+def test_relay_cut_of_the_vehicle_side_closes_and_reopens_its_device():
+    """--cut-side vehicle, the vehicle's side a device path: the relay closes it for the cut and
+    opens it again after (the far end sees a dead line, not a vanished device); bytes pass after."""
+    vehicle = PtyLink(19200)
+    try:
+        with FaultRelay("pty", vehicle.name, "cut=0.4s@0.3", cut_side="vehicle", realtime=False) as relay:
+            fd = open_peer(relay.port)
+            try:
+                time.sleep(max(0.0, relay.t0 + 0.8 - time.monotonic()))
+                os.write(fd, b"$OSD,S*27\r\n")
+                assert b"".join(d for _, d in link_read(vehicle, 11, 2.0)) == b"$OSD,S*27\r\n"
+                vehicle.write_all(b"$ACK,8,0,0*5D\r\n")
+                assert b"".join(d for _, d in read_for(fd, 15, 2.0)) == b"$ACK,8,0,0*5D\r\n"
+            finally:
+                os.close(fd)
+            notes = [text for _, text in relay.notes()]
+            assert any(n.startswith(f"relay: the vehicle side's port {vehicle.name} unplugged") for n in notes)
+            assert any(n == f"relay: the vehicle side's port is back: {vehicle.name}" for n in notes)
+    finally:
+        vehicle.close()
