@@ -3,7 +3,7 @@
 Run: ``.venv/bin/python benchmarks/monitor_bench.py [--seconds S] [--blast-seconds S]``.
 
 This process is the monitor, as ``helmcheck monitor --between`` runs it: a
-:class:`~helmcheck.monitor.relay.Relay` between two ptys whose ``on_bytes`` writes each chunk to
+:class:`~helmcheck.line.relay.Relay` between two ptys whose ``on_bytes`` writes each chunk to
 the session's wire log (:class:`~helmcheck.monitor.sessionlog.SessionLog`: a record, flushed),
 which the live judges (:class:`~helmcheck.monitor.live.LiveJudge`: check-log's vehicle and
 backseat observers, in a process of their own) follow as it grows. The backseat and the vehicle
@@ -49,7 +49,7 @@ from helmcheck.grammar import sentences as S  # noqa: E402
 from helmcheck.grammar.wirelog import FROM_VEHICLE, TO_VEHICLE  # noqa: E402
 from helmcheck.line.pty_link import PtyLink  # noqa: E402
 from helmcheck.monitor.live import LiveJudge  # noqa: E402
-from helmcheck.monitor.relay import Relay  # noqa: E402
+from helmcheck.line.relay import Relay  # noqa: E402
 from helmcheck.monitor.sessionlog import SessionLog  # noqa: E402
 from helmcheck.profile import DEFAULT  # noqa: E402
 

@@ -41,6 +41,7 @@ SUBCOMMANDS = {
     "diff": ("helmcheck.commands.diff_cmd", "drive two vehicles with the same sequences; report their first divergence"),
     "check-log": ("helmcheck.commands.checklog_cmd", "check a recorded serial log against the model"),
     "monitor": ("helmcheck.commands.monitor_cmd", "judge a live backseat-vehicle session (tap or in line)"),
+    "relay": ("helmcheck.commands.relay_cmd", "relay between two ports through a line with faults (for testing on a bad line)"),
     "report": ("helmcheck.commands.report_cmd", "render a results directory as HTML, JUnit, Markdown"),
     "matrix": ("helmcheck.commands.matrix_cmd", "one overview of several runs: clauses x implementations"),
     "verify": ("helmcheck.commands.verify_cmd", "check a results directory against its evidence and signature"),
@@ -50,7 +51,7 @@ SUBCOMMANDS = {
 }
 
 #: Exit code of a command stopped by a signal before it could end its run itself.
-INTERRUPT_CODE = {"emulate": exitcodes.OK}
+INTERRUPT_CODE = {"emulate": exitcodes.OK, "relay": exitcodes.OK}
 
 DESCRIPTION = """\
 helmcheck — the formal model and conformance suite for the Iver3 remote helm protocol.
@@ -64,6 +65,7 @@ Typical use:
   helmcheck matrix out/a out/b --out out/          # several runs side by side, clause by clause
   helmcheck verify reports/demo                    # re-judge the wire log; check the signature
   helmcheck monitor --tap /dev/ttyUSB0 /dev/ttyUSB1  # judge a live session from a Y-cable, live
+  helmcheck relay --between pty /dev/ttyUSB0 --impair 'flip=1e-5,cut=5s@60'  # test on a bad line
   helmcheck parse wire.log                         # validate a capture line by line
   helmcheck profile init iver3.toml                # a commented profile for a vehicle to fill in
 

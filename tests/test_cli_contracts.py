@@ -74,6 +74,7 @@ USAGE = {
     "diff": ["diff", "--port", "/dev/null"],
     "check-log": ["check-log"],
     "monitor": ["monitor", "--tap", "pty"],
+    "relay": ["relay", "--between", "pty", "pty", "--impair", "flip=often"],
     "report": ["report", "--format", "pdf", "x"],
     "docs": ["docs", "--bogus"],
 }
@@ -129,6 +130,7 @@ PORT_COMMANDS = {
     "replay": lambda port, tmp: ["replay", replay_file(tmp), "--port", port],
     "diff": lambda port, tmp: ["diff", "--port", port, "--port", port, "--report-dir", tmp / "r"],
     "monitor": lambda port, tmp: ["monitor", "--between", "pty", port, "--report-dir", tmp / "r"],
+    "relay": lambda port, tmp: ["relay", "--between", "pty", port, "--wire-log", tmp / "r"],
 }
 
 

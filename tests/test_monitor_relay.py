@@ -22,7 +22,7 @@ from helmcheck.grammar.wirelog import FROM_VEHICLE, TO_VEHICLE
 from helmcheck.line.pty_link import PtyLink
 from helmcheck.line.serial_link import SerialLink
 from helmcheck.line.tcp_link import TcpServerLink
-from helmcheck.monitor.relay import Relay
+from helmcheck.line.relay import Relay
 
 
 def open_peer(path: str) -> int:

@@ -4,7 +4,7 @@
   :mod:`.certify_backseat_cmd` — the two roles;
 * :mod:`.emulate_cmd` — ``emulate``; :mod:`.checklog_cmd` — ``check-log`` (a whole archive:
   :mod:`.checklog_fleet_cmd`); :mod:`.monitor_cmd` —
-  ``monitor``; :mod:`.verify_cmd` —
+  ``monitor``; :mod:`.relay_cmd` — ``relay`` (a line with faults); :mod:`.verify_cmd` —
   ``verify``; :mod:`.report_cmd` — ``report``; :mod:`.matrix_cmd` — ``matrix``;
 * :mod:`.replay_cmd` — ``replay``; :mod:`.diff_cmd` — ``diff``; :mod:`.parse_cmd` — ``parse``; :mod:`.keygen_cmd` — ``keygen``;
   :mod:`.profile_cmd` — ``profile init``; :mod:`.docs_cmd` — ``docs``.

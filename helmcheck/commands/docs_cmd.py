@@ -5,7 +5,8 @@ The grammar reference comes from ``remote_helm.lark``, and so do the fast path's
 table and state diagram come from ``helmcheck/model/transitions.py``; the documentation site's
 reference pages (every profile key, the clause catalogue, the reference profile:
 ``docs/reference/``, :mod:`helmcheck.reference_docs`) from the ``Profile`` dataclass and the
-shipped reference profile; ``examples/emulator.toml`` is what ``helmcheck profile init
+shipped reference profile; the line-fault relay's page (``docs/line-faults.md``) from
+:mod:`helmcheck.line.faultdocs`; ``examples/emulator.toml`` is what ``helmcheck profile init
 --emulator`` writes. The other pages of ``docs/`` are written by hand. Each file is written
 atomically; one that cannot be written is exit 2 naming it. ``--check`` exits 1 when a
 checked-in copy is stale.
@@ -43,9 +44,11 @@ def targets() -> dict[Path, str]:
     from .. import reference_docs
     from ..grammar import derive
     from ..grammar import docs as grammar_docs
+    from ..line import faultdocs as fault_docs
     from ..model import docs as model_docs
 
-    out = {grammar_docs.DOCS_FILE: grammar_docs.render_markdown(), derive.TABLE_FILE: derive.render_table()}
+    out = {grammar_docs.DOCS_FILE: grammar_docs.render_markdown(), derive.TABLE_FILE: derive.render_table(),
+           fault_docs.DOCS_FILE: fault_docs.render_markdown()}
     out.update({model_docs.DOCS_DIR / name: text for name, text in model_docs.render_all().items()})
     out.update(reference_docs.render_all())
     out[EMULATOR_EXAMPLE] = emulator_example()

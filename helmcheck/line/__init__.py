@@ -8,6 +8,19 @@
 * :mod:`.pty_link`, :mod:`.serial_link`, :mod:`.tcp_link` — the pseudo-terminal, the serial
   device (pyserial) and the TCP client and server links;
 * :mod:`.pacer` — :class:`~helmcheck.line.pacer.LinePacer`, a UART's capacity at a baud rate;
+* :mod:`.relay` — :class:`~helmcheck.line.relay.Relay`, the I/O thread between two links that
+  reads both with one clock and forwards every byte in line (``helmcheck monitor --between``) or
+  only reads (``--tap``);
+* the line-fault relay, which spoils the line on purpose: :mod:`.impair_spec` (the ``--impair``
+  text read into settings), :mod:`.impair` (the sans-IO schedule: what comes out when, and the
+  notes), :mod:`.uart` (a bit stream re-sampled by a receiver at another baud),
+  :mod:`.relaylog` (its wire log), :mod:`.faultrelay` (the ports, links and cuts around a
+  :class:`~.relay.Relay` with the schedule as its stage: ``helmcheck relay``) and
+  :mod:`.faultline` (:func:`~.faultline.impaired_line`, a vehicle behind a bad line for a test);
+  :mod:`.faultdocs` makes its page, ``docs/line-faults.md``;
+* :mod:`.baudguess` — which common baud rate would make a garbled capture sentences (sans-IO);
+* :mod:`.counters` — a serial port's error counters from the kernel (``TIOCGICOUNT``), or why
+  there are none (a pty, a socket);
 * :mod:`.recorder` — every event of a live run to the wire log (by the one wire-log writer,
   :mod:`helmcheck.grammar.wirelog`) and to the judges, identically;
 * :mod:`.launcher` — start, watch and stop the implementation under test (``--exec CMD``);

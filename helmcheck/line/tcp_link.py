@@ -146,9 +146,9 @@ class TcpServerLink(Link):
             return len(data)  # the next poll reports the disconnect
 
     def close(self) -> None:
-        if self.client is not None:
-            self._drop("closed by server")
-        try:
+        try:  # first stop listening: a client that sees its connection end can connect nowhere
             self.listener.close()
         except OSError:
             pass
+        if self.client is not None:
+            self._drop("closed by server")

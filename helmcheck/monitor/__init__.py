@@ -4,8 +4,9 @@ Two ways onto the line: **tap** (``--tap``: the two receive lines of a Y-cable, 
 is ever written) and **in line** (``--between``: every byte forwarded unchanged, in arrival order,
 at once, and a copy judged). Modules, one concern each:
 
-* :mod:`.relay` — the I/O thread: reads both sides with one clock, forwards in line, hands each
-  chunk on; it never alters, delays on purpose, drops or injects a byte;
+* the I/O thread is :class:`helmcheck.line.relay.Relay` (:mod:`helmcheck.line.relay`): it reads
+  both sides with one clock, forwards in line, hands each chunk on; the monitor gives it no
+  impairment stage, so it never alters, delays on purpose, drops or injects a byte;
 * :mod:`.sessionlog` — the session's wire log: each record written, flushed and handed to the
   judges as written; rotated by size (``wire.log``, ``wire.001.log``, …);
 * :mod:`.live` — check-log's judges (:class:`helmcheck.checklog.checker.SessionJudge`) fed the

@@ -1,6 +1,6 @@
 """One monitored session, from the open ports to the results directory: :func:`monitor`.
 
-The wiring: the :class:`.relay.Relay` thread reads both sides with one clock (and, in line,
+The wiring: the :class:`helmcheck.line.relay.Relay` thread reads both sides with one clock (and, in line,
 forwards every byte at once); each chunk it read goes to the :class:`.sessionlog.SessionLog`,
 which writes and flushes it as a wire-log record; the :class:`.live.LiveJudge` — check-log's
 judges in a process of their own — follows the log as it grows. New findings go to
@@ -37,7 +37,7 @@ from ..reports.render import render_all
 from ..reports.results import exit_code, write_results_atomic
 from ..reports.segments import read_session
 from .live import Finding, LiveJudge, helper_process
-from .relay import Relay
+from ..line.relay import Relay
 from .sessionlog import ROTATE_BYTES, SessionLog
 
 __all__ = ["Options", "Result", "monitor", "open_sides", "side_roles"]
@@ -65,7 +65,7 @@ class Options:
     on_port: Optional[Callable[[str, str], None]] = None  #: (side, name) of a pty the monitor created
     view: Any = None  #: has ``refresh(state)``/``close()`` (``.view``), or None
     links: Optional[tuple[Link, Link]] = None  #: command hook: the two sides, opened by the command
-    realtime: bool = True  #: the relay asks for real-time priority (:mod:`.relay`)
+    realtime: bool = True  #: the relay asks for real-time priority (:mod:`helmcheck.line.relay`)
     on_relay: Optional[Callable[[str], None]] = None  #: told the relay's priority once it runs
 
 

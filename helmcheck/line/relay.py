@@ -1,8 +1,9 @@
-"""The monitor's I/O core (:class:`Relay`): one thread that reads both sides of a live line with
-one clock, forwards every byte in line, and hands a copy of each chunk on.
+"""The relay between two links (:class:`Relay`): one thread that reads both sides of a live line
+with one clock, forwards every byte in line, and hands a copy of each chunk on. It is the I/O
+core of ``helmcheck monitor`` and of ``helmcheck relay`` (the line-fault relay).
 
-It owns the bytes on the wire while ``helmcheck monitor`` runs, and nothing above them: no
-framing, no judging, no log format (the callback does that). Two modes:
+It owns the bytes on the wire while it runs, and nothing above them: no framing, no judging, no
+log format (the callbacks do that). Three modes:
 
 * **in line** (``forward=True``, ``--between``): every chunk read from one side is written to
   the other at once, unchanged, in arrival order (no line buffering). It never alters, delays on
@@ -11,28 +12,40 @@ framing, no judging, no log format (the callback does that). Two modes:
   writable. The only bytes not delivered (counted in :attr:`Relay.stats` as ``undelivered``) are
   those going to a side that has closed for good or to a TCP server with no client (like bytes
   sent down an unplugged line), including what waited for a client that left;
+* **in line through an impairment stage** (``stage``, an :class:`~.impair.ImpairedLine`): what is
+  read goes to the stage, and what the stage says is due is written when it is due — its bytes
+  (forwarded as above), its notes (``on_note(t, text)``, ``t`` the fault's time) and its cuts:
+  at a cut's start the side ``cut_side`` is unplugged (``unplug(side, link)``: the owner closes
+  it; the relay neither reads nor writes it meanwhile) and at its end plugged back
+  (``replug(side)`` returns the new link; None or an ``OSError``: tried again every
+  :data:`REPLUG_RETRY_S`). The thread wakes when something is due (a paced byte's end), not
+  only for input, but not sooner than :data:`PACE_TICK_S` after it last looked;
 * **tap** (``forward=False``, ``--tap``): the two receive lines of a Y-cable; only read, never
   a byte written to either.
 
 Each chunk is reported as ``on_bytes(t, direction, data)``: ``direction`` is
 :data:`~helmcheck.grammar.wirelog.TO_VEHICLE` for bytes the backseat sent and
 :data:`~helmcheck.grammar.wirelog.FROM_VEHICLE` for the vehicle's; ``t`` is read from ``clock``
-(one clock for both directions) right after the read, before forwarding. The callback runs after
-the forwarding write, so slow judging never delays a forwarded byte; it should be quick (append
-to a log) because the next read waits for it. The judges run in a process of their own
-(:mod:`.live`); any other thread of this process (the main loop, a live screen) shares the
-interpreter lock with this one, so while a relay runs the interpreter's switch interval is
-:data:`SWITCH_INTERVAL_S`: such a thread holds a read byte back at most that long
-(``benchmarks/monitor_bench.py`` measures what it all comes to). With ``realtime`` (the
-default) the thread asks for the lowest real-time priority (Linux ``SCHED_FIFO``
-:data:`RT_PRIORITY`), so that a waking relay is not queued behind whatever else keeps the CPUs
-busy; it blocks in ``select`` between chunks, so it takes no CPU it does not use. Without the
-permission (root, ``CAP_SYS_NICE``, or an ``rtprio`` limit of at least :data:`RT_PRIORITY`) it
-runs at normal priority; :attr:`Relay.priority` says which, once :meth:`started` returns. Sides coming and going are
-``on_event(t, kind, side)``: ``connect``/``disconnect`` (a TCP server link's client) or
-``closed`` (the link raised :class:`~helmcheck.line.link.LinkClosed`: a pty or device gone);
-the relay keeps serving the other side. RH-FRM-9: the line is 8N1 and a TCP byte stream carries
-the same bytes, so every link is the same byte stream here. The caller opens and closes links.
+(one clock for both directions). Without a stage the chunk is what was read, ``t`` read right
+after the read, before forwarding; with a stage it is what was delivered, ``t`` read right
+before the write. The callback runs after the forwarding write, so slow judging never delays a
+forwarded byte; it should be quick (append to a log) because the next read waits for it.
+``on_idle(t)``, if given, is called once per turn of the loop (at least every :data:`_IDLE` s).
+The judges run in a process of their own (:mod:`helmcheck.monitor.live`); any other thread of
+this process (the main loop, a live screen) shares the interpreter lock with this one, so while
+a relay runs the interpreter's switch interval is :data:`SWITCH_INTERVAL_S`: such a thread
+holds a read byte back at most that long (``benchmarks/monitor_bench.py`` measures what it all
+comes to). With ``realtime`` (the default) the thread asks for the lowest real-time priority
+(Linux ``SCHED_FIFO`` :data:`RT_PRIORITY`), so that a waking relay is not queued behind
+whatever else keeps the CPUs busy; it blocks in ``select`` between chunks, so it takes no CPU it
+does not use. Without the permission (root, ``CAP_SYS_NICE``, or an ``rtprio`` limit of at
+least :data:`RT_PRIORITY`) it runs at normal priority; :attr:`Relay.priority` says which, once
+:meth:`started` returns. Sides coming and going are ``on_event(t, kind, side)``:
+``connect``/``disconnect`` (a TCP server link's client), ``closed`` (the link raised
+:class:`~helmcheck.line.link.LinkClosed`: a pty or device gone), ``unplugged``/``replugged``
+(a stage's cut); the relay keeps serving the other side. RH-FRM-9: the line is 8N1 and a TCP
+byte stream carries the same bytes, so every link is the same byte stream here. The caller
+opens and closes links (a replugged one included).
 """
 
 from __future__ import annotations
@@ -45,7 +58,8 @@ import time
 from typing import Callable, Optional
 
 from ..grammar.wirelog import FROM_VEHICLE, TO_VEHICLE
-from ..line.link import Link, LinkClosed
+from .impair import BYTES, NOTE, REPLUG, UNPLUG, ImpairedLine
+from .link import Link, LinkClosed
 
 __all__ = ["Relay", "SIDES"]
 
@@ -55,6 +69,16 @@ _GOES_TO = {TO_VEHICLE: "vehicle", FROM_VEHICLE: "backseat"}  # the side a direc
 _IDLE = 0.05  # the longest select wait: a side without a descriptor, a missed wake-up
 _NO_FD_WAIT = 0.005  # the wait when a side has no descriptor (pyserial loop://) and is polled
 _MAX_WRITE = 65536  # the most offered to one write_some
+#: How often a side that could not be plugged back after a cut is tried again.
+REPLUG_RETRY_S = 0.25
+#: With a stage, the shortest wait for something due later: what falls due within it is done
+#: together at its end (a paced byte is never early, and at most this late, plus the host's
+#: scheduling). One wake a byte would cost a third of a CPU at 115200 baud both ways; a USB
+#: serial adapter delivers in chunks of a millisecond or more anyway.
+PACE_TICK_S = 0.001
+#: With a stage, the most read from a side at a time: the stage handles bytes one by one, so a
+#: long burst taken at once would hold back what falls due meanwhile (about 4 ms a kilobyte).
+STAGE_READ = 256
 #: The interpreter's thread switch interval while a relay runs (Python's default is 5 ms): another
 #: thread holding the interpreter lock hands it over within this, so a byte read waits on it at
 #: most this long before it is forwarded.
@@ -68,10 +92,15 @@ def _ignore(t: float, kind: str, side: str) -> None:  # noqa: ARG001 - the defau
     pass
 
 
+def _no_note(t: float, text: str) -> None:  # noqa: ARG001 - the default on_note
+    pass
+
+
 class Relay(threading.Thread):
     """Reads ``backseat`` and ``vehicle`` (both :class:`~helmcheck.line.link.Link`), forwards
-    when ``forward``, reports each chunk to ``on_bytes(t, direction, data)`` and each side's
-    ``connect``/``disconnect``/``closed`` to ``on_event(t, kind, side)``.
+    when ``forward`` (through ``stage`` when given), reports each chunk to
+    ``on_bytes(t, direction, data)`` and each side's ``connect``/``disconnect``/``closed``/
+    ``unplugged``/``replugged`` to ``on_event(t, kind, side)`` (module docstring).
 
     :meth:`start` it; :meth:`stop` ends it promptly (a self-pipe wakes the loop). An exception
     that ended the thread (raised by a link or a callback) is in :attr:`error`."""
@@ -80,8 +109,24 @@ class Relay(threading.Thread):
                  on_bytes: Callable[[float, str, bytes], None],
                  on_event: Callable[[float, str, str], None] = _ignore,
                  clock: Callable[[], float] = time.monotonic, name: str = "helmcheck-relay",
-                 realtime: bool = True):
+                 realtime: bool = True, stage: Optional[ImpairedLine] = None,
+                 on_note: Callable[[float, str], None] = _no_note, cut_side: str = "backseat",
+                 unplug: Optional[Callable[[str, Link], None]] = None,
+                 replug: Optional[Callable[[str], Optional[Link]]] = None,
+                 on_idle: Optional[Callable[[float], None]] = None):
         super().__init__(name=name, daemon=True)
+        if stage is not None and not forward:
+            raise ValueError("an impairment stage needs the relay in line (forward=True)")
+        if cut_side not in SIDES:
+            raise ValueError(f"cut_side must be one of {SIDES}, not {cut_side!r}")
+        self.stage = stage
+        self.on_note = on_note
+        self.cut_side = cut_side
+        self._unplug_cb = unplug
+        self._replug_cb = replug
+        self.on_idle = on_idle
+        self.unplugged: set[str] = set()  #: sides a cut has unplugged, not yet back
+        self._replug_at: dict[str, float] = {}  # side -> when to try plugging it back (again)
         self.realtime = realtime
         #: the thread's scheduling, once running: "real-time" or "normal (…why…)"
         self.priority = ""
@@ -158,7 +203,7 @@ class Relay(threading.Thread):
         wfds: dict[int, str] = {}
         unselectable: list[str] = []
         for side in SIDES:
-            if side in self.closed:
+            if side in self.closed or side in self.unplugged:
                 continue
             try:
                 fd = self.links[side].fileno()  # re-read each turn: a TCP server's changes
@@ -169,6 +214,12 @@ class Relay(threading.Thread):
             if self.forward and self._pending[_READS[_other(side)]]:
                 wfds[fd] = side
         timeout = _NO_FD_WAIT if unselectable else _IDLE
+        if self.stage is not None:
+            now = self.clock()
+            wake = [t for t in (self.stage.next_due(), *self._replug_at.values()) if t is not None]
+            if wake:
+                left = min(wake) - now
+                timeout = min(timeout, 0.0 if left <= 0 else max(left, PACE_TICK_S))
         r, w, _ = select.select([self._wake_r, *rfds], list(wfds), [], timeout)
         if self._wake_r in r:
             try:
@@ -182,14 +233,18 @@ class Relay(threading.Thread):
         for side in [rfds[fd] for fd in r if fd in rfds] + unselectable:
             if side not in self.closed:
                 self._read(side)
+        if self.stage is not None:
+            self._run_stage()
         if self.forward:
             for side in unselectable:  # no descriptor to wait on for writability
                 self._flush(_READS[_other(side)])
+        if self.on_idle is not None:
+            self.on_idle(self.clock())
 
     def _read(self, side: str) -> None:
         link = self.links[side]
         try:
-            events = link.poll()
+            events = link.poll() if self.stage is None else link.poll(STAGE_READ)
         except LinkClosed:
             self._gone(side)
             return
@@ -197,10 +252,13 @@ class Relay(threading.Thread):
         direction = _READS[side]
         for ev in events:
             if ev.kind == "data" and ev.data:
-                if self.forward:
-                    self._send(direction, ev.data)
                 self._stats["bytes"][direction] += len(ev.data)
                 self._stats["chunks"][direction] += 1
+                if self.stage is not None:
+                    self.stage.push(t, direction, ev.data)
+                    continue
+                if self.forward:
+                    self._send(direction, ev.data)
                 self.on_bytes(t, direction, ev.data)
             elif ev.kind in ("connect", "disconnect"):
                 if ev.kind == "disconnect":  # what waited for that client is not for the next one
@@ -222,9 +280,58 @@ class Relay(threading.Thread):
         self._flush(direction)
 
     def _reachable(self, side: str) -> bool:
-        """False for a side closed for good and a TCP server with no client (its link would
-        take the bytes and drop them, like an unplugged line)."""
-        return side not in self.closed and self.links[side].connected
+        """False for a side closed for good or unplugged, and a TCP server with no client (its
+        link would take the bytes and drop them, like an unplugged line)."""
+        return side not in self.closed and side not in self.unplugged and self.links[side].connected
+
+    # ------------------------------------------------------------------ the stage
+    def _run_stage(self) -> None:
+        """Carry out what the stage says is due now (module docstring)."""
+        stage = self.stage
+        for a in stage.due(self.clock()):  # type: ignore[union-attr]
+            if a.kind == BYTES:
+                t = self.clock()
+                self._send(a.direction, a.data)
+                self.on_bytes(t, a.direction, a.data)
+            elif a.kind == NOTE:
+                self.on_note(a.t, a.text)
+            elif a.kind == UNPLUG:
+                self._unplug(self.cut_side)
+            elif a.kind == REPLUG:
+                self._replug_at[self.cut_side] = self.clock()
+        now = self.clock()
+        for side, when in list(self._replug_at.items()):
+            if when <= now:
+                self._replug(side)
+
+    def _unplug(self, side: str) -> None:
+        if side in self.closed or side in self.unplugged:
+            return
+        self.unplugged.add(side)
+        self._forget(_READS[_other(side)])
+        if self._unplug_cb is not None:
+            self._unplug_cb(side, self.links[side])
+        self.on_event(self.clock(), "unplugged", side)
+
+    def _replug(self, side: str) -> None:
+        if side not in self.unplugged:
+            self._replug_at.pop(side, None)
+            return
+        link = None
+        if self._replug_cb is not None:
+            try:
+                link = self._replug_cb(side)
+            except OSError:
+                link = None
+        else:
+            link = self.links[side]
+        if link is None:
+            self._replug_at[side] = self.clock() + REPLUG_RETRY_S
+            return
+        self._replug_at.pop(side, None)
+        self.links[side] = link
+        self.unplugged.discard(side)
+        self.on_event(self.clock(), "replugged", side)
 
     def _flush(self, direction: str) -> None:
         pending = self._pending[direction]
@@ -238,7 +345,7 @@ class Relay(threading.Thread):
 
     def _write(self, direction: str, data: bytes) -> int:
         side = _GOES_TO[direction]
-        if side in self.closed:
+        if side in self.closed or side in self.unplugged:
             return 0
         try:
             return self.links[side].write_some(data)
