@@ -7,6 +7,8 @@ reads them. Modules:
 * :mod:`~helmcheck.judge.verdict` — :class:`Verdict`, the one type of a clause or run verdict;
 * :mod:`~helmcheck.judge.ledger` — the one verdict ledger and its one combining rule;
 * :mod:`~helmcheck.judge.timing` — RH-TIM-1 tolerances, observer slack, the ACK window;
+* :mod:`~helmcheck.judge.linebudget` — what the line costs the observer (reply latency, transmit
+  time, the host's jitter, at the time scale) and which durations it can time on it;
 * :mod:`~helmcheck.judge.facts` — protocol facts derived from the transition table;
 * :mod:`~helmcheck.judge.wire` — wire events and the recorder notes a judge understands;
 * :mod:`~helmcheck.judge.runfacts` — the run facts (selection, the implementation's end, a

@@ -12,6 +12,9 @@ entry point is :func:`.runner.certify`. Modules, one concern each:
 * :mod:`.catalogue` — the numbered, data-described clause cases (description, expectation,
   steps); :mod:`.steps` — their step vocabulary; :mod:`.interpreter` — runs a case's steps.
 * :mod:`.session` — runs steps against a vehicle: verified reset, send, poll, timed waits.
+* :mod:`.linemeter` — what the line costs, measured as the run goes (reply latency, the host's
+  jitter, the report's size); :mod:`.durations` — the timeouts, parks and waits chosen from it
+  so that the observer can time every one (or a case NOT-TESTED before it runs).
 * :mod:`.flow` — how a case stops early (flow control, never a verdict).
 * :mod:`.explore` — hypothesis sequences aimed at the model (:mod:`.machine`: the rules and
   episodes), shrunk on failure, within a budget
