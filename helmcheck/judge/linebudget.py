@@ -58,6 +58,7 @@ from ..model.timers import tolerance
 from .timing import JITTER_S
 
 __all__ = ["LineBudget", "MARGIN", "POLL_PAUSE_S", "OSI_BYTES", "POLL_BYTES", "ACK_BYTES", "planning_latency",
+           "planning_spread",
            "parse_budget", "BAUDS", "assumed"]
 
 #: Every uncertainty a tester's choice rests on is taken 1.25 times (a choice that only just fits
@@ -76,6 +77,15 @@ BAUDS = (9600, 19200, 57600, 115200)
 ASSUMED_LATENCY_S = 0.05
 
 
+def planning_spread(samples: Iterable[float], window_s: float) -> float:
+    """How much later than another a line may be answered: the measured spread a tenth more and
+    10 ms (:func:`planning_latency`'s rule), never more than the ACK window."""
+    xs = [x for x in samples if x == x]
+    if not xs:
+        return min(window_s, ASSUMED_LATENCY_S * 1.1 + 0.01)
+    return min(window_s, (max(xs) - min(xs)) * 1.1 + 0.01)
+
+
 def planning_latency(samples: Iterable[float], window_s: float) -> float:
     """The reply latency a tester plans with: the largest measured and a tenth more, and 10 ms,
     never more than the ACK window (RH-ACK-2)."""
@@ -91,6 +101,10 @@ class LineBudget:
     baud: int
     latency_s: float  #: the planning reply latency (:func:`planning_latency`)
     jitter_s: float = JITTER_S
+    #: how much later one line may be answered than the line before it (the spread of the measured
+    #: latencies, planned like the latency): what separates two lines written together, such as
+    #: an ``$OXFLT`` and the commands after it (RH-ACK-6: in arrival order)
+    spread_s: float = ASSUMED_LATENCY_S
     osi_bytes: int = OSI_BYTES
     resolution: float = 1e-6
     latency_p50: Optional[float] = None  #: measured, for the report
@@ -197,12 +211,13 @@ class LineBudget:
         p50 = "-" if self.latency_p50 is None else f"{self.latency_p50:.4f}"
         p99 = "-" if self.latency_p99 is None else f"{self.latency_p99:.4f}"
         return (f"line budget: baud {self.baud} latency {self.latency_s:.4f} p50 {p50} p99 {p99} "
-                f"samples {self.samples} jitter {self.jitter_s:.4f} osi {self.osi_bytes} k {self.k:g}")
+                f"samples {self.samples} jitter {self.jitter_s:.4f} osi {self.osi_bytes} k {self.k:g} "
+                f"spread {self.spread_s:.4f}")
 
     def as_dict(self) -> dict:
         """For ``results.json`` ``settings.line_budget``."""
         return {"baud": self.baud, "time_scale": self.k, "measured": self.measured,
-                "latency_planned_s": round(self.latency_s, 4),
+                "latency_planned_s": round(self.latency_s, 4), "spread_planned_s": round(self.spread_s, 4),
                 "latency_p50_s": None if self.latency_p50 is None else round(self.latency_p50, 4),
                 "latency_p99_s": None if self.latency_p99 is None else round(self.latency_p99, 4),
                 "samples": self.samples, "jitter_s": round(self.jitter_s, 4), "osi_bytes": self.osi_bytes,
@@ -216,7 +231,7 @@ def assumed(k: float, baud: int, window_s: float = 1.0) -> LineBudget:
 
 
 _NOTE = re.compile(r"^line budget: baud (\d+) latency ([0-9.]+) p50 (\S+) p99 (\S+) samples (\d+) "
-                   r"jitter ([0-9.]+) osi (\d+) k ([0-9.eE+-]+)")
+                   r"jitter ([0-9.]+) osi (\d+) k ([0-9.eE+-]+)(?: spread ([0-9.]+))?")
 
 
 def parse_budget(text: str) -> Optional[LineBudget]:
@@ -229,4 +244,5 @@ def parse_budget(text: str) -> Optional[LineBudget]:
         return None if x == "-" else float(x)
     return LineBudget(k=float(m.group(8)), baud=int(m.group(1)), latency_s=float(m.group(2)),
                       jitter_s=float(m.group(6)), osi_bytes=int(m.group(7)), latency_p50=opt(m.group(3)),
-                      latency_p99=opt(m.group(4)), samples=int(m.group(5)), measured=True)
+                      latency_p99=opt(m.group(4)), samples=int(m.group(5)), measured=True,
+                      spread_s=float(m.group(9)) if m.group(9) else float(m.group(2)))

@@ -137,7 +137,7 @@ CASES: tuple[Case, ...] = (
        Send("OJW,{wp_other}"), Poll(mode="N"), Send(OMS), Poll(mode="A"), Settle("remote"), Poll(mode="N|P")),
     _c("V-23", "RH-INT-2", "Control released to the mission park (P)",
        "a servo control taken 5 s into a mission park ends in P with the park time left at takeover",
-       "P", Wait(5.0), Send(OMS), Poll(mode="A"), Wait(5.0), Settle("remote"), Poll(mode="P")),
+       "P", Wait(5.0), Send(OMS), Poll(mode="A"), Settle("remote"), Poll(mode="P")),
     _c("V-24", "RH-INT-3", "An interrupted $OPK park is abandoned",
        "$OPK then $OMS: when the servo times out the mission resumes, not the park", "N",
        Send("OPK,{lat},{lon},5,{speed}"), Poll(mode="mP"), Send(OMS), Poll(mode="A"),
@@ -202,9 +202,9 @@ CASES: tuple[Case, ...] = (
        Send("OPK,{lat},{lon},1,{speed}", expect="$ACK,11,0,0"), Poll(mode="mP")),
     _c("V-37", "RH-PK-2", "$OPK park counts down on station",
        "mode mP; field 10 counts down from minutes×60 once on station (parked where the vehicle is)",
-       "N", Send(OMS0), Poll(), Send("OPK,{lat},{lon},2,{speed}"), Poll(mode="mP"),
-       Until("the $OPK countdown", mode="mP", park_below=120, budget_v=60.0),
-       Wait(10.0), Poll(mode="mP", park_below=115)),
+       "N", Send(OMS0), Poll(), Send("OPK,{lat},{lon},{opk_long},{speed}"), Poll(mode="mP"),
+       Until("the $OPK countdown", mode="mP", park_below="{opk_long_s}", budget_v=60.0),
+       Wait(10.0), Poll(mode="mP", park_below="{opk_long_below}")),
     _c("V-64", "RH-PK-2", "$OPK counts only once on station",
        "an $OPK 15 m away: mode mP at once, field 10 stays at minutes×60 while field 7 shows more than "
        "3 m, then counts down once on station (RH-RD-5)", "N",
@@ -321,7 +321,7 @@ CASES: tuple[Case, ...] = (
        "under water, $OMS is refused (26)", "N",
        Send(OMS_DIVE), Until("under water", mode="A", submerged=True, depth_at_least="{dive_at}", budget_v=300.0),
        Fault("Sed"), Settle("lockout", probe=OMP_HOLD), Poll(mode="M", submerged=True),
-       Send(OMS, expect="$ACK,9,1,26"), Poll(mode="M"), needs=("violation",)),
+       Send(OMS, expect="$ACK,9,1,26"), Poll(mode="M"), needs=("violation", "ascent")),
     _c("V-61", "RH-SAF-4", "At the surface the SafetyAction runs",
        "with SafetyAction park the vehicle parks at the surface: mode P, P0, the code kept", "N",
        Fault("Sfp"), Settle("lockout"),
@@ -380,7 +380,7 @@ def unmet_need(case: Case, profile: Profile, durations=None) -> Optional[str]:
             return f"the profile's $OSI has {profile.osi_fields} fields: none shows whether the SRP runs"
         if kind == "cmd" and arg not in profile.commands:
             return f"the profile does not claim ${arg}"
-        if kind == "lockout":
+        if kind in ("lockout", "ascent"):
             continue  # the line's (line_needs)
     cmds = {b.body.split(",")[0] for b in _sends(case.steps)}
     missing = sorted(c for c in cmds if c in s.__dict__ and c not in profile.commands and c != "OSD")
@@ -400,7 +400,7 @@ def line_needs(case: Case) -> list[str]:
     """What the line must allow for ``case``: a timeable duration for every timer it sets going and
     then times (a ``Settle`` of a remote control or an ``$OPK``), and ``lockout`` where its commands
     must reach the vehicle inside a lockout (:meth:`.durations.Durations.unmet`)."""
-    out = [n for n in case.needs if n == "lockout"]
+    out = [n for n in case.needs if n in ("lockout", "ascent")]
     if any(isinstance(st, Settle) and st.timer in ("remote", "opk") for st in case.steps):
         for st in _sends(case.steps):
             for key, need in _TIMED_KEYS.items():

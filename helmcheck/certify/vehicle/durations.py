@@ -19,6 +19,8 @@ The keys :meth:`Durations.context` adds to a case's templates (:mod:`.interprete
 ``to_restart``  a timeout restarted ``gap`` into it, both deadlines told apart (RH-SRV-3)
 ``gap``         vehicle seconds between the two ``$OMS`` of ``to_restart``
 ``opk_min``     ``$OPK`` minutes whose countdown is timed (RH-PK-3); ``opk_s`` the seconds
+``opk_long``    ``$OPK`` minutes that outlast a report, a countdown seen starting and a wait of
+                10 s after it (RH-PK-2); ``opk_long_s`` the seconds, ``opk_long_below`` 5 less
 ``qpark``       a park time on a queued ``$OMW`` waypoint the observer can time (RH-OMW-4)
 ``dive_depth``  the depth of the dive before a violation (10 m, at most half the depth range)
 ``dive_at``     the depth at which the dive counts as under way (four fifths of it)
@@ -28,7 +30,8 @@ Decisions (the profile is silent): a dive goes to 10 m (at the bench speed it ta
 case that needs the vehicle under water after a lockout sends the ``$OMP`` that holds its depth
 (RH-RD-12) as the probe that finds the lockout's end, so no ascent rate is assumed; a lockout's
 commands go in one burst after the violation, and need the lockout to last the burst's
-processing with the observer's margin.
+processing with the observer's margin; the case that needs the vehicle still under water after a
+lockout assumes an ascent of :data:`ASCENT_MPS` and says so where the line makes it matter.
 """
 
 from __future__ import annotations
@@ -45,7 +48,10 @@ __all__ = ["Durations", "derive", "BURST_BYTES", "DURATION_KEYS"]
 
 #: The template keys :meth:`Durations.context` fills.
 DURATION_KEYS = ("to", "to_long", "to_tim", "to_restart", "gap", "opk_min", "opk_s", "qpark", "dive_depth",
-                 "dive_at")
+                 "dive_at", "opk_long", "opk_long_s", "opk_long_below")
+#: The ascent rate (m/s) after a lockout a case plans for (the reference emulator's): the profile
+#: sets none, so a case that needs the vehicle under water after a lockout says so when it is assumed.
+ASCENT_MPS = 0.3
 
 #: Bytes of the burst of commands a lockout case sends after the violation.
 BURST_BYTES = 90
@@ -64,8 +70,10 @@ class Durations:
     to_restart: Optional[int]
     gap: float
     opk_min: Optional[int]
+    opk_long: int
     qpark: Optional[int]
     lockout_ok: bool
+    ascent_ok: bool
     lockout_s: float
     seen_by_poll: bool  #: the violation is seen by a poll first (not ``$OXFLT``, RH-SAF-5)
     dive_depth: float
@@ -77,7 +85,8 @@ class Durations:
         for key in ("to", "to_long", "to_tim", "to_restart"):
             ctx[key] = str(getattr(self, key) or self.hi)
         m = self.opk_min or 1440
-        ctx.update(opk_min=str(m), opk_s=str(60 * m), qpark=str(self.qpark or 86400))
+        ctx.update(opk_min=str(m), opk_s=str(60 * m), qpark=str(self.qpark or 86400), opk_long=str(self.opk_long),
+                   opk_long_s=str(60 * self.opk_long), opk_long_below=str(60 * self.opk_long - 5))
         return ctx
 
     def unmet(self, need: str) -> Optional[str]:
@@ -95,6 +104,11 @@ class Durations:
             hi = 1440 * 60 if arg == "opk" else self.hi
             return (f"no {what} the profile allows (up to {hi} s) can be timed on this line at time scale "
                     f"{b.k:g} (RH-TIM-1: {b.describe()}); run at {b.advice(self.lo, hi)}")
+        if kind == "ascent" and not self.ascent_ok:
+            return (f"after the lockout the vehicle may reach the surface from {0.8 * self.dive_depth:g} "
+                    f"{self.depth_unit} before a command can be answered on this line at time scale {b.k:g} "
+                    f"(RH-SAF-3: assuming an ascent of {ASCENT_MPS:g} m/s; {b.describe()}); run at "
+                    f"{_ascent_advice(b, self.dive_depth, self.depth_unit)}")
         if kind == "lockout" and not self.lockout_ok:
             return (f"the {self.lockout_s:g} s lockout ends before the commands sent into it can be "
                     f"answered on this line at time scale {b.k:g} (RH-SAF-1: {b.describe()}); run at "
@@ -102,10 +116,30 @@ class Durations:
         return None
 
 
+def _ascent_fits(b: LineBudget, dive_depth: float, unit: str) -> bool:
+    """Does the ascent from the dive outlast one probe's round trip (the ``$OMP`` that finds the
+    lockout's end and holds the depth, RH-RD-12)?"""
+    metres = 0.8 * dive_depth * (1.0 if unit == "m" else 0.3048)
+    return metres / ASCENT_MPS >= MARGIN * (b.k * b.rtt_s + b.observe_v)
+
+
+def _ascent_advice(b: LineBudget, dive_depth: float, unit: str) -> str:
+    k = b.k
+    while k > 1:
+        k = math.floor(k) - 1 if k > 2 else 1
+        if _ascent_fits(b.at(k=k), dive_depth, unit):
+            return f"--time-scale {k:g}"
+    return "a vehicle that answers sooner"
+
+
 def _lockout_fits(b: LineBudget, lockout_s: float, seen_by_poll: bool = False) -> bool:
     """Do the commands of a lockout case, one burst written right after the violation (or after the
     poll that saw a violation the vehicle raised itself), reach the vehicle inside the lockout?"""
-    need = b.command_v + b.k * b.tx(BURST_BYTES) + MARGIN * b.observe_v + (b.poll_v if seen_by_poll else 0.0)
+    if seen_by_poll:  # the burst goes after the report that showed the violation, and is answered late
+        need = b.poll_v + b.command_v
+    else:  # written with the $OXFLT: answered at most the latencies' spread after it (RH-ACK-6)
+        need = b.k * (b.spread_s + b.jitter_s)
+    need += b.k * b.tx(BURST_BYTES) + MARGIN * b.observe_v
     return need + tolerance(lockout_s) <= lockout_s
 
 
@@ -139,10 +173,11 @@ def derive(profile: Profile, budget: LineBudget) -> Durations:
             gap = b.gap_v(hi)
     opk = b.shortest(60, 1440 * 60, unseen_start=True)
     opk_min = None if opk is None else int(math.ceil(opk / 60))
+    opk_long = max(2, int(math.ceil((2 * b.hold_v + 3 * MARGIN * b.poll_v + 10.0) / 60)))
     qpark = b.shortest(1, 86400, hold=False, unseen_start=True)
     depth_m = min(profile.max_depth_m / 2, 10.0)
     depth = float(math.floor(depth_m if profile.depth_unit == "m" else depth_m / 0.3048))
     by_poll = profile.trigger != "oxflt"
-    return Durations(b, lo, hi, to, to_long, to_tim, to_restart, round(gap, 1), opk_min, qpark,
-                     _lockout_fits(b, profile.lockout_s, by_poll), profile.lockout_s, by_poll, depth,
-                     profile.depth_unit)
+    return Durations(b, lo, hi, to, to_long, to_tim, to_restart, round(gap, 1), opk_min, opk_long, qpark,
+                     _lockout_fits(b, profile.lockout_s, by_poll), _ascent_fits(b, depth, profile.depth_unit),
+                     profile.lockout_s, by_poll, depth, profile.depth_unit)

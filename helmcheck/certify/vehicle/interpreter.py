@@ -351,10 +351,9 @@ def _violation(session: Session, st: Fault, ctx: dict) -> None:
     trig = p.trigger
     then = [frame(fill(body, ctx)) for body in st.then]
     if trig == "oxflt" or "oxflt" in session.case_needs:
-        if then:
-            session.burst([frame(f"OXFLT,{st.code}"), *then])
-        else:
-            session.exchange(frame(f"OXFLT,{st.code}"))
+        # with a line after it in the same write: its answer bounds when the violation began
+        # (the judge's window), whatever the vehicle's latency
+        session.burst([frame(f"OXFLT,{st.code}"), *(then or [frame("OSD,S")])])
         return
     _raised(session, st, trig)
     if then:

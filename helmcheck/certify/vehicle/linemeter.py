@@ -19,7 +19,7 @@ from collections import deque
 from typing import Optional
 
 from ...grammar.wirelog import transmit_time
-from ...judge.linebudget import OSI_BYTES, LineBudget, planning_latency
+from ...judge.linebudget import OSI_BYTES, LineBudget, planning_latency, planning_spread
 from ...judge.timing import JITTER_S
 
 __all__ = ["LineMeter", "host_jitter", "LINK_PROBES"]
@@ -71,6 +71,7 @@ class LineMeter:
         p50 = statistics.median(lats) if lats else None
         p99 = sorted(lats)[min(len(lats) - 1, int(0.99 * len(lats)))] if lats else None
         return LineBudget(k=self.k, baud=self.baud, latency_s=planning_latency(lats, self.window_s),
+                          spread_s=planning_spread(lats, self.window_s),
                           jitter_s=self.jitter, osi_bytes=self.osi_bytes or OSI_BYTES, latency_p50=p50,
                           latency_p99=p99, samples=len(lats), measured=self.measured)
 

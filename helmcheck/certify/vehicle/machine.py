@@ -500,8 +500,7 @@ def machine(state, p, tos, deep: bool = True):
                 if dive and mode() in ("N", "P"):
                     send(frame(fill("OMS,90,{dive_depth},20,{speed},120", self.ctx)))
                     session.wait(10.0)
-                session.exchange(frame(f"OXFLT,{code}"))
-                session.poll()
+                session.burst([frame(f"OXFLT,{code}"), frame("OSD,S")])  # its answer bounds the violation
                 send(frame(fill(inside, self.ctx)))
                 probe = next((frame(b) for b in ("ORWSET,Sle,R", "OLOGL,probe") if b[:b.index(",")] in claimed),
                              None)

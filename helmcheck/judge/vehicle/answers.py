@@ -129,17 +129,26 @@ class Answers:
     def _bound_oxflt(self, p: Sent, t_reply: float) -> None:
         """An ``$OXFLT`` raises its violation when the vehicle processes it (RH-SAF-5), which no
         answer shows: some time after it was sent and before the vehicle answers a line sent after
-        it (RH-ACK-6: arrival order). The mirror applied it at the send; from the first such
-        answer on, every candidate carries that window as uncertainty on the timers the
-        violation started (the lockout, RH-SAF-1), as for an unseen event (:mod:`.closure`)."""
+        it (RH-ACK-6: arrival order). The mirror takes it in at the first such answer, at the
+        instant that answer went out (the latest it can have been), and every candidate carries the
+        window since the send as uncertainty on the timers it started (the lockout, RH-SAF-1), as
+        for an unseen event (:mod:`.closure`): a vehicle that answers every line late has its
+        lockout timed from about when it began, whatever its latency."""
         if self.oxflt_open is None or p.seq < self.oxflt_open[1]:
             return
-        t0 = self.oxflt_open[0]
+        self._apply_oxflt(t_reply)
+
+    def _apply_oxflt(self, t_reply: float) -> None:
+        """The pending ``$OXFLT`` into the mirror, taken in by ``t_reply`` (:meth:`_bound_oxflt`)."""
+        t0, _, item = self.oxflt_open
         self.oxflt_open = None
-        lo, hi = self.v(t0), self.v(max(t0, t_reply))
+        t1 = max(t0, t_reply)
+        self.beliefs.command(item, self.v(t1), self.slack_v(), [])
+        lo, hi = self.v(t0), self.v(t1)
         for c in self.beliefs.cands:
             c.extra_v = max(c.extra_v, hi - lo)
             c.window = (lo, hi)
+            c.carried = c.carried | {"lockout"}
 
     def _answered(self, p: Sent, a: s.ACK, t: float, evd: Evidence, late: bool) -> None:
         p.state, p.ack, p.t_ack = "answered", a, t

@@ -68,6 +68,8 @@ def retime(c: Candidate, osi: s.OSI, v_sent: float, v_recv: float, slack_v: floa
     start = deadline - dur
     lo_w, hi_w = c.window
     if not lo_w - 1e-6 <= start <= hi_w + 1e-6:
+        if name in c.carried:  # resumed after a freeze: what was left carries the window's width
+            _redate(c, name, dur, deadline, osi, v_sent, v_recv, slack_v)
         return
     lo = max(lo_w, v_sent - dur + osi.park_time - 1.0 - slack_v)
     hi = min(hi_w, v_recv - dur + osi.park_time + slack_v)
@@ -76,6 +78,22 @@ def retime(c: Candidate, osi: s.OSI, v_sent: float, v_recv: float, slack_v: floa
     mid = (lo + hi) / 2
     m.timers.arm(name, mid, dur)
     c.window = (lo, hi)
+    c.extra_v = (hi - lo) / 2
+    for tt in c.timed:
+        tt.extra_v = min(tt.extra_v, c.extra_v)
+
+
+def _redate(c: Candidate, name: str, dur: float, deadline: float, osi: s.OSI, v_sent: float, v_recv: float,
+            slack_v: float) -> None:
+    """A countdown frozen and resumed since an adopted event started it (``Candidate.carried``):
+    its deadline is uncertain by the window either way; the displayed park time narrows it."""
+    width = c.extra_v
+    lo = max(deadline - width, v_sent + osi.park_time - 1.0 - slack_v)
+    hi = min(deadline + width, v_recv + osi.park_time + slack_v)
+    if lo > hi:
+        return
+    mid = (lo + hi) / 2
+    c.model.timers.arm(name, mid - dur, dur)
     c.extra_v = (hi - lo) / 2
     for tt in c.timed:
         tt.extra_v = min(tt.extra_v, c.extra_v)

@@ -8,7 +8,9 @@ never their values) and keeps, besides the model, what judging needs and the mod
   plausible) and what they were;
 * ``extra_v`` — vehicle seconds of uncertainty an adopted event's time window adds to every
   timer it started (RH-TIM-1: the observer widens by what it cannot see); it lapses when no timer
-  started inside the window is left;
+  started inside the window is left — nor one that did and was frozen and resumed since (a mission
+  park frozen by remote control resumes with what was left of it, which the window's uncertainty
+  still has: ``carried``, RH-INT-2, RH-RD-5);
 * ``pending`` — table rows applied since the last confirming ``$OSI``: their clauses pass when an
   ``$OSI`` confirms the state they led to (rows that change nothing visible pass at their ACK);
 * ``timed`` — timer-driven transitions awaiting their RH-TIM-1 bracket (:class:`Timed`);
@@ -73,6 +75,11 @@ class Timed:
         return tuple(c for c in self.row.clauses if c in TIMED_CLAUSES)
 
 
+def _started_in(t, name: str, lo: float, hi: float) -> bool:
+    d, dur = t.deadline(name), t.duration(name)
+    return d is not None and dur is not None and lo - 1e-6 <= d - dur <= hi + 1e-6
+
+
 def sig(m: VehicleModel) -> tuple:
     """What an ``$OSI`` shows of the judged state: mode, field 3, error state, SRP flag."""
     return (m.mode, m.osi_waypoint, m.error_state, m.srp_active)
@@ -83,7 +90,7 @@ class Candidate:
 
     __slots__ = ("model", "events", "story", "extra_v", "window", "pending", "timed", "abandoned",
                  "s_cause", "refused_locked", "seen_v", "seen_mode", "seen_at", "locked_v", "code_unknown",
-                 "refresh", "nav_seen", "fix_seen", "_mode", "_phase")
+                 "refresh", "nav_seen", "fix_seen", "_mode", "_phase", "carried")
 
     def __init__(self, model: VehicleModel):
         if model.trace is None:
@@ -94,6 +101,9 @@ class Candidate:
         self.story: tuple[str, ...] = ()
         self.extra_v = 0.0
         self.window: Optional[tuple[float, float]] = None
+        #: timers started inside ``window`` (their remaining time carries its uncertainty when
+        #: frozen and resumed)
+        self.carried: frozenset = frozenset()
         self.pending: list[Row] = []
         self.timed: list[Timed] = []
         self.abandoned: set[str] = set()
@@ -118,6 +128,7 @@ class Candidate:
         # (RH-TIM-1's slow shadow): a copy answering a command is the same vehicle, not a new one
         c.model._base = self.model.checkpoint
         c.events, c.story, c.extra_v, c.window = self.events, self.story, self.extra_v, self.window
+        c.carried = self.carried
         c.pending = list(self.pending)
         c.timed = [Timed(**vars(t)) for t in self.timed] if self.timed else []
         c.abandoned = set(self.abandoned)
@@ -136,6 +147,9 @@ class Candidate:
         width = max(0.0, hi - lo)
         self.extra_v = max(self.extra_v, width)
         self.window = (lo, hi)
+        t = self.model.timers
+        # an earlier window's timers keep their uncertainty (a later event does not settle them)
+        self.carried = self.carried | frozenset(name for name in t.names() if _started_in(t, name, lo, hi))
         return self
 
     # ------------------------------------------------------------------ the trace
@@ -206,15 +220,22 @@ class Candidate:
         if self.window is None:
             return
         lo, hi = self.window
-        t = self.model.timers
-        for name in t.names():
-            d, dur = t.deadline(name), t.duration(name)
-            if d is not None and dur is not None and lo - 1e-6 <= d - dur <= hi + 1e-6:
-                return
-        if any(x.extra_v for x in self.timed):
+        m = self.model
+        t = m.timers
+        inside = {name for name in t.names() if _started_in(t, name, lo, hi)}
+        self.carried = (self.carried | inside) & self._alive()
+        if self.carried or any(x.extra_v for x in self.timed):
             return
         self.window = None
         self.extra_v = 0.0
+
+    def _alive(self) -> set:
+        """Timers armed now, and a mission park frozen with time left (RH-RD-5)."""
+        m = self.model
+        alive = set(m.timers.names())
+        if m.park_left is not None:
+            alive.add("park")
+        return alive
 
     def signature(self) -> tuple:
         """Equal signatures: the same future as far as judging goes (for de-duplication)."""

@@ -109,9 +109,14 @@ def explain_osi(c: Candidate, osi: s.OSI, v: float, slack_v: float, tp: float, c
                 fix_depth: float, depth_unit: str) -> Optional[Candidate]:
     """A copy of ``c`` with the unseen events that explain ``osi`` (module docstring), or None."""
     m = c.model
+    # the events happened after the last observation that showed they had not (``seen``), but the
+    # model runs forward only: they are applied once the commands since then (whose answers did
+    # not depend on them) have been, and the window from ``seen`` is carried as their uncertainty
+    # — the commands of a slow line can fill much of it
+    seen = min(tp, v)
     tp = max(tp, m.now if m.now is not None else tp)
     tp = min(tp, v)
-    gap = max(0.0, v - tp)
+    gap = max(0.0, v - seen)
     depth = osi_depth_m(osi, depth_unit)
     at_surface = depth is not None and depth <= fix_depth
 
@@ -127,7 +132,7 @@ def explain_osi(c: Candidate, osi: s.OSI, v: float, slack_v: float, tp: float, c
         if ok(trial, early):
             if learn is not None:
                 learn()
-            return trial.adopted(f"{name} between v={tp - early:.1f} and v={v:.1f}", tp - early, v, n)  # type: ignore[union-attr]
+            return trial.adopted(f"{name} between v={seen - early:.1f} and v={v:.1f}", seen - early, v, n)  # type: ignore[union-attr]
         return None
 
     def surfaced(t: Candidate) -> Candidate:
@@ -156,7 +161,7 @@ def explain_osi(c: Candidate, osi: s.OSI, v: float, slack_v: float, tp: float, c
             trials.append((f"safety violation {osi.error_state} and the surface",
                            lambda t: violation(t, True), 2, None))
     if m.phase == "none":
-        motion = _motion_trials(c, osi, tp, gap, catalog)
+        motion = _motion_trials(c, osi, tp, gap, catalog, v)
         trials += motion
         if osi.error_state in _SAFETY and osi.error_state != m.error_state:
             # the way made first, then a violation the vehicle raised by itself (RH-SAF-5) — the
@@ -167,11 +172,29 @@ def explain_osi(c: Candidate, osi: s.OSI, v: float, slack_v: float, tp: float, c
                 if at_surface:
                     trials.append((f"{name}, then safety violation {osi.error_state} and the surface",
                                    _then(build, lambda t: violation(t, True)), n + 2, learn))
+    due = m.timers.due
+    if m.phase == "none" and due is not None and tp <= due <= v:
+        # a timer ran out between the reports (a release to the mission, RH-INT-2), and the way made
+        # after it is unseen too: the same motion, from the state after the timer
+        after = c.clone()
+        after.model.advance(due)
+        after.drain()
+        if after.model.mode != m.mode:
+            for name, build, n, learn in _motion_trials(after, osi, due, gap, catalog, v):
+                trials.append((f"{name} after the {after.model.mode} the timer left it in",
+                               _then(_advance(due), build), n, learn))
     for name, build, n, learn in trials:
         got = run(name, build, n, learn)
         if got is not None:
             return got
     return None
+
+
+def _advance(t_due: float) -> Callable[[Candidate], Candidate]:
+    def build(t: Candidate) -> Candidate:
+        t.model.advance(t_due)
+        return t
+    return build
 
 
 def _then(first: Callable[[Candidate], Optional[Candidate]],
@@ -183,7 +206,7 @@ def _then(first: Callable[[Candidate], Optional[Candidate]],
     return build
 
 
-def _motion_trials(c: Candidate, osi: s.OSI, tp: float, gap: float, catalog) -> list:
+def _motion_trials(c: Candidate, osi: s.OSI, tp: float, gap: float, catalog, v: float) -> list:
     """The plant events that fit ``c``'s mode, each only where it is physically possible.
 
     Nothing moves faster than the profile's ``max_speed_kn`` (or the speed the vehicle itself
@@ -205,7 +228,6 @@ def _motion_trials(c: Candidate, osi: s.OSI, tp: float, gap: float, catalog) -> 
     """
     m = c.model
     out: list = []
-    v = tp + gap
 
     def can_reach(k: int) -> bool:
         return reachable(c, k, v, catalog, float(osi.speed))
@@ -260,6 +282,22 @@ def _motion_trials(c: Candidate, osi: s.OSI, tp: float, gap: float, catalog) -> 
         for n in range(1, min(len(m.queue), MAX_WAYPOINTS) + 1):
             out.append(("queued waypoint reached" if n == 1 else f"{n} queued waypoints reached",
                         queue(n), n, None))
+        whole = len(m.queue)
+        if m.mission is not None and 0 < whole <= MAX_WAYPOINTS and can_reach(m.mission_wp):
+            # the queue done, the mission resumed (RH-OMW-4, RH-INT-2) and its next waypoint reached
+            # too between two reports (a slow line leaves long gaps between them)
+            def then_mission(j: int):
+                def build(t: Candidate) -> Optional[Candidate]:
+                    got = queue(whole)(t)
+                    for _ in range(j):
+                        if got is None or got.model.mode != "N":
+                            return None
+                        got.model.plant(WaypointReached(), tp)
+                    return got
+                return build
+            for j in (1, 2):
+                out.append((f"the queue done, then {j} mission waypoint(s) reached", then_mission(j), whole + j,
+                            None))
     return out
 
 

@@ -83,9 +83,9 @@ class VehicleObserver(Answers, Deadlines):
         self.dead: list[Sent] = []  #: missing while the vehicle said nothing at all (yet)
         self.quiet: list[Sent] = []  #: discarded lines waiting for proof the vehicle listens
         self.last_osd: Optional[Sent] = None
-        #: (wall time, line number) of an ``$OXFLT`` whose violation no later reply has bounded yet
+        #: (wall time, line number, sentence) of an ``$OXFLT`` no later reply has bounded yet
         #: (answers.py)
-        self.oxflt_open: Optional[tuple[float, int]] = None
+        self.oxflt_open: Optional[tuple] = None
         self.mission_shown: list[tuple] = []  #: $OMSTARTs the reports to come judge (answers.py)
         self.sent: deque[Sent] = deque(maxlen=256)
         self.seq = 0
@@ -277,8 +277,10 @@ class VehicleObserver(Answers, Deadlines):
         elif k.kind == "oxflt":
             sent.state = "silent"
             self.silent.append(sent)
-            self.beliefs.command(k.item, self.v(ev.t), self.slack_v(), [])
-            self.oxflt_open = (ev.t, sent.seq)  # when it took effect: known at the next reply (answers.py)
+            if self.oxflt_open is not None:  # an earlier one, unanswered: taken in before this one
+                self._apply_oxflt(ev.t)
+            # into the mirror at the next reply, which bounds when it took effect (answers.py)
+            self.oxflt_open = (ev.t, sent.seq, k.item)
             self.checks.oxflt_sent(k.item.code, ev.t)  # type: ignore[union-attr]
             self.event(ev.t, "lockout", f"$OXFLT,{k.item.code} sent")  # type: ignore[union-attr]
         else:
