@@ -116,6 +116,9 @@ class Session:
         got = self.failures()
         if self.ignore:
             got = [f for f in got if f[0] not in self.ignore]
+        read = self.obs.out.read_anyway
+        if read:  # a bad field of a report still read is no cause of what follows (judge.vehicle.lines)
+            got = [f for f in got if f[0] in self.case_clauses or f not in read]
         if got and self.stop_on_fail:
             cid, reason = got[0]
             raise CaseStop("fail", f"{cid}: {reason}", cid)
@@ -275,6 +278,10 @@ class Session:
                 self.tester("not-tested", self.case_clauses, "the profile's osd_letters lack S: the "
                                                              "vehicle's state cannot be observed")
                 raise CaseStop("not-tested", "the profile's osd_letters lack S")
+            if sent is not None and any(cls == "OSI" for _, cls, _ in sent.data):
+                # an $OSI came, but its state fields could not be read (booked on their clause)
+                raise CaseStop("inconclusive", "the $OSI answering $OSD,S shows no readable state (mode, "
+                                               "waypoint, park time, error state)")
             raise CaseStop("fail", "$OSD,S was answered without an $OSI", "RH-OSD-1")
         if self.on_poll is not None:
             self.on_poll()
@@ -430,6 +437,9 @@ class Session:
         o = self.obs.last_osi
         if o is None:
             o = self.poll()
+        if o.lat is None or o.lon is None:
+            raise CaseStop("inconclusive", "the vehicle's last $OSI does not show its position readably "
+                                           "(fields 4 and 5)")
         return f"{float(o.lat):.6f}", f"{float(o.lon):.6f}"
 
 
