@@ -3,15 +3,16 @@
 ``decode(line, profile)`` is the full reading of one line — framing (RH-FRM-1..7), checksum
 (RH-FRM-2/3), ID (RH-FRM-5, RH-RD-16), field syntax (the grammar), and value ranges (the
 profile) — and returns a :class:`Decoded` with the sentence, or the first error, plus SHOULD
-findings. A line that is framed, checksummed and split into its sentence's fields, but has a
-field the grammar cannot read or a value out of its range, is still invalid; its
-:attr:`Decoded.partial` is the sentence read without those fields (each ``None``) and
-:attr:`Decoded.field_errors` names every one of them, with its clause and its text as sent
-(:func:`_split_fields`: the grammar and the range rules decide which field is bad, nothing else).
-Only a line that cannot be framed, or whose fields cannot be told apart (too few or too many of
-them), has no partial reading. ``parse`` is the same but raises :class:`SentenceError`. ``format`` writes canonical
+findings. ``parse`` is the same but raises :class:`SentenceError`. ``format`` writes canonical
 bytes: upper-case zero-padded checksum and CR LF, so ``parse(format(s)) == s`` and, for
 canonical input, ``format(parse(b)) == b``.
+
+A line that is framed, checksummed and split into its sentence's fields, but has a field the
+grammar cannot read or a value out of its range, is still invalid; its :attr:`Decoded.partial` is
+the sentence read without those fields (each ``None``), and :attr:`Decoded.field_errors` names
+every one of them with its clause and its text as sent (:func:`_split_fields`: the grammar and the
+range rules decide which field is bad, nothing else does). Only a line that cannot be framed, or
+whose fields cannot be told apart (one missing, one too many), has no partial reading.
 
 Two engines read the body: ``"fast"`` (regular expressions compiled from the grammar, the
 default) and ``"lark"`` (the Lark LALR parser over the same grammar). They agree; the property
@@ -303,7 +304,7 @@ def _split_fields(body: str, sid: str, err: SentenceError, engine: str):
     if not rules:
         return None
     names = rules[0].cls.field_names()
-    parts = body.split(",")
+    sent = parts = body.split(",")
     bad: list[tuple[str, str, SentenceError]] = []
     got = err
     for _ in range(len(parts)):
@@ -320,7 +321,10 @@ def _split_fields(body: str, sid: str, err: SentenceError, engine: str):
                 if after is None or after <= idx:
                     continue  # the stand-in does not fit there either
             _FITTED[(sid, idx)] = stand_in
-            bad.append((names[idx - 1], stand_in, _field_error(got, sid, names[idx - 1], idx, text)))
+            # (the grammar's column where it stopped, for the first; for the others, where the field
+            # begins in the line as sent: their errors were found with stand-ins before them)
+            column = got.column if not bad else len(",".join(sent[:idx])) + 3
+            bad.append((names[idx - 1], stand_in, _field_error(got, sid, names[idx - 1], idx, text, column)))
             parts, got = trial, nxt
             break
         else:
@@ -335,11 +339,11 @@ def _split_fields(body: str, sid: str, err: SentenceError, engine: str):
     return got, [e for _, _, e in bad]
 
 
-def _field_error(err: SentenceError, sid: str, name: str, idx: int, text: str) -> SentenceError:
+def _field_error(err: SentenceError, sid: str, name: str, idx: int, text: str, column) -> SentenceError:
     """The grammar's error as the fault of field ``idx`` (``name``), with the text sent there."""
     message = err.message if err.field == name else (
         f"${sid} {name}: field {idx} is empty" if not text else f"${sid} {name}: {text!r} is not its form")
-    return replace(err, message=message, field=name, value=text)
+    return replace(err, message=message, field=name, value=text, column=column)
 
 
 def _from_tree(node: Tree) -> S.Sentence:
