@@ -9,8 +9,12 @@ into the ledger. The session only decides what to send next and how long to wait
   ``$ACK`` arrived, or the window of a line the vehicle must discard went by). A command left
   unanswered is followed by a liveness probe (``$OSD,S``), which is also what lets the observer
   tell a missing ACK (RH-ACK-1) from a dead link. When the observer has booked a failure inside
-  the present case, the case stops (:class:`~.flow.CaseStop`): the first fail is the root cause.
-* :meth:`Session.poll` — ``$OSD,S``; the ``$OSI`` the observer judged.
+  the present case, the case stops (:class:`~.flow.CaseStop`): the first fail is the root cause —
+  except a bad field of a report the observer still read (RH-OUT-1/3 on one field of an ``$OSI``,
+  :mod:`helmcheck.judge.vehicle.lines`), which causes nothing after it, unless the case is about
+  that clause.
+* :meth:`Session.poll` — ``$OSD,S``; the ``$OSI`` the observer judged (read without its bad
+  fields, if it has any; one whose state fields cannot be read ends the case INCONCLUSIVE).
 * :meth:`Session.wait`, :meth:`Session.settle`, :meth:`Session.until` — protocol time passing
   (vehicle seconds ÷ k, RH-TIM-2), polling all along. ``settle`` polls across a model timer's
   deadline until the vehicle is seen to have left the state before it, so the observer can
