@@ -3,7 +3,10 @@
 Every mutant in :mod:`tests.faulty_vehicles` is served behind a real pty (the emulator's own I/O
 loop in a thread) and certified, at each of its two time scales, with only the clauses that
 reach its fault selected, so each run takes a few seconds. The conforming core passes the same
-selections at the same time scales (no false alarms). Every run directory is also re-judged
+selections at the same time scales (no false alarms). Some mutants say more: that the run fails
+the clause that states the rule alone, not a neighbour (``only``), or that a fault in one field
+of every report blinds the tester to nothing else (``blinds_nothing``: every other selected
+clause judged as on the conforming core, the restore verified, exit 1). Every run directory is also re-judged
 offline by the suite's agreement check (``tests/conftest.py``): live and offline must agree.
 """
 
@@ -37,6 +40,15 @@ def test_mutant_fails_on_its_clause(mutant, k, tmp_path):
     assert mutant.clause in failed, f"failed {sorted(failed)}: {out.reason}"
     entry = failed[mutant.clause]
     assert entry["reason"] and entry["evidence"], entry
+    if mutant.only:  # booked on the clause that states the rule (and those that also name it), no neighbour
+        assert set(failed) == {mutant.clause, *mutant.also}, {c: e["reason"] for c, e in failed.items()}
+    if mutant.blinds_nothing:  # every other selected clause judged as on the conforming core (the test
+        # below: every selected clause passes there), the restore verified, exit 1 (above)
+        judged = {c["id"] for c in out.results["clauses"] if c["verdict"] in ("pass", "fail", "inconclusive")}
+        assert judged >= set(mutant.select), {c["id"]: c["reason"] for c in out.results["clauses"]
+                                              if c["id"] in set(mutant.select) - judged}
+        assert not not_passed(out.results, set(mutant.select) - {mutant.clause, *mutant.also})
+        assert out.results["restore"]["verified"], out.results["restore"]
 
 
 SCALES = sorted({k for m in MUTANTS for k in m.time_scales})

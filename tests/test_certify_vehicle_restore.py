@@ -1,5 +1,6 @@
 """The vehicle left as found: settings read before they are written, written back and read again
-at the end of every run — also after SIGTERM — and a restore that cannot be verified is exit 2.
+at the end of every run — also after SIGTERM — and a restore that cannot be verified is exit 2 (1, named
+beside the verdict, when the run failed).
 
 Real vehicles here: the emulator as a subprocess with its settings kept in a file
 (``helmcheck emulate --settings``), and faulty vehicles served behind ptys: one that will not
@@ -118,12 +119,15 @@ def test_a_setting_whose_value_cannot_be_read_is_never_written(tmp_path):
     assert set2["verdict"] != "pass", set2
 
 
-def test_a_restore_that_does_not_stick_is_exit_2_and_names_what_to_set_by_hand(tmp_path, capsys):
+def test_a_restore_that_does_not_stick_is_named_beside_the_fail_and_what_to_set_by_hand(tmp_path, capsys):
+    """The vehicle fails RH-SET-2 (a write does not stick) and so cannot be restored either: the
+    run is non-conformant (exit 1, the verdict stands), and its reason names the restore too."""
     m = Mutant("sticks-at-first-write", "RH-SET-2", ("RH-SET-2",), model=SticksAtFirstWrite)
     with serve(lambda start: make_core(m, K, start)) as port:
         out = _certify(port, tmp_path, ["RH-SET-2"])
     rec = out.results["restore"]
-    assert out.exit_code == 2, (out.verdict, rec)
+    assert out.verdict == "fail" and out.exit_code == 1, (out.verdict, rec)
+    assert "NOT verified as restored" in out.reason and "$ORWSET,Sop,W," in out.reason, out.reason
     assert rec["verified"] is False
     sop = next(x for x in rec["settings"] if x["name"] == "Sop")
     assert sop["written"] and sop["after"] != sop["before"]

@@ -390,3 +390,68 @@ def test_RH_SAF_4_a_violation_in_S_needs_no_visible_action_at_the_surface(tmp_pa
     v = {c["id"]: c for c in out.clauses}
     assert verdict(v, "RH-SAF-4") != "fail", v["RH-SAF-4"]
     assert not failed(v), {c: v[c]["reason"] for c in failed(v)}
+
+
+# ============================================================ the clause that states the rule leads
+
+def test_RH_PRM_2_an_OMP_in_lower_case_hex_refused_is_RH_PRM_2_s_not_the_case_s(tmp_path):
+    """RH-PRM-2 says hex case is free on input: an ``$OMP`` in lower-case hex refused with its
+    "incorrect values" error (21) breaks RH-PRM-2 — inside a case about RH-PRM-3 (which the
+    refusal does not speak to) and outside one (not RH-PRM-1, the accepting row's first clause).
+    The same line in upper case, accepted, fails nothing."""
+    case = [(0.9, "!", "case V-31 RH-PRM-3: $OSI echoes the commanded fins and motor")]
+    for within in ([], case):
+        rec = poll(0.0, mode="S") + within + send(1.0, "OMP,8a8a767690,00,10", "ACK,10,1,21") + poll(1.5, mode="S")
+        v = judge(tmp_path, rec)
+        assert failed(v) == {"RH-PRM-2"}, {c: v[c]["reason"] for c in failed(v)}
+    good = poll(0.0, mode="S") + case + send(1.0, "OMP,8A8A767690,00,10", "ACK,10,0,0") + poll(
+        1.5, mode="M", act="8A8A767690")
+    v = judge(tmp_path, good)
+    assert not failed(v), {c: v[c]["reason"] for c in failed(v)}
+
+
+def test_an_upper_case_OMP_refused_with_a_precondition_error_is_not_RH_PRM_2(tmp_path):
+    """The form leads only where the line is written in it: an ``$OMP`` in upper case refused in
+    ``S`` is RH-PRM-1's (accepted from S too), whatever its error number."""
+    rec = poll(0.0, mode="S") + send(1.0, "OMP,8A8A767690,00,10", "ACK,10,1,21") + poll(1.5, mode="S")
+    v = judge(tmp_path, rec)
+    assert failed(v) == {"RH-PRM-1"}, {c: v[c]["reason"] for c in failed(v)}
+
+
+def test_RH_SAF_1_an_OSD_refused_in_the_lockout_is_RH_SAF_1_s_then_RH_OSD_1_s(tmp_path):
+    """RH-SAF-1: every command but ``$OSD`` is refused in the lockout; RH-OSD-1: ``$OSD`` is
+    accepted in every mode, including the lockout. An ``$OSD`` refused there (26) breaks both,
+    RH-SAF-1 first — not a neighbour the case is about (RH-ACK-5 here). Served, it fails nothing."""
+    from helmcheck.profile import emulator_profile
+
+    def run(answer: list) -> dict:
+        rec = start() + [(1.0, ">", "OXFLT,Sle")] + poll(1.5, mode="N", dist=149.0, err="Sle", speed=2.0)
+        rec += [(1.9, "!", "case V-99 RH-ACK-5: data before the ACK"), (2.0, ">", "OSD,S")] + answer
+        out = check_log(write(tmp_path, rec), profile=emulator_profile(), role="vehicle")
+        return {c["id"]: c for c in out.clauses}
+
+    from tests.test_judge_vehicle_readings import osi
+    v = run([(2.01, "<", "ACK,8,1,26")])
+    assert failed(v) == {"RH-SAF-1", "RH-OSD-1"}, {c: v[c]["reason"] for c in failed(v)}
+    assert "$ACK,8,1,26" in v["RH-SAF-1"]["reason"], v["RH-SAF-1"]["reason"]
+    v = run([(2.01, "<", osi(mode="N", dist=149.0, err="Sle", speed=2.0)), (2.02, "<", "ACK,8,0,0")])
+    assert not failed(v), {c: v[c]["reason"] for c in failed(v)}
+
+
+def test_the_lockout_s_exception_is_derived_from_the_transition_table():
+    """RH-SAF-1's "except $OSD" is read from the table's lockout rows (every command event but one
+    refused with 26 under one clause), not written by hand; the ascent's refusals (some control
+    commands, RH-SAF-3) name no exception."""
+    from helmcheck.judge.vehicle.blame import phase_exceptions
+
+    assert phase_exceptions() == {("OSD", "lockout"): ("RH-SAF-1", "RH-OSD-1")}
+
+
+def test_RH_OMW_3_an_OMW_with_an_empty_depth_2_refused_is_RH_OMW_3_s(tmp_path):
+    """RH-OMW-3 says depth 2 may be empty: an ``$OMW`` written so, refused with 36 while a mission
+    runs, breaks RH-OMW-3 — not RH-OMW-1 (the accepting row's first clause: accepted while a
+    mission runs, which it is)."""
+    rec = start() + send(1.0, f"OMW,{LAT},{FAR_LON},2,,15,1,0,", "ACK,16,1,36") + poll(1.5, mode="N", dist=149.0,
+                                                                                    speed=2.0)
+    v = judge(tmp_path, rec)
+    assert failed(v) == {"RH-OMW-3"}, {c: v[c]["reason"] for c in failed(v)}

@@ -81,15 +81,16 @@ certificate: a run that judges every vehicle clause is a certificate; --select r
 the vehicle left as found: before it writes a setting helmcheck reads it (in S), and at the end
   of every run (also after a FAIL, Ctrl-C, SIGTERM or SIGHUP) it stops the vehicle ($OMSTOP until
   S), writes back every setting it changed and reads them again. A restore that cannot be verified
-  is exit 2 and a message naming what to set by hand; the report's "Vehicle restored" section
-  lists each setting before and after.
+  is exit 2 (1 when the run also failed) and a message naming what to set by hand; the report's
+  "Vehicle restored" section lists each setting before and after.
 
 results: DIR/results.json (schema 1), DIR/wire.log, DIR/profile.toml, DIR/signature.json (signed runs),
   DIR/report.html, DIR/junit.xml, DIR/report.md. A DIR that holds an earlier run is refused
   unless --overwrite. SIGINT, SIGTERM and SIGHUP end the run early: results marked partial,
   reports rendered.
 exit status: 0 pass (or non-strict without --strict), 1 fail, 2 inconclusive, link fault, tester
-  error, a vehicle not verified as restored, or an output that could not be written, 64 usage
+  error, a vehicle not verified as restored after a run that did not fail, or an output that could
+  not be written, 64 usage
   (bad option, profile, port or path).
 """
 

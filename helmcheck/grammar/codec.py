@@ -7,6 +7,13 @@ findings. ``parse`` is the same but raises :class:`SentenceError`. ``format`` wr
 bytes: upper-case zero-padded checksum and CR LF, so ``parse(format(s)) == s`` and, for
 canonical input, ``format(parse(b)) == b``.
 
+A line that is framed, checksummed and split into its sentence's fields, but has a field the
+grammar cannot read or a value out of its range, is still invalid; its :attr:`Decoded.partial` is
+the sentence read without those fields (each ``None``), and :attr:`Decoded.field_errors` names
+every one of them with its clause and its text as sent (:func:`_split_fields`: the grammar and the
+range rules decide which field is bad, nothing else does). Only a line that cannot be framed, or
+whose fields cannot be told apart (one missing, one too many), has no partial reading.
+
 Two engines read the body: ``"fast"`` (regular expressions compiled from the grammar, the
 default) and ``"lark"`` (the Lark LALR parser over the same grammar). They agree; the property
 tests prove it. Errors are always located with Lark, which knows where a parse went wrong;
@@ -17,7 +24,7 @@ from __future__ import annotations
 
 import builtins
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from decimal import Decimal
 from typing import TYPE_CHECKING, Optional
 
@@ -26,7 +33,7 @@ from . import sentences as S
 from .checksum import checksum
 from .compile import build_sentence, fast_builder, lark_parser, specs
 from .errors import SYNTAX, Finding, SentenceError
-from .ranges import check_ranges
+from .ranges import check_ranges, field_text, range_errors
 
 if TYPE_CHECKING:
     from lark import Tree
@@ -44,21 +51,38 @@ class Decoded:
     findings: tuple[Finding, ...] = ()
     sentence_id: Optional[str] = None
     terminator: str = ""  #: "\r\n", "\n" or "" (none)
+    #: an invalid line split into its sentence's fields: the sentence without its bad fields
+    #: (each ``None``), which :attr:`field_errors` name; None when the line has no such reading
+    partial: Optional[S.Sentence] = None
+    #: every field fault of :attr:`partial` (syntax first, then ranges); ``error`` is the first
+    field_errors: tuple[SentenceError, ...] = ()
 
     @property
     def valid(self) -> bool:
         return self.sentence is not None
 
+    @property
+    def unread(self) -> frozenset:
+        """The fields of :attr:`partial` left out (``None``) because they are bad."""
+        if self.partial is None:
+            return frozenset()
+        names = self.partial.field_names()
+        return frozenset(e.field for e in self.field_errors if e.field in names)
+
     def as_dict(self) -> dict:
         s = self.sentence
-        return {
+        out = {
             "type": type(s).__name__ if s is not None else None,
             "id": self.sentence_id,
             "valid": self.valid,
             "fields": s.as_dict() if s is not None else None,
-            "errors": [self.error.as_dict()] if self.error else [],
+            "errors": [e.as_dict() for e in self.field_errors] or ([self.error.as_dict()] if self.error else []),
             "findings": [f.as_dict() for f in self.findings],
         }
+        if self.partial is not None:
+            out["type"] = type(self.partial).__name__
+            out["partial"] = self.partial.as_dict()
+        return out
 
 
 # --------------------------------------------------------------------------- ID dispatch
@@ -205,12 +229,23 @@ def decode(line: bytes | str, profile: Profile = DEFAULT, engine: str = "fast") 
     if sid not in KNOWN_IDS:
         return _fail(raw, SentenceError("RH-FRM-5", f"unknown ID {sid!r}", 2), findings, sid, term)
     sentence = _read_body(body, sid, engine)
+    bad: list[SentenceError] = []
     if isinstance(sentence, SentenceError):
-        return _fail(raw, sentence, findings, sid, term)
-    problem = check_ranges(sentence, profile)
-    if problem is not None:
-        return _fail(raw, problem, findings, sid, term)
-    return Decoded(raw, sentence, None, tuple(findings), sid, term)
+        split = _split_fields(body, sid, sentence, engine)
+        if split is None:
+            return _fail(raw, sentence, findings, sid, term)
+        sentence, bad = split
+    unreadable = {e.field for e in bad}
+    names = sentence.field_names()
+    problems = [e for e in range_errors(sentence, profile) if e.field not in unreadable]
+    if unreadable and any(e.field not in names for e in problems):
+        return _fail(raw, bad[0], findings, sid, term)  # read with stand-ins to a wrong field count:
+        # a field missing or one too many, not a field the grammar cannot read
+    bad += problems
+    if not bad:
+        return Decoded(raw, sentence, None, tuple(findings), sid, term)
+    partial = replace(sentence, **{e.field: None for e in bad if e.field in names})
+    return Decoded(raw, None, bad[0], tuple(findings), sid, term, partial, tuple(bad))
 
 
 def parse(line: bytes | str, profile: Profile = DEFAULT, engine: str = "fast") -> S.Sentence:
@@ -241,6 +276,74 @@ def _read_body(body: str, sid: str, engine: str):
             return _locate_error(body, sid)
         return _from_tree(tree.children[0])
     raise ValueError(f"unknown engine {engine!r}")
+
+
+#: Texts tried in place of a field the grammar cannot read, to read the fields around it: the
+#: grammar decides which one fits there (a number, a park time, a mode or error letter, the SRP
+#: flag, the fins and motor, text, or nothing for a field that may be empty).
+_STAND_INS = ("0", "P0", "N", "False", "8080808080", "00", "X", "")
+#: (sentence ID, field index) → the stand-in that fitted there last (tried first next time)
+_FITTED: dict = {}
+
+
+def _field_index(body: str, err: SentenceError) -> Optional[int]:
+    """The comma-separated field (1 = the first after the ID) where ``err`` was found."""
+    if err.column is None or err.column - 2 > len(body):
+        return None  # at the end of the body: a field is missing, not wrong
+    return body[: max(err.column - 2, 0)].count(",")
+
+
+def _split_fields(body: str, sid: str, err: SentenceError, engine: str):
+    """``(sentence, [field errors])`` for a body whose fields are all there but some cannot be
+    read, else None (module docstring). Each unreadable field is found where the grammar stops
+    (:func:`_locate_error`), and set aside by putting in its place a stand-in the grammar accepts
+    there (:data:`_STAND_INS`); the sentence built from that is kept, each stand-in's field being
+    a bad one. A field that takes no stand-in, or a stand-in that lands in another field (a field
+    missing, or one too many), leaves the line without a partial reading."""
+    rules = rules_for_id(sid)
+    if not rules:
+        return None
+    names = rules[0].cls.field_names()
+    sent = parts = body.split(",")
+    bad: list[tuple[str, str, SentenceError]] = []
+    got = err
+    for _ in range(len(parts)):
+        idx = _field_index(",".join(parts), got)
+        if idx is None or not 0 < idx < len(parts) or idx > len(names):
+            return None
+        text = parts[idx]
+        tried = (_FITTED[(sid, idx)],) if (sid, idx) in _FITTED else ()
+        for stand_in in tried + tuple(x for x in _STAND_INS if x not in tried and x != text):
+            trial = parts[:idx] + [stand_in] + parts[idx + 1:]
+            nxt = _read_body(",".join(trial), sid, engine)
+            if isinstance(nxt, SentenceError):
+                after = _field_index(",".join(trial), nxt)
+                if after is None or after <= idx:
+                    continue  # the stand-in does not fit there either
+            _FITTED[(sid, idx)] = stand_in
+            # (the grammar's column where it stopped, for the first; for the others, where the field
+            # begins in the line as sent: their errors were found with stand-ins before them)
+            column = got.column if not bad else len(",".join(sent[:idx])) + 3
+            bad.append((names[idx - 1], stand_in, _field_error(got, sid, names[idx - 1], idx, text, column)))
+            parts, got = trial, nxt
+            break
+        else:
+            return None
+        if not isinstance(got, SentenceError):
+            break
+    if isinstance(got, SentenceError):
+        return None
+    for name, stand_in, _ in bad:
+        if (field_text(got, name) or "") != stand_in:
+            return None  # a stand-in landed in another field: the fields are not where they seem
+    return got, [e for _, _, e in bad]
+
+
+def _field_error(err: SentenceError, sid: str, name: str, idx: int, text: str, column) -> SentenceError:
+    """The grammar's error as the fault of field ``idx`` (``name``), with the text sent there."""
+    message = err.message if err.field == name else (
+        f"${sid} {name}: field {idx} is empty" if not text else f"${sid} {name}: {text!r} is not its form")
+    return replace(err, message=message, field=name, value=text, column=column)
 
 
 def _from_tree(node: Tree) -> S.Sentence:

@@ -34,6 +34,7 @@ class SentenceError(Exception):
     field: Optional[str] = None  #: the field's name for syntax/range errors
     ack_type: Optional[int] = None  #: the $ACK type a vehicle answers with, None = silent discard
     ack_err: Optional[int] = None  #: the error number in that $ACK
+    value: Optional[str] = None  #: the field's text as sent, for a field error (``field`` names it)
 
     def __str__(self) -> str:
         where = f" at column {self.column}" if self.column is not None else ""
@@ -47,7 +48,7 @@ class SentenceError(Exception):
     def as_dict(self) -> dict:
         return {"clause": self.clause, "message": self.message, "column": self.column,
                 "kind": self.kind, "field": self.field, "ack_type": self.ack_type,
-                "ack_err": self.ack_err, "text": str(self)}
+                "ack_err": self.ack_err, "value": self.value, "text": str(self)}
 
 
 @dataclass(frozen=True)

@@ -20,7 +20,7 @@ from ..profile import Profile, SAFETY_CODES
 from . import sentences as S
 from .errors import RANGE, SentenceError
 
-__all__ = ["check_ranges", "mission_name_problem"]
+__all__ = ["check_ranges", "range_errors", "field_text", "mission_name_problem"]
 
 _D = Decimal
 Problem = tuple[str, str, str]  # (clause, field, message)
@@ -263,14 +263,40 @@ def check_ranges(s: S.Sentence, profile: Profile) -> Optional[SentenceError]:
                 return None
         except (ArithmeticError, TypeError):
             pass  # what the rule itself says of it
+    for err in _errors(s, profile):
+        return err
+    return None
+
+
+def range_errors(s: S.Sentence, profile: Profile) -> list[SentenceError]:
+    """Every range problem of ``s`` under ``profile``, in field order (the first is
+    :func:`check_ranges`'); each names its field, and ``value`` is that field's text as sent."""
+    if check_ranges(s, profile) is None:
+        return []
+    return list(_errors(s, profile))
+
+
+def _errors(s: S.Sentence, profile: Profile) -> Iterator[SentenceError]:
     rule = _RULES.get(type(s))
     if rule is None:
-        return None
+        return
+    is_cmd = isinstance(s, S.Command)
     for clause, field, message in rule(s, profile):
-        is_cmd = isinstance(s, S.Command)
-        return SentenceError(
+        yield SentenceError(
             clause, f"${s.ID} {message}", None, RANGE, s.ID, field,
             getattr(s, "ACK_TYPE", None) if is_cmd else None,
-            getattr(s, "ERR", None) if is_cmd else None,
+            getattr(s, "ERR", None) if is_cmd else None, field_text(s, field),
         )
-    return None
+
+
+def field_text(s: S.Sentence, field: str) -> Optional[str]:
+    """A scalar field's text as the sentence carries it (Decimals keep the digits sent), or None
+    for a name that is no scalar field of ``s`` (``fields``, the field count)."""
+    if field not in s.field_names():
+        return None
+    v = getattr(s, field)
+    if v is None or isinstance(v, (tuple, S.Sentence)):
+        return None
+    if type(s) is S.OSI and field == "park_time":
+        return f"P{v}"
+    return format(v, "f") if isinstance(v, Decimal) else str(v)

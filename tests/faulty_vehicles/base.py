@@ -60,6 +60,12 @@ class Mutant:
     model: type | None = None
     profile_changes: tuple = ()  #: (key, value) pairs for the *vehicle's* profile
     time_scales: tuple = TIME_SCALES  #: k for the emulator and the tester (higher for long missions)
+    #: the run fails its clause (and :attr:`also`, the other clauses that name the fault) alone
+    only: bool = False
+    also: tuple = ()
+    #: every selected clause is judged, as on the conforming core, and the restore is verified: the
+    #: fault (a bad field of every report) blinds the tester to nothing else
+    blinds_nothing: bool = False
 
 
 

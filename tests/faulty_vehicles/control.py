@@ -191,6 +191,26 @@ class OmpReservedIgnored(EmulatorCore):
         return super()._line(raw, now, v)
 
 
+class OmpLowerHexRefused(Model):
+    """RH-PRM-2: an $OMP whose fins and motor are written in lower-case hex is refused (err 21),
+    though hex case is free on input; in upper case it is accepted."""
+
+    def receive(self, item, now):
+        if isinstance(item, s.OMP) and item.actuators != item.actuators.upper() and self.phase != "lockout":
+            return [ack(10, 21)]
+        return super().receive(item, now)
+
+
+class OsdRefusedInLockout(Model):
+    """RH-SAF-1: $OSD is refused (26) during the lockout like every other command, though it is
+    the one command the lockout serves."""
+
+    def receive(self, item, now):
+        if isinstance(item, s.OSD) and self.phase == "lockout":
+            return [ack(8, 26)]
+        return super().receive(item, now)
+
+
 class OsiFinsSwapped(Model):
     """RH-PRM-3: in M, $OSI field 1 shows the pitch fins before the yaw fins."""
 
@@ -452,4 +472,8 @@ class OmpNineHexAccepted(EmulatorCore):
 
 MUTANTS += (
     Mutant("omp-nine-hex-accepted", "RH-PRM-2", ("RH-PRM-2",), core=OmpNineHexAccepted),
+    # refused where a clause names the behaviour: booked on that clause, not on the case's subject
+    Mutant("omp-lower-hex-refused", "RH-PRM-2", ("RH-PRM-2", "RH-PRM-3"), model=OmpLowerHexRefused, only=True),
+    Mutant("osd-refused-in-lockout", "RH-SAF-1", ("RH-SAF-1", "RH-OSD-1"), model=OsdRefusedInLockout, only=True,
+           also=("RH-OSD-1",)),
 )

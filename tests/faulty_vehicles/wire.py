@@ -13,7 +13,13 @@ from helmcheck.model.vehicle import VehicleModel
 
 from .base import Model, Mutant, body, reframe
 
-__all__ = ["MUTANTS"]
+__all__ = ["MUTANTS", "BAD_FIELD_SELECT"]
+
+#: What a vehicle with one bad ``$OSI`` field is certified on: its field's clause, and clauses
+#: judged from what the reports show (the mode, the fins and motor, the position), a setting
+#: written (the restore puts it back), and the lockout (polled through).
+BAD_FIELD_SELECT = ("RH-OUT-3", "RH-OUT-1", "RH-OUT-4", "RH-SRV-3", "RH-PRM-3", "RH-MSN-3", "RH-SET-2", "RH-POS-2",
+                    "RH-SAF-1")
 
 
 class AcceptsBadChecksum(EmulatorCore):
@@ -291,6 +297,22 @@ class MagneticUnwrapped(Model):
         return out
 
 
+class TrueHeadingNegative(Model):
+    """RH-OUT-3: $OSI field 14, the true heading, is -0.1 (just below its range [0, 360)) in every
+    report; every other field is right."""
+
+    def osi(self, now=None):
+        return replace(super().osi(now), true_heading=Decimal("-0.1"))
+
+
+class BatteryOver100(Model):
+    """RH-OUT-3: $OSI field 16, the battery percent, is 100.1 (just above its range [0, 100]) in
+    every report; every other field is right."""
+
+    def osi(self, now=None):
+        return replace(super().osi(now), battery="100.1")
+
+
 class WaypointOneBased(Model):
     """RH-OUT-4: $OSI field 3 is the waypoint index plus one (1-based), so it shows 1 in S."""
 
@@ -399,6 +421,10 @@ MUTANTS = (
     Mutant("opos-ack-next-cycle", "RH-ACK-6", ("RH-ACK-6",), core=OposAckNextCycle),
     Mutant("opi-without-leak", "RH-OUT-2", ("RH-OUT-2",), core=OpiWithoutLeak),
     Mutant("magnetic-heading-unwrapped", "RH-OUT-3", ("RH-OUT-3",), model=MagneticUnwrapped),
+    # one bad field in every report blinds the tester to nothing else (judge.vehicle.lines)
+    Mutant("osi-true-heading-negative", "RH-OUT-3", BAD_FIELD_SELECT, model=TrueHeadingNegative, only=True,
+           blinds_nothing=True),
+    Mutant("osi-battery-over-100", "RH-OUT-3", BAD_FIELD_SELECT, model=BatteryOver100, only=True, blinds_nothing=True),
     Mutant("waypoint-one-based", "RH-OUT-4", ("RH-OUT-4",), model=WaypointOneBased),
     Mutant("opos-sixth-field-refused", "RH-POS-1", ("RH-POS-1",), model=OposSixthFieldRefused),
     Mutant("opos-ignores-gps-fix", "RH-POS-2", ("RH-POS-2",), model=OposIgnoresFix),

@@ -227,6 +227,8 @@ def _return(doc: dict, session) -> bool:
         best, near = apart + p.on_station_m, apart
         while session.now() < end:
             osi = session.poll()
+            if osi.lat is None or osi.lon is None:
+                break  # the report does not show readably where it is
             here = distance_m(float(osi.lat), float(osi.lon), o_lat, o_lon)
             # done: the queue ended, on the origin, or past the nearest point of the way to the aim
             if osi.mode != "W" or here <= ON_ORIGIN_M or (here < p.on_station_m and here > near):

@@ -397,7 +397,11 @@ def certify(opts: Options) -> Outcome:
                 run.progress.note(f"reports not rendered: {e}")
     r = run.results
     code = R.exit_code(r["verdict"], opts.strict)
+    reason = r["verdict_reason"]
     restore = r.get("restore")
     if restore is not None and restore["attempted"] and not restore["verified"]:
-        code = 2  # the vehicle may have left with a setting changed: never a green run
-    return Outcome(r["verdict"], r["verdict_reason"], code, run.dir, r)
+        from .restore import unverified_text
+        reason = f"{reason.rstrip('.')}; {unverified_text(restore)}"
+        if code != 1:  # the vehicle may have left with a setting changed: never a green run; a
+            code = 2   # FAIL stays non-conformant (1), the restore named beside it
+    return Outcome(r["verdict"], reason, code, run.dir, r)

@@ -9,8 +9,12 @@ into the ledger. The session only decides what to send next and how long to wait
   ``$ACK`` arrived, or the window of a line the vehicle must discard went by). A command left
   unanswered is followed by a liveness probe (``$OSD,S``), which is also what lets the observer
   tell a missing ACK (RH-ACK-1) from a dead link. When the observer has booked a failure inside
-  the present case, the case stops (:class:`~.flow.CaseStop`): the first fail is the root cause.
-* :meth:`Session.poll` — ``$OSD,S``; the ``$OSI`` the observer judged.
+  the present case, the case stops (:class:`~.flow.CaseStop`): the first fail is the root cause —
+  except a bad field of a report the observer still read (RH-OUT-1/3 on one field of an ``$OSI``,
+  :mod:`helmcheck.judge.vehicle.lines`), which causes nothing after it, unless the case is about
+  that clause.
+* :meth:`Session.poll` — ``$OSD,S``; the ``$OSI`` the observer judged (read without its bad
+  fields, if it has any; one whose state fields cannot be read ends the case INCONCLUSIVE).
 * :meth:`Session.wait`, :meth:`Session.settle`, :meth:`Session.until` — protocol time passing
   (vehicle seconds ÷ k, RH-TIM-2), polling all along. ``settle`` polls across a model timer's
   deadline until the vehicle is seen to have left the state before it, so the observer can
@@ -153,6 +157,9 @@ class Session:
         got = self.failures()
         if self.ignore:
             got = [f for f in got if f[0] not in self.ignore]
+        read = self.obs.out.read_anyway
+        if read:  # a bad field of a report still read is no cause of what follows (judge.vehicle.lines)
+            got = [f for f in got if f[0] in self.case_clauses or f not in read]
         if got and self.stop_on_fail:
             cid, reason = got[0]
             raise CaseStop("fail", f"{cid}: {reason}", cid)
@@ -315,6 +322,10 @@ class Session:
                 self.tester("not-tested", self.case_clauses, "the profile's osd_letters lack S: the "
                                                              "vehicle's state cannot be observed")
                 raise CaseStop("not-tested", "the profile's osd_letters lack S")
+            if sent is not None and any(cls == "OSI" for _, cls, _ in sent.data):
+                # an $OSI came, but its state fields could not be read (booked on their clause)
+                raise CaseStop("inconclusive", "the $OSI answering $OSD,S shows no readable state (mode, "
+                                               "waypoint, park time, error state)")
             raise CaseStop("fail", "$OSD,S was answered without an $OSI", "RH-OSD-1")
         if self.on_poll is not None:
             self.on_poll()
@@ -477,6 +488,9 @@ class Session:
         o = self.obs.last_osi
         if o is None:
             o = self.poll()
+        if o.lat is None or o.lon is None:
+            raise CaseStop("inconclusive", "the vehicle's last $OSI does not show its position readably "
+                                           "(fields 4 and 5)")
         return f"{float(o.lat):.6f}", f"{float(o.lon):.6f}"
 
 

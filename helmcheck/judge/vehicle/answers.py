@@ -23,7 +23,7 @@ from ...grammar import sentences as s
 from ...grammar.wirelog import escape
 from ..ledger import Evidence
 from ..timing import ack_allowance, ack_uncertainty, ack_verdict, transmit_time
-from .blame import command_clauses, looked_up, passable
+from .blame import command_clauses, looked_up, passable, stated_by
 from .sent import Sent, brief, names, text_of
 
 __all__ = ["Answers", "UNSOLICITED", "OWN_REASON"]
@@ -212,11 +212,14 @@ class Answers:
                 cands = (first,) + tuple(c for c in cands if c != first)
             what = (f"{text_of(p)}: a conforming vehicle in mode {res.before[0]} answers "
                     f"{brief(res.expected)}; got {brief(observed)}")
+            # refused where a conforming vehicle accepts: on the clauses that name that behaviour
+            stated = (stated_by(p.kind.item, a.err, res.row, res.before[1])
+                      if a.status == 1 and want is not None and want.status == 0 else ())
             if res.desync:
                 self.book("inconclusive", cands, f"{what} — not judged: the observer lost track of the "
-                                                 f"vehicle's state before ({res.desync})", ev, at=p)
+                                                 f"vehicle's state before ({res.desync})", ev, at=p, stated=stated)
             else:
-                self.book("fail", cands, what, ev, at=p)
+                self.book("fail", cands, what, ev, at=p, stated=stated)
         for tt, verdict, reason in res.timings:
             self._timing(tt, verdict, reason, ev)
         if p.kind.ack_type == 8:

@@ -470,11 +470,11 @@ class Beliefs:
         if depth is not None and m.phase == "ascent":
             depth = None
         snap = m.snapshot
-        if snap.lat != lat or snap.lon != lon or snap.speed_kn != speed or (depth is not None
-                                                                           and snap.depth_m != depth):
-            changes = {"lat": lat, "lon": lon, "speed_kn": speed}
-            if depth is not None:
-                changes["depth_m"] = depth
+        if ((lat is not None and snap.lat != lat) or (lon is not None and snap.lon != lon)
+                or (speed is not None and snap.speed_kn != speed) or (depth is not None and snap.depth_m != depth)):
+            # (a field the report does not show readably leaves the plant's value as it was)
+            changes = {k: x for k, x in (("lat", lat), ("lon", lon), ("speed_kn", speed), ("depth_m", depth))
+                       if x is not None}
             m.update_plant(snap.with_(**changes))
             c.drain()
 

@@ -21,7 +21,15 @@ Every finding names an ordered tuple of *candidate* clauses, the most specific f
   look-up's error (1, 3, 31), is RH-MSN-1's (:func:`looked_up`: the name was looked up, not
   rejected);
 * a line the vehicle must discard but answered — the discard's own clause (RH-FRM-2/4/5/6/7),
-  whatever else is wrong with the answer.
+  whatever else is wrong with the answer;
+* a command refused where a conforming vehicle accepts it, where a clause names that very
+  behaviour — :func:`stated_by`, booked on those clauses alone (not on the case's subject or the
+  accepting row's first clause, which the refusal does not speak to): a command the phase's
+  refusal of every other command spares (:func:`phase_exceptions`, derived from the transition
+  table: ``$OSD`` in the lockout is RH-SAF-1's "except ``$OSD``", and RH-OSD-1's, whose row lists
+  the lockout); a command refused with its own "incorrect values" error, written in a form of a
+  field the profile names beside the plain one (:data:`FORMS`: ``$OMP`` hex digits in lower case,
+  RH-PRM-2 "hex case is free on input"; an empty ``$OMW`` depth 2, RH-OMW-3; …).
 
 :func:`targets` books a finding: inside a clause case (its ``case …`` note) on the candidates the
 case is about, if any (a failure inside a case belongs to its subject, not to a neighbour it
@@ -58,8 +66,10 @@ from typing import Iterable, Optional
 from ...clauses import catalogue
 from ...grammar import sentences as s
 from ...grammar.errors import SentenceError
+from ...model.transitions import COMMAND_EVENTS, MODES, PHASES, TABLE
 
-__all__ = ["command_clauses", "looked_up", "targets", "vehicle_clause", "OWN_EVIDENCE", "FIELD_CLAUSE", "passable"]
+__all__ = ["command_clauses", "looked_up", "targets", "vehicle_clause", "OWN_EVIDENCE", "FIELD_CLAUSE", "passable",
+           "stated_by", "phase_exceptions", "FORMS"]
 
 #: clause → the observation that passes it (instead of a row's confirmation).
 OWN_EVIDENCE = {
@@ -155,6 +165,70 @@ def command_clauses(item, expected_ack: Optional[s.ACK], row, before_mode: str =
     return out or ("RH-ACK-1",)
 
 
+#: The forms of a command's fields the profile names beside the plain one, and the clause that
+#: names each: (sentence ID, field) → (clause, whether a field's value is in that form). A vehicle
+#: that refuses a command written so, with the command's own "incorrect values" error, breaks that
+#: clause (:func:`stated_by`).
+FORMS = {
+    ("OMP", "actuators"): ("RH-PRM-2", lambda v: v != v.upper()),  # "hex case is free on input"
+    ("OMW", "keyword"): ("RH-OMW-3", lambda v: v != "Clr"),  # CLEAR and STOP, any case (RH-RD-4)
+    ("OMW", "depth2"): ("RH-OMW-3", lambda v: v is None),  # "depth2 may be empty"
+    ("OPOS", "conductivity"): ("RH-POS-1", lambda v: v is None),  # "… may be empty"
+    ("OPOS", "temperature"): ("RH-POS-1", lambda v: v is None),
+    ("OPOS", "trailing_empty"): ("RH-POS-1", bool),  # "a sixth empty field is tolerated"
+    ("OSD", "letters"): ("RH-OSD-1", lambda v: "" in v),  # "the positional form … accepted"
+}
+
+
+def _forms(item) -> list[str]:
+    out = []
+    for name in item.field_names():
+        value = getattr(item, name)
+        if isinstance(value, s.Command):  # ``$OMW,CLEAR,<waypoint>``: its waypoint's fields too
+            out += _forms(value)
+            continue
+        form = FORMS.get((item.ID, name))
+        if form is not None and form[1](value):
+            out.append(form[0])
+    return out
+
+
+@lru_cache(maxsize=1)
+def phase_exceptions() -> dict[tuple[str, str], tuple[str, ...]]:
+    """(command event, phase) → the clauses that say the event is answered in a phase whose rule
+    refuses every other command, derived from the transition table: where the rows that refuse a
+    command in every mode of a phase all name one clause, and refuse more commands than they
+    spare, that clause states the rule with its exceptions ("every remote-helm command except
+    ``$OSD``", RH-SAF-1); an exception's own row names the phase among its phases, and its first
+    clause says so too (RH-OSD-1, "including the safety lockout")."""
+    out: dict = {}
+    for phase in PHASES:
+        refused = [r for r in TABLE if r.error is not None and phase in r.phases and r.event in COMMAND_EVENTS
+                   and set(r.sources) == set(MODES) and not r.guard]
+        clauses = {r.clauses[0] for r in refused}
+        events = {r.event for r in refused}
+        spared = [e for e in COMMAND_EVENTS if e not in events]
+        if len(clauses) != 1 or len(spared) >= len(events):
+            continue
+        (rule,) = clauses
+        for ev in spared:
+            own = next((r for r in TABLE if r.event == ev and phase in r.phases and r.error is None), None)
+            out[(ev, phase)] = (rule,) + ((own.clauses[0],) if own is not None and own.clauses[0] != rule else ())
+    return out
+
+
+def stated_by(item, err: int, row, phase: str) -> tuple[str, ...]:
+    """The clauses that name the behaviour a vehicle broke by refusing ``item`` (with ``err``) in
+    ``phase``, where a conforming vehicle takes ``row`` and accepts it; () when none does beyond
+    the row's own (module docstring)."""
+    out: list[str] = []
+    if row is not None:
+        out += phase_exceptions().get((row.event, phase), ())
+    if isinstance(item, s.Command) and err == item.ERR:
+        out += _forms(item)
+    return _dedupe(tuple(out))
+
+
 #: The answers of a mission look-up (RH-MSN-1/2, RH-RD-6): 1 not found, 3 does not parse, 31 the SRP.
 LOOKUP_ERRORS = frozenset({1, 3, 31})
 
@@ -187,8 +261,10 @@ ACCEPTANCE = frozenset({"RH-SRV-1", "RH-SRV-2", "RH-PRM-1", "RH-PRM-2", "RH-JW-1
 _TIMING = frozenset({"RH-TIM-1", "RH-TIM-2"})
 
 
-def targets(candidates: tuple[str, ...], case_clauses: tuple[str, ...]) -> tuple[str, ...]:
-    """Where a finding is booked (module docstring)."""
+def targets(candidates: tuple[str, ...], case_clauses: tuple[str, ...], stated: tuple[str, ...] = ()) -> tuple[str, ...]:
+    """Where a finding is booked (module docstring): on ``stated`` (:func:`stated_by`) when given."""
+    if stated:
+        return stated
     if case_clauses:
         inside = tuple(c for c in candidates if c in case_clauses)
         if inside:

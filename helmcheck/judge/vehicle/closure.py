@@ -90,12 +90,15 @@ def osi_depth_m(osi: s.OSI, depth_unit: str) -> Optional[float]:
 
 def osi_numbers(osi: s.OSI) -> tuple:
     """``(lat, lon, speed, field 7, depth or None)`` of a report as floats, worked out once per
-    report however many checks read them (``float`` of a ``Decimal`` formats and parses it)."""
+    report however many checks read them (``float`` of a ``Decimal`` formats and parses it).
+    A field the report does not show readably (``None``: a bad field, :mod:`.lines`) is None."""
     hit = _NUMBERS[0]
     if hit[0] is osi:
         return hit[1]
-    got = (float(osi.lat), float(osi.lon), float(osi.speed), float(osi.distance),
-           None if osi.depth is None else float(osi.depth))
+    lat, lon, speed, distance, depth = osi.lat, osi.lon, osi.speed, osi.distance, osi.depth
+    got = (None if lat is None else float(lat), None if lon is None else float(lon),
+           None if speed is None else float(speed), None if distance is None else float(distance),
+           None if depth is None else float(depth))
     _NUMBERS[0] = (osi, got)  # one item, replaced whole: the latest report
     return got
 
@@ -230,7 +233,7 @@ def _motion_trials(c: Candidate, osi: s.OSI, tp: float, gap: float, catalog, v: 
     out: list = []
 
     def can_reach(k: int) -> bool:
-        return reachable(c, k, v, catalog, float(osi.speed))
+        return reachable(c, k, v, catalog, osi_numbers(osi)[2] or 0.0)
 
     if m.mode == "N" and m.mission is not None:
         k = m.mission_wp
@@ -262,10 +265,11 @@ def _motion_trials(c: Candidate, osi: s.OSI, tp: float, gap: float, catalog, v: 
     elif m.mode == "mP":
         from ...model.timers import tolerance
         prof = m.profile
-        knots = max([prof.max_speed_kn, float(osi.speed)] + [x[-1] for x in (c.nav_seen, c.fix_seen) if x is not None])
+        _, _, speed, distance, _ = osi_numbers(osi)  # (an unread field 7 is no evidence of where it is)
+        knots = max([prof.max_speed_kn, speed or 0.0] + [x[-1] for x in (c.nav_seen, c.fix_seen) if x is not None])
         vmax = knots * KNOT_MPS  # m/s
         counted = max(0.0, m.opk_seconds - osi.park_time) + 1.0 + tolerance(m.opk_seconds)
-        if float(osi.distance) <= prof.on_station_m + vmax * counted:
+        if distance is None or distance <= prof.on_station_m + vmax * counted:
             def on_station(t: Candidate) -> Candidate:
                 t.model.plant(OnStation(), tp)
                 return t

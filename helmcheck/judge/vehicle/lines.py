@@ -14,6 +14,15 @@ that is a sentence with a parity bit in bit 7 of every byte fails RH-FRM-9 (not 
 the vehicle that frame into no sentence cannot be attributed (line noise looks the same) and are
 INCONCLUSIVE for RH-FRM-1 — except the same bytes before reply after reply (a modem or vehicle
 prefix), which is an RH-FRM-1 FAIL quoting them.
+
+A sentence with bad fields (:attr:`~helmcheck.grammar.Decoded.partial`: framed, checksummed, split
+into its fields, but with a field the grammar cannot read or a value out of its range) fails each
+bad field's clause — the one the grammar or the range rule names: RH-OUT-1 for a field's form,
+RH-OUT-3 for a physical range — and an ``$OSI`` among them is still a report: the rest of its
+fields are read (:data:`STATE_FIELDS` must be among them, or it shows no state), for every other
+clause, the tester's polls and the restore. The failures so booked are kept in
+:attr:`OutputJudge.read_anyway`: a fault of the line's form, not of what the vehicle does, which
+does not stop a case about another clause (:meth:`~helmcheck.certify.vehicle.session.Session.check`).
 """
 
 from __future__ import annotations
@@ -30,7 +39,7 @@ from ...profile import Profile
 from ..ledger import Evidence, Ledger
 from ..wire import LINE_CACHE
 
-__all__ = ["Kind", "classify", "OutputJudge", "ID_ACK_TYPE", "PREFIX_REPEAT"]
+__all__ = ["Kind", "classify", "OutputJudge", "ID_ACK_TYPE", "PREFIX_REPEAT", "STATE_FIELDS"]
 
 #: Sentence ID → the ACK type a vehicle answers it with (for a line it must not answer).
 ID_ACK_TYPE = {cls.ID: cls.ACK_TYPE for cls in (s.OMS, s.OMP, s.OJW, s.OMSTOP, s.OMLOAD, s.OMSTART,
@@ -41,6 +50,8 @@ PREFIX_REPEAT = 3
 _ID = re.compile(rb"\$([A-Za-z]+)[,*\r\n]")
 #: Vehicle-output decode errors → the clause a vehicle breaks by sending it.
 _OUT_CLAUSE = {"RH-FRM-4": "RH-FRM-2", "RH-FRM-5": "RH-FRM-1", "RH-FRM-7": "RH-FRM-1", "RH-ACK-3": "RH-FRM-1"}
+#: The ``$OSI`` fields a report's state is (RH-OUT-4): one of them unread, the report shows none.
+STATE_FIELDS = frozenset({"mode", "next_waypoint", "park_time", "error_state"})
 #: Backseat-line decode errors → the clause that says the vehicle discards such a line.
 _DISCARD_CLAUSE = {"RH-FRM-2": "RH-FRM-4"}
 
@@ -128,6 +139,9 @@ class OutputJudge:
         self.discards = 0
         #: a line's bytes → (its sentence, its passes), for lines judged without any fault
         self._clean: dict = {}
+        #: (clause, reason) of the failures booked for bad fields of sentences still read (module
+        #: docstring; the latest :data:`~helmcheck.judge.wire.LINE_CACHE` of them)
+        self.read_anyway: set = set()
 
     def discard(self, raw: bytes, length: int, clause: str, ev: Evidence, case: str) -> None:
         """Bytes from the vehicle that frame into no sentence."""
@@ -158,12 +172,10 @@ class OutputJudge:
                 led.failed("RH-FRM-3", f"the vehicle emitted lower-case checksum hex: {f.message}", [ev], case)
         sent = d.sentence
         if sent is None:
+            if d.partial is not None and not isinstance(d.partial, s.Command):
+                return self._partial(d, ev, case)
             err = d.error
-            clause = _OUT_CLAUSE.get(err.clause, err.clause) if err is not None else "RH-FRM-1"
-            why = str(err)
-            if d.sentence_id == "C" and clause == "RH-OUT-2":
-                clause = "RH-FRM-8"  # the $C form is RH-FRM-8's: no commas, letters in order
-                why = f"{err.message} (the form is $C<hdg>P<pitch>R<roll>T<temp>D<depth>, no commas)"
+            clause, why = self._clause(d, err)
             led.failed(clause, f"the vehicle sent an invalid {d.sentence_id or 'line'}: {why}", [ev], case)
             return None
         if isinstance(sent, s.Command):
@@ -180,6 +192,36 @@ class OutputJudge:
                 self._clean.clear()
             self._clean[d.raw] = (sent, passes)
         return sent
+
+    @staticmethod
+    def _clause(d: Decoded, err: Optional[SentenceError]) -> tuple[str, str]:
+        """The clause a vehicle breaks by sending a line the grammar read as ``err``, and why."""
+        clause = _OUT_CLAUSE.get(err.clause, err.clause) if err is not None else "RH-FRM-1"
+        why = str(err)
+        if d.sentence_id == "C" and clause == "RH-OUT-2":
+            clause = "RH-FRM-8"  # the $C form is RH-FRM-8's: no commas, letters in order
+            why = f"{err.message} (the form is $C<hdg>P<pitch>R<roll>T<temp>D<depth>, no commas)"
+        return clause, why
+
+    def _partial(self, d: Decoded, ev: Evidence, case: str) -> Optional[s.Reply]:
+        """A reply with bad fields (module docstring): each fails its own clause; an ``$OSI`` whose
+        state fields were read is returned, the bad fields ``None`` in it."""
+        sent = d.partial
+        read = isinstance(sent, s.OSI) and not d.unread & STATE_FIELDS
+        failed = set()
+        for err in d.field_errors:
+            clause, why = self._clause(d, err)
+            reason = f"the vehicle sent ${d.sentence_id} with a bad field: {why}"
+            if read:
+                if len(self.read_anyway) >= LINE_CACHE:
+                    self.read_anyway.clear()
+                self.read_anyway.add((clause, reason))
+            failed.add(clause)
+            self.ledger.failed(clause, reason, [ev], case)
+        # what the line does show: its frame, and the rules no field of it breaks
+        self.ledger.passed_all(tuple((c, "the other fields in their form and range" if c.startswith("RH-OUT") else r)
+                                     for c, r in _passes(sent, d) if c not in failed), [ev], case)
+        return sent if read else None
 
     def _parity(self, d: Decoded, ev: Evidence, case: str) -> bool:
         """RH-FRM-9: a line whose bytes carry a parity bit in bit 7 (7E1 or 7O1 read as 8N1): every

@@ -123,13 +123,14 @@ class VehicleObserver(Answers, Deadlines):
         return self.k * (self.jitter + self.res)
 
     def book(self, verdict: str, candidates: tuple[str, ...], reason: str, evidence=(),
-             at: Optional["Sent"] = None) -> None:
-        """Book a finding on :func:`~.blame.targets` of ``candidates``, in the case context of
-        ``at`` (the line it is about) or the present one."""
+             at: Optional["Sent"] = None, stated: tuple[str, ...] = ()) -> None:
+        """Book a finding on :func:`~.blame.targets` of ``candidates`` (on ``stated``, the clauses
+        that name the broken behaviour, when given), in the case context of ``at`` (the line it is
+        about) or the present one."""
         case, clauses = (at.case, at.case_clauses) if at is not None else (self.case, self.case_clauses)
         if case and verdict != "pass":
             reason = f"{case}: {reason}"
-        for cid in targets(candidates, clauses):
+        for cid in targets(candidates, clauses, stated):
             if verdict == "fail":
                 self.ledger.failed(cid, reason, evidence, case)
             elif verdict == "inconclusive":

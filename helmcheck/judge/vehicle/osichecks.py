@@ -192,8 +192,8 @@ class OsiChecks:
                 c.nav_seen = None
         last = o.last_osi
         rec = o.beliefs.primary.model.opos_records
-        if last is None or not rec:
-            return
+        if last is None or not rec or last.lat is None or last.lon is None:
+            return  # (where it was before is not known: the report before did not show it readably)
         self.pos = {"applied": rec[-1].position_applied, "lat": float(item.lat), "lon": float(item.lon),
                     "prev": (float(last.lat), float(last.lon)), "prev_t": o.last_osi_t, "t": p.t_ack,
                     "depth": osi_depth_m(last, o.profile.depth_unit)}
@@ -257,6 +257,8 @@ class OsiChecks:
     def _actuators(self, osi: s.OSI, m, p, ev: list) -> None:
         o = self.o
         cand = o.beliefs.primary
+        if osi.actuators is None:
+            return  # field 1 not readable: judged on the next report that shows it
         if osi.mode == "M" and m.mode == "M" and m.primitive is not None:
             want = m.primitive.actuators.upper()
             if osi.actuators == want:
@@ -281,9 +283,12 @@ class OsiChecks:
         o = self.o
         target = (pos["lat"], pos["lon"])
         prev = pos["prev"]
-        here = (float(osi.lat), float(osi.lon))
+        lat, lon, speed, _, _ = osi_numbers(osi)
+        if lat is None or lon is None:
+            return  # the report does not show readably where it is
+        here = (lat, lon)
         dt_v = max(0.0, o.v(o.t) - o.v(pos["prev_t"]))
-        allow = max(float(osi.speed), o.profile.max_speed_kn) * KNOT_MPS * dt_v + 10.0
+        allow = max(speed or 0.0, o.profile.max_speed_kn) * KNOT_MPS * dt_v + 10.0
         apart = distance_m(*prev, *target)
         if apart < max(_POS_DECIDABLE_M, 3 * allow):
             return  # the two readings cannot be told apart
@@ -333,7 +338,10 @@ class OsiChecks:
         # for the report judged against it (its own time is known only to within that)
         v, late = o.v(p.t) - 2 * o.slack_v(), o.v(t) + o.slack_v()
         lat, lon, speed, distance, _ = osi_numbers(osi)
-        nav = osi.mode in ("N", "P")
+        if lat is None or lon is None:
+            return  # a position not shown readably: the last one seen still bounds the way made
+        speed = speed or 0.0
+        nav = osi.mode in ("N", "P") and distance is not None
         for c in o.beliefs.cands:
             c.fix_seen = (v, late, lat, lon, speed)
             m = c.model
@@ -352,10 +360,12 @@ class OsiChecks:
         prof = o.profile
         slack = o.slack_v()
         lo, hi = o.v(p.t) - slack, o.v(t) + slack  # when the report was made
-        d = float(osi.distance)
+        _, _, speed, d, _ = osi_numbers(osi)
+        if d is None:
+            return  # field 7 not readable: where the park counts is judged on the next report
         near = d <= prof.on_station_m  # RH-RD-5: field 7 as reported, inclusive
         secs, shown = park.seconds, osi.park_time
-        park.knots = max(park.knots, prof.max_speed_kn, float(osi.speed))
+        park.knots = max(park.knots, prof.max_speed_kn, speed or 0.0)
         if not near:
             park.away.append((lo, hi, d))
             del park.away[:-_AWAY_KEPT]
@@ -408,6 +418,9 @@ class OsiChecks:
         prof = o.profile
         key = None
         d = osi_numbers(osi)[3]
+        if d is None:
+            self.watch = None  # field 7 not readable: nothing is watched across this report
+            return
         # RH-RD-5: on station means within on_station_m, inclusive, judged on field 7 as reported (a
         # vehicle that stopped 2.996 m away reports 3.00 and is on station; one still approaching
         # does not sit at that distance long enough to be watched)

@@ -62,7 +62,9 @@ class QueueTarget:
     def report(self, osi: s.OSI, model, v_early: float, v_late: float, ev: list, case: str, book) -> None:
         """One judged ``$OSI``, made between vehicle times ``v_early`` and ``v_late``, with the
         mirror's most plausible ``model``; ``book(verdict, clauses, reason)`` books a finding."""
-        lat, lon = osi_numbers(osi)[:2]
+        lat, lon, speed, distance, _ = osi_numbers(osi)
+        if lat is None or lon is None or distance is None:
+            return  # a report that does not show readably where it is says nothing of the order
         before, self.last = self.last, (v_early, lat, lon)
         if osi.mode != "W" or model.mode != "W" or model.phase != "none" or not model.queue or model.queue_parking:
             self.key = None
@@ -72,8 +74,8 @@ class QueueTarget:
         here = (lat, lon)
         if key != self.key:  # a new queue: it set out from where the last report saw it
             self.key, self.index, self.seen = key, 0, before
-        mps = max(self.max_speed_kn, float(osi.speed)) * KNOT_MPS
-        d7 = float(osi.distance)
+        mps = max(self.max_speed_kn, speed or 0.0) * KNOT_MPS
+        d7 = distance
         fits = [i for i, w in enumerate(queue)
                 if abs(d7 - (d := distance_m(*here, float(w.lat), float(w.lon)))) <= allowance(osi, d, mps)]
         if self.index in fits:
