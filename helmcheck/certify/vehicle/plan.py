@@ -152,15 +152,19 @@ class _PlanCatalog:
 
 def estimate(profile: Profile, time_scale: float, *, select: Optional[list] = None,
              examples: Optional[int] = None, hypothesis_profile: str = "fast",
-             missions_dir: Optional[Path] = None, latency_s: float = ASSUMED_LATENCY_S) -> Plan:
+             missions_dir: Optional[Path] = None, latency_s: float = ASSUMED_LATENCY_S,
+             vehicle=None) -> Plan:
     """Time the run's phases at ``time_scale`` (module docstring): the link check, the selected
-    cases, the exploration's budget and the restore, in the runner's order."""
+    cases, the exploration's budget and the restore, in the runner's order. ``vehicle``: the
+    reference vehicle's freedoms (an :class:`~helmcheck.emulator.freedoms.EmulatorSettings`; the
+    suite plans on vehicles that choose otherwise, and ``latency_s`` may then be a callable that
+    draws each line's delay)."""
     from ...emulator.core import EmulatorCore
 
     k = float(time_scale)
     profile = profile.replace(time_scale=k)
     catalog = _PlanCatalog(profile, missions_dir)
-    core = EmulatorCore(profile, catalog, start=0.0, time_scale=k, baud=profile.baud)
+    core = EmulatorCore(profile, catalog, start=0.0, time_scale=k, baud=profile.baud, settings=vehicle)
     line = VirtualLine(core, profile.baud, vehicle_delay_s=latency_s)
     ledger = Ledger([c.id for c in vehicle_clauses()])
     observer = VehicleObserver(profile, ledger, time_scale=k, baud=profile.baud)
@@ -173,7 +177,7 @@ def estimate(profile: Profile, time_scale: float, *, select: Optional[list] = No
     if profile.trigger == "operator":
         session.operator = _operator(line, core)
     plan = Plan(profile=profile.name, protocol=profile.protocol, time_scale=k, baud=profile.baud,
-                select=list(select or []), latency_s=latency_s)
+                select=list(select or []), latency_s=latency_s if not callable(latency_s) else -1.0)
 
     def timed(fn) -> tuple[float, float]:
         t0, w0 = link.now(), session.forced_wait

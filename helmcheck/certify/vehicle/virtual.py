@@ -12,7 +12,9 @@ The line model (both directions 8N1 at ``baud``, 10 bits a byte):
 
 * tester → vehicle: a write leaves when the line is free; each line of it (up to its LF)
   reaches the vehicle when its last byte has crossed, and the vehicle acts on it
-  :data:`VEHICLE_DELAY_S` later (its reading and processing time);
+  :data:`VEHICLE_DELAY_S` later (its reading and processing time), or a delay drawn per line by
+  a callable (a vehicle whose answers come anywhere inside the ACK window), in arrival order
+  all the same (RH-ACK-6);
 * vehicle → tester: the vehicle's own pacing (:class:`~helmcheck.line.transport.LinePacer`)
   decides when a sentence starts; it reaches the tester once its last byte has crossed.
 
@@ -60,12 +62,13 @@ class VirtualLine(Link):
     description = "a virtual-time line to the in-process reference vehicle"
 
     def __init__(self, core, baud: int, clock: Optional[VirtualClock] = None,
-                 vehicle_delay_s: float = VEHICLE_DELAY_S):
+                 vehicle_delay_s: "float | Callable[[], float]" = VEHICLE_DELAY_S):
         self.core = core
         self.baud = baud
         self.clock = clock if clock is not None else VirtualClock(core.start)
         self.per_byte = transmit_time(1, baud)
         self.vehicle_delay_s = vehicle_delay_s
+        self._acts = -math.inf  #: when the vehicle acted on the last line (arrival order kept)
         self._seq = 0
         self._to_vehicle: list[tuple[float, int, bytes]] = []  #: (when the vehicle acts, order, bytes)
         self._to_tester: list[tuple[float, int, bytes]] = []  #: (when the tester has them, order, bytes)
@@ -162,7 +165,9 @@ class VirtualLine(Link):
         sent = 0
         for line in data.splitlines(keepends=True):
             sent += len(line)
-            self._push(self._to_vehicle, start + sent * self.per_byte + self.vehicle_delay_s, line)
+            delay = self.vehicle_delay_s() if callable(self.vehicle_delay_s) else self.vehicle_delay_s
+            self._acts = max(self._acts, start + sent * self.per_byte + delay)
+            self._push(self._to_vehicle, self._acts, line)
         self._line_free = start + len(data) * self.per_byte
         return len(data)
 
