@@ -226,8 +226,10 @@ def run(args: argparse.Namespace) -> int:  # noqa: C901 - argument checks, then 
     finally:
         if link is not None:
             link.close()
-    from ..reports.scope import headline
-    print(f"{headline(out.results)}. {out.reason} — report: {out.report_dir / 'report.html'}")
+    from ..reports.scope import headline, what_to_change
+    change = what_to_change(out.results)
+    print(f"{headline(out.results)}. {out.reason}{' ' + change if change else ''} — report: "
+          f"{out.report_dir / 'report.html'}")
     sys.stdout.flush()
     restore = out.results.get("restore")
     if restore is not None and restore.get("attempted") and not restore.get("verified"):

@@ -39,7 +39,8 @@ from helmcheck.clauses import backseat_clauses, catalogue, vehicle_clauses
 from ..judge.verdict import Verdict
 from .view import VERDICT_LABEL
 
-__all__ = ["JUDGED", "Gap", "Scope", "claimed_clauses", "scope_of", "headline", "id_ranges", "model_coverage_note"]
+__all__ = ["JUDGED", "Gap", "Scope", "claimed_clauses", "scope_of", "headline", "id_ranges", "model_coverage_note",
+           "what_to_change"]
 
 JUDGED = (Verdict.PASS, Verdict.NON_STRICT, Verdict.FAIL)
 _GAPS_SHOWN = 4
@@ -135,6 +136,21 @@ def headline(results: Mapping[str, Any]) -> str:
     :attr:`Scope.statement`): the first line of every rendering."""
     verdict = results.get("verdict")
     return f"{VERDICT_LABEL.get(verdict, str(verdict).upper())} — {scope_of(results).statement}"
+
+
+_RUN_AT = re.compile(r"run at (.+?)(?:$|\.\s)")
+
+
+def what_to_change(results: Mapping[str, Any]) -> str:
+    """What would let the clauses the line left unjudged be judged, from their reasons (the line
+    budget names a time scale or a baud: ``run at --time-scale 5``), as one sentence; ``""`` when
+    no gap names one."""
+    out = []
+    for g in scope_of(results).gaps:
+        m = _RUN_AT.search(g.reason)
+        if m:
+            out.append(f"run at {m.group(1).rstrip('.')} to judge {id_ranges(g.clauses)}")
+    return ("On this line: " + "; ".join(out) + ".") if out else ""
 
 
 def model_coverage_note(results: Mapping[str, Any]) -> str:

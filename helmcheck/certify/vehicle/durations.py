@@ -40,7 +40,7 @@ import math
 from dataclasses import dataclass
 from typing import Optional
 
-from ...judge.linebudget import MARGIN, LineBudget
+from ...judge.linebudget import BAUDS, MARGIN, LineBudget
 from ...model.timers import tolerance
 from ...profile import Profile
 
@@ -78,6 +78,21 @@ class Durations:
     seen_by_poll: bool  #: the violation is seen by a poll first (not ``$OXFLT``, RH-SAF-5)
     dive_depth: float
     depth_unit: str
+    profile: Profile
+
+    def advice(self, need: str) -> str:
+        """The largest time scale (a whole number), else the lowest faster baud of RH-FRM-9, at
+        which this line would meet ``need``; or that the vehicle would have to answer sooner."""
+        b = self.budget
+        k = b.k
+        while k > 1:
+            k = math.floor(k) - 1 if k > 2 else 1
+            if derive(self.profile, b.at(k=k)).meets(need):
+                return f"--time-scale {k:g}"
+        for baud in BAUDS:
+            if baud > b.baud and derive(self.profile, b.at(baud=baud)).meets(need):
+                return f"--baud {baud} (if the vehicle's line allows it)"
+        return "a vehicle that answers sooner"
 
     def context(self) -> dict[str, str]:
         ctx = {"gap": f"{self.gap:.1f}", "dive_depth": f"{self.dive_depth:g}",
@@ -88,6 +103,17 @@ class Durations:
         ctx.update(opk_min=str(m), opk_s=str(60 * m), qpark=str(self.qpark or 86400), opk_long=str(self.opk_long),
                    opk_long_s=str(60 * self.opk_long), opk_long_below=str(60 * self.opk_long - 5))
         return ctx
+
+    def meets(self, need: str) -> bool:
+        """Does this line meet ``need`` (:meth:`unmet` without the reason)?"""
+        kind, _, arg = need.partition(":")
+        if kind == "timer":
+            return (self.opk_min if arg == "opk" else getattr(self, arg, None)) is not None
+        if kind == "ascent":
+            return self.ascent_ok
+        if kind == "lockout":
+            return self.lockout_ok
+        return True
 
     def unmet(self, need: str) -> Optional[str]:
         """Why a case needing ``need`` (``timer:to``, ``timer:opk``, ``lockout`` …) cannot be run
@@ -103,16 +129,16 @@ class Durations:
                     "and have both deadlines told apart", "opk": "$OPK park"}.get(arg, arg)
             hi = 1440 * 60 if arg == "opk" else self.hi
             return (f"no {what} the profile allows (up to {hi} s) can be timed on this line at time scale "
-                    f"{b.k:g} (RH-TIM-1: {b.describe()}); run at {b.advice(self.lo, hi)}")
+                    f"{b.k:g} (RH-TIM-1: {b.describe()}); run at {self.advice(need)}")
         if kind == "ascent" and not self.ascent_ok:
             return (f"after the lockout the vehicle may reach the surface from {0.8 * self.dive_depth:g} "
                     f"{self.depth_unit} before a command can be answered on this line at time scale {b.k:g} "
                     f"(RH-SAF-3: assuming an ascent of {ASCENT_MPS:g} m/s; {b.describe()}); run at "
-                    f"{_ascent_advice(b, self.dive_depth, self.depth_unit)}")
+                    f"{self.advice(need)}")
         if kind == "lockout" and not self.lockout_ok:
             return (f"the {self.lockout_s:g} s lockout ends before the commands sent into it can be "
                     f"answered on this line at time scale {b.k:g} (RH-SAF-1: {b.describe()}); run at "
-                    f"{_lockout_advice(b, self.lockout_s, self.seen_by_poll)}")
+                    f"{self.advice(need)}")
         return None
 
 
@@ -122,14 +148,6 @@ def _ascent_fits(b: LineBudget, dive_depth: float, unit: str) -> bool:
     metres = 0.8 * dive_depth * (1.0 if unit == "m" else 0.3048)
     return metres / ASCENT_MPS >= MARGIN * (b.k * b.rtt_s + b.observe_v)
 
-
-def _ascent_advice(b: LineBudget, dive_depth: float, unit: str) -> str:
-    k = b.k
-    while k > 1:
-        k = math.floor(k) - 1 if k > 2 else 1
-        if _ascent_fits(b.at(k=k), dive_depth, unit):
-            return f"--time-scale {k:g}"
-    return "a vehicle that answers sooner"
 
 
 def _lockout_fits(b: LineBudget, lockout_s: float, seen_by_poll: bool = False) -> bool:
@@ -142,14 +160,6 @@ def _lockout_fits(b: LineBudget, lockout_s: float, seen_by_poll: bool = False) -
     need += b.k * b.tx(BURST_BYTES) + MARGIN * b.observe_v
     return need + tolerance(lockout_s) <= lockout_s
 
-
-def _lockout_advice(b: LineBudget, lockout_s: float, seen_by_poll: bool) -> str:
-    k = b.k
-    while k > 1:
-        k = math.floor(k) - 1 if k > 2 else 1
-        if _lockout_fits(b.at(k=k), lockout_s, seen_by_poll):
-            return f"--time-scale {k:g}"
-    return "a vehicle that answers sooner"
 
 
 def derive(profile: Profile, budget: LineBudget) -> Durations:
@@ -180,4 +190,4 @@ def derive(profile: Profile, budget: LineBudget) -> Durations:
     by_poll = profile.trigger != "oxflt"
     return Durations(b, lo, hi, to, to_long, to_tim, to_restart, round(gap, 1), opk_min, opk_long, qpark,
                      _lockout_fits(b, profile.lockout_s, by_poll), _ascent_fits(b, depth, profile.depth_unit),
-                     profile.lockout_s, by_poll, depth, profile.depth_unit)
+                     profile.lockout_s, by_poll, depth, profile.depth_unit, profile)
