@@ -270,8 +270,8 @@ CASES: tuple[Case, ...] = (
        "in S at the surface the position is not applied, conductivity/temperature are; after an "
        "ignore-GPS start the position is applied", "S",
        Until("the surface in S", mode="S", surface=True, budget_v=300.0),
-       Send("OPOS,{near_lat},{lon},0.5,33.3,12.5"), Poll(), Octd(), Start(ignore_gps=1), Send(OMS0), Poll(),
-       Send("OPOS,{near_lat},{lon},0,,"), Poll()),
+       Send("OPOS,{opos_lat},{lon},0.5,33.3,12.5"), Poll(), Octd(), Start(ignore_gps=1), Send(OMS0), Poll(),
+       Send("OPOS,{opos_lat},{lon},0,,"), Poll()),
     _c("V-50", "RH-OSD-1", "$OSD forms and order",
        "positional and free order both work, replies come in request order, a repeated letter is "
        "served twice", "N",

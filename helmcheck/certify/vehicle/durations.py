@@ -24,6 +24,9 @@ The keys :meth:`Durations.context` adds to a case's templates (:mod:`.interprete
 ``qpark``       a park time on a queued ``$OMW`` waypoint the observer can time (RH-OMW-4)
 ``dive_depth``  the depth of the dive before a violation (10 m, at most half the depth range)
 ``dive_at``     the depth at which the dive counts as under way (four fifths of it)
+``opos_m``      how far an ``$OPOS`` moves the vehicle (metres; ``{opos_lat}`` is that far north):
+                far enough that the next report tells applied from not applied (RH-POS-2) however
+                far the vehicle can have gone at full speed since the report before it
 ==============  ==============================================================================
 
 Decisions (the profile is silent): a dive goes to 10 m (at the bench speed it takes a while); the
@@ -48,7 +51,7 @@ __all__ = ["Durations", "derive", "BURST_BYTES", "DURATION_KEYS"]
 
 #: The template keys :meth:`Durations.context` fills.
 DURATION_KEYS = ("to", "to_long", "to_tim", "to_restart", "gap", "opk_min", "opk_s", "qpark", "dive_depth",
-                 "dive_at", "opk_long", "opk_long_s", "opk_long_below")
+                 "dive_at", "opk_long", "opk_long_s", "opk_long_below", "opos_m")
 #: The ascent rate (m/s) after a lockout a case plans for (the reference emulator's): the profile
 #: sets none, so a case that needs the vehicle under water after a lockout says so when it is assumed.
 ASCENT_MPS = 0.3
@@ -79,6 +82,7 @@ class Durations:
     dive_depth: float
     depth_unit: str
     profile: Profile
+    opos_m: float
 
     def advice(self, need: str) -> str:
         """The largest time scale (a whole number), else the lowest faster baud of RH-FRM-9, at
@@ -96,7 +100,7 @@ class Durations:
 
     def context(self) -> dict[str, str]:
         ctx = {"gap": f"{self.gap:.1f}", "dive_depth": f"{self.dive_depth:g}",
-               "dive_at": f"{0.8 * self.dive_depth:g}"}
+               "dive_at": f"{0.8 * self.dive_depth:g}", "opos_m": f"{self.opos_m:.0f}"}
         for key in ("to", "to_long", "to_tim", "to_restart"):
             ctx[key] = str(getattr(self, key) or self.hi)
         m = self.opk_min or 1440
@@ -162,6 +166,14 @@ def _lockout_fits(b: LineBudget, lockout_s: float, seen_by_poll: bool = False) -
 
 
 
+def _opos_m(profile: Profile, b: LineBudget) -> float:
+    """Metres an ``$OPOS`` moves the vehicle: four times the way it can make at full speed between
+    the report before it and the report after it (two round trips) and 10 m, at least 110 m (the
+    judge decides only beyond three times that, :mod:`helmcheck.judge.vehicle.osichecks`)."""
+    way = profile.max_speed_kn * 0.514444 * 2 * MARGIN * b.k * b.rtt_s + 10.0
+    return max(110.0, 4 * way)
+
+
 def derive(profile: Profile, budget: LineBudget) -> Durations:
     """The durations for ``profile`` on the line ``budget`` describes."""
     lo, hi = int(profile.timeout_range[0]), int(profile.timeout_range[1])
@@ -190,4 +202,4 @@ def derive(profile: Profile, budget: LineBudget) -> Durations:
     by_poll = profile.trigger != "oxflt"
     return Durations(b, lo, hi, to, to_long, to_tim, to_restart, round(gap, 1), opk_min, opk_long, qpark,
                      _lockout_fits(b, profile.lockout_s, by_poll), _ascent_fits(b, depth, profile.depth_unit),
-                     profile.lockout_s, by_poll, depth, profile.depth_unit, profile)
+                     profile.lockout_s, by_poll, depth, profile.depth_unit, profile, _opos_m(profile, b))

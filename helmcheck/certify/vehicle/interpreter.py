@@ -47,14 +47,16 @@ def context(session: Session) -> dict:
            "depth_over": f"{p.max_depth + 1:g}", "speed_over": f"{p.max_speed_kn + 0.5:g}",
            # deep enough that an ascent after a lockout takes a while, within any depth range
            "dive_depth": f"{min(p.max_depth / 2, 10.0 if p.depth_unit == 'm' else 33.0):g}"}
+    ctx.update(session.durations().context())
     _position(ctx, lat, lon)
     _other(session, ctx)
-    ctx.update(session.durations().context())
     return ctx
 
 
 def _position(ctx: dict, lat: str, lon: str) -> None:
+    opos = float(ctx.get("opos_m", 110.0)) / 111320.0  # an $OPOS the next report tells apart (RH-POS-2)
     ctx.update(lat=lat, lon=lon, near_lat=f"{float(lat) + 0.001:.6f}", near_lon=f"{float(lon) + 0.001:.6f}",
+               opos_lat=f"{float(lat) + opos:.6f}",
                far_lat=f"{float(lat) + 1.0:.6f}", km_lat=f"{float(lat) + 0.01:.6f}",  # 1.1 km north
                stn_lat=f"{float(lat) + 15.0 / 111320.0:.6f}")  # 15 m north
 

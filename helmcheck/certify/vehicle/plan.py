@@ -104,6 +104,7 @@ class Plan:
     latency_s: float = ASSUMED_LATENCY_S
     line: dict = field(default_factory=dict)  #: the line budget (``LineBudget.as_dict``)
     durations: dict = field(default_factory=dict)  #: the durations chosen from it (``Durations.context``)
+    verdicts: dict = field(default_factory=dict)  #: clause → the judge's verdict on the planned vehicle
 
     @property
     def total_wall_s(self) -> float:
@@ -156,15 +157,20 @@ def estimate(profile: Profile, time_scale: float, *, select: Optional[list] = No
              vehicle=None) -> Plan:
     """Time the run's phases at ``time_scale`` (module docstring): the link check, the selected
     cases, the exploration's budget and the restore, in the runner's order. ``vehicle``: the
-    reference vehicle's freedoms (an :class:`~helmcheck.emulator.freedoms.EmulatorSettings`; the
-    suite plans on vehicles that choose otherwise, and ``latency_s`` may then be a callable that
-    draws each line's delay)."""
+    reference vehicle's freedoms (an :class:`~helmcheck.emulator.freedoms.EmulatorSettings`), or a
+    callable ``(profile, catalog, k) -> core`` that makes another vehicle: the suite runs the cases
+    on vehicles that choose otherwise, and on faulty ones, over lines in virtual time (``latency_s``
+    may then be a callable that draws each line's delay); :attr:`Plan.verdicts` holds what the
+    judge made of them."""
     from ...emulator.core import EmulatorCore
 
     k = float(time_scale)
     profile = profile.replace(time_scale=k)
     catalog = _PlanCatalog(profile, missions_dir)
-    core = EmulatorCore(profile, catalog, start=0.0, time_scale=k, baud=profile.baud, settings=vehicle)
+    if callable(vehicle):
+        core = vehicle(profile, catalog, k)
+    else:
+        core = EmulatorCore(profile, catalog, start=0.0, time_scale=k, baud=profile.baud, settings=vehicle)
     line = VirtualLine(core, profile.baud, vehicle_delay_s=latency_s)
     ledger = Ledger([c.id for c in vehicle_clauses()])
     observer = VehicleObserver(profile, ledger, time_scale=k, baud=profile.baud)
@@ -222,6 +228,7 @@ def estimate(profile: Profile, time_scale: float, *, select: Optional[list] = No
     finally:
         recorder.close()
         observer.close()
+    plan.verdicts = {v.id: v.verdict for v in ledger.verdicts()}
     plan.missions = {"directories": [str(d) for d in catalog.dirs], "given": missions_dir is not None,
                      "stand_ins": dict(catalog.stand_ins)}
     plan.assumptions = _assumptions(plan, profile, catalog, missions_dir, n, budget, hypothesis_profile)

@@ -8,7 +8,8 @@ the clause on this vehicle: INCONCLUSIVE with that reason, never PASS.
 
 Templates in step text (and in the numbers a step takes as text, ``Wait("{gap}")``): the durations
 the line budget allows (``{to}``, ``{to_long}``, ``{to_tim}``, ``{to_restart}``, ``{gap}``,
-``{opk_min}``, ``{opk_s}``, ``{dive_depth}``, ``{dive_at}``: :mod:`.durations`), ``{mission}`` the profile's mission, ``{speed}`` a speed within the
+``{opk_min}``, ``{opk_s}``, ``{dive_depth}``, ``{dive_at}``: :mod:`.durations`; ``{opos_lat}`` a point
+far enough north that an ``$OPOS`` there is told applied or not by the next report), ``{mission}`` the profile's mission, ``{speed}`` a speed within the
 bench-safety limit, ``{motor}`` a motor byte within it, ``{lat}``/``{lon}`` the vehicle's last
 reported position, ``{near_lat}``/``{near_lon}`` a point ~110 m north/east of it, ``{far_lat}`` one
 ~111 km north, ``{km_lat}`` one ~1.1 km north, ``{wp_last}``/``{wp_bad}`` the last and one-past-the-last waypoint number,

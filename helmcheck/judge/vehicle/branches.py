@@ -74,7 +74,9 @@ def branches(c: Candidate, item, v: float, slack_v: float, catalog) -> list:
         t = c.clone()
         t.model.plant(_wp(), tp)
         if t.model.mode in ("N", "P"):
-            t.adopted(f"mission waypoint reached just before the command (v={tp:.1f}..{v:.1f})", tp, v)
+            # strictly before the command: what the command itself starts (a takeover's timeout, at
+            # its ACK, RH-RD-15) is not in the window and keeps its own timing
+            t.adopted(f"mission waypoint reached just before the command (v={tp:.1f}..{v:.1f})", tp, v - 1e-3)
             t.model.advance(v)
             before = (t.model.mode, t.model.phase)
             row = t.model.row_for(item)

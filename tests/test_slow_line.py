@@ -1,0 +1,96 @@
+"""Certifications on slow lines, on real ptys: the Iver3's 19200 baud, replies 0.6 s after each line.
+
+A reply 0.6 s after its command is inside the 1 s ACK window (RH-ACK-2), and the window is wall
+time at any time scale (RH-TIM-2): at x20 it is 12 s of vehicle time per exchange. A conforming
+vehicle on such a line must certify PASS with every clause it claims judged, and a faulty one must
+still FAIL on its clause. ``tests/test_line_budget.py`` runs every case over such lines in virtual
+time; this file runs the real thing, end to end (the emulator, the independent simulator behind
+the line-fault relay, a faulty vehicle behind it), on the clauses whose timing the line changes:
+
+* the built-in emulator answering every line 0.6 s late (its ``reply_delay_s`` freedom), paced at
+  19200 baud, at x20 — the servo and primitive timeouts and their restart, the release to the
+  mission, the lockout and the ascent after it, RH-TIM-1/2;
+* ``../shared/third-party/uvc_sim.py`` (a vehicle we did not write) behind the relay
+  (``helmcheck relay``'s ``baud=19200,<line-delay=0.6``): every line it sends paced at 19200 and
+  held 0.6 s — any vehicle can be put behind such a line;
+* a faulty vehicle behind the same relay: still FAIL on its own clause.
+
+Whole certifications (every case and the exploration) on every line-timing freedom at x5, x20 and
+x40 are ``make matrix``'s (``HELMCHECK_MATRIX=1``; the README says how long).
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import pytest
+
+from helmcheck.certify.vehicle.runner import Options, certify
+from helmcheck.line.faultline import impaired_line
+from helmcheck.profile import emulator_profile
+
+from tests.judging import not_passed
+
+MATRIX = os.environ.get("HELMCHECK_MATRIX") == "1"
+ROOT = Path(__file__).resolve().parent.parent
+SIM = ROOT.parent / "shared" / "third-party" / "uvc_sim.py"
+SLOW = "baud=19200,<line-delay=0.6"
+
+#: The clauses whose cases set timers going, confirm what they set, wait out a lockout or an ascent.
+TIMING = ["RH-SRV-3", "RH-SRV-4", "RH-PRM-4", "RH-INT-2", "RH-SAF-1", "RH-SAF-3", "RH-TIM-1", "RH-TIM-2"]
+
+
+def _certify(port: str, profile, k: float, out: Path, select=None, examples: int = 0):
+    return certify(Options(port=port, profile=profile.replace(time_scale=k), time_scale=k, report_dir=out,
+                           select=select, examples=examples, progress=False, render=False, seed=1))
+
+
+def _judged_pass(out, select) -> None:
+    bad = not_passed(out.results)
+    assert not bad, bad
+    judged = {c["id"] for c in out.results["clauses"] if c["verdict"] == "pass"}
+    assert set(select) <= judged, {c["id"]: c["reason"] for c in out.results["clauses"] if c["id"] in select}
+    budget = out.results["settings"]["line_budget"]
+    assert budget["measured"] and budget["latency_p50_s"] >= 0.5, budget  # it saw the line it ran on
+
+
+def test_the_emulator_answering_every_line_0_6_s_late_at_x20_passes(tmp_path):
+    """The issue's vehicle: every reply 0.6 s after its line (RH-RD-15: durations start as the ACK
+    goes out), 19200 baud, x20. Before the line budget: 13 INCONCLUSIVE and 4 false FAILs."""
+    from helmcheck.emulator.process import EmulatorProcess  # the emulator as a process of its own
+    profile = emulator_profile()
+    with EmulatorProcess(["--set", "reply_delay_s=0.6"], time_scale=20.0, baud=19200) as emu:
+        out = _certify(emu.port, profile, 20.0, tmp_path / "r", select=TIMING)
+    _judged_pass(out, TIMING)
+
+
+def _sim_profile(tmp: Path) -> object:
+    from helmcheck.profile import load_profile
+    path = tmp / "sim.toml"
+    path.write_text('protocol = "rh5"\nmission = "conformance.mis"\nmission_waypoints = 4\nsrp_mission = "srp.mis"\n'
+                    'fault_injection = "oxflt"\nviolation_trigger = "oxflt"\n')
+    return load_profile(str(path))
+
+
+@pytest.mark.skipif(not SIM.is_file(), reason=f"the independent simulator is not there: {SIM}")
+def test_a_vehicle_we_did_not_write_behind_a_slow_line_passes(tmp_path):
+    """``uvc_sim.py`` behind the relay: 19200 baud, each line it sends held 0.6 s (its own missions)."""
+    from tests.test_third_party_vehicle import uvc_sim
+    with uvc_sim(tmp_path, 20.0) as port, impaired_line(port, SLOW, link=tmp_path / "vehicle") as line:
+        out = _certify(str(line.port), _sim_profile(tmp_path), 20.0, tmp_path / "r", select=TIMING)
+    _judged_pass(out, TIMING)
+
+
+def test_a_faulty_vehicle_behind_a_slow_line_still_fails_its_clause(tmp_path):
+    """A servo that ignores a second ``$OMS`` (RH-SRV-3: the timeout is not restarted) behind the
+    same line: FAIL on RH-SRV-3 (the restart is told apart with the line's durations)."""
+    from tests.faulty_vehicles import EMU_PROFILE, MUTANTS, make_core, serve
+    mutant = next(m for m in MUTANTS if m.clause == "RH-SRV-3")
+    with serve(lambda start: make_core(mutant, 20.0, start)) as port, \
+            impaired_line(port, SLOW, link=tmp_path / "vehicle") as line:
+        out = _certify(str(line.port), EMU_PROFILE.replace(baud=19200), 20.0, tmp_path / "r",
+                       select=list(mutant.select))
+    failed = {c["id"] for c in out.results["clauses"] if c["verdict"] == "fail"}
+    assert mutant.clause in failed, out.reason
+    assert out.exit_code == 1
