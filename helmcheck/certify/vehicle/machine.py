@@ -72,6 +72,10 @@ def _reach_park(session, ctx: dict) -> None:
     _here(session, ctx)
 
 
+#: Commands that may set a timer going (a remote control's timeout, a park, RH-RD-15).
+_ARMING = frozenset({"OMS", "OMP", "OPK", "OMW", "ODVL", "OJW", "OMSTART"})
+
+
 def machine(state, p, tos, deep: bool = True):
     """The ``RuleBasedStateMachine`` class of one exploration: ``state`` is shared by its
     instances (the exploration's budget, counts, coverage and smallest failure). ``deep=False``:
@@ -269,7 +273,12 @@ def machine(state, p, tos, deep: bool = True):
             self._guard(lambda: self._together(bodies))
 
         def _together(self, bodies) -> None:
-            """Write the lines back to back, then read the answers (RH-ACK-6), coverage counted."""
+            """Write the lines back to back, then read the answers (RH-ACK-6), coverage counted. A
+            command that may set a timer going goes first: behind another command's data its ACK
+            would wait on a paced line, and when it took effect (RH-RD-15) would be known only
+            within their transmit time — at a high time scale too widely to time what it started
+            (an observation the exploration must not book)."""
+            bodies = sorted(bodies, key=lambda b: 0 if b.split(",", 1)[0] in _ARMING else 1)
             raws = [frame(fill(b, self.ctx)) for b in bodies]
             mets = [cov.before(obs.state(), r) for r in raws]
             for met, sent in zip(mets, session.burst(raws)):

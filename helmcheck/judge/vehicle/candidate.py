@@ -161,6 +161,8 @@ class Candidate:
             return []
         steps, self.model.trace = list(trace), []
         fired = []
+        if any(st.row.event == "violation" for st in steps):
+            self._depth_unknown()
         for st in steps:
             row = st.row
             before_mode, before_phase = self._mode, self._phase
@@ -181,6 +183,17 @@ class Candidate:
                 self.timed.append(Timed(st.timer, row, st.at, st.duration, before_mode, t_old, self.extra_v))
             self._book(row, before_mode, before_phase)
         return fired
+
+    def _depth_unknown(self) -> None:
+        """A violation came: the depth the mirror has is the last report's, from before it, and the
+        vehicle may have gone down since (a mission's dive). During the lockout it holds that unseen
+        depth (RH-RD-11), so whether it is at the surface when the lockout ends (RH-SAF-4 at once, or
+        the ascent first) is for a report to show: the surface is then adopted (:mod:`.closure`),
+        never assumed from a depth read before the violation."""
+        m = self.model
+        fix = m.profile.gps_fix_depth_m
+        if m.phase == "lockout" and m.snapshot.depth_m <= fix:
+            m.update_plant(m.snapshot.with_(depth_m=fix + 1e-3))
 
     def _book(self, row: Row, before_mode: str, before_phase: str) -> None:
         if row.error is not None:
