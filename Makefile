@@ -4,7 +4,7 @@ VENV   := .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 
-.PHONY: demo test fuzz bench docs clean explore-reach
+.PHONY: demo test fuzz bench docs clean explore-reach matrix
 
 #: The property tests, for `make fuzz`.
 FUZZ_TESTS := tests/test_grammar_fastpath.py tests/test_grammar_framer.py tests/test_grammar_roundtrip.py \
@@ -35,6 +35,14 @@ fuzz: $(STAMP)
 # suite (tests/test_explore_reach.py, benchmarks/explore_reach.py).
 explore-reach: $(STAMP)
 	HELMCHECK_REACH=1 $(PY) -m pytest -q tests/test_explore_reach.py
+
+# Not run by CI (about an hour on two cores): the slow-line grid — every case on the reference and
+# every faulty vehicle over lines in virtual time (time scales 1-40, replies 3 ms-0.9 s, 9600-115200
+# baud, the timing freedoms at their bounds), and whole certifications on real ptys of the emulator
+# at each line-timing freedom's bound at x5, x20 and x40 and of the independent simulator behind a
+# slow line (tests/test_line_budget.py, tests/test_slow_line.py).
+matrix: $(STAMP)
+	HELMCHECK_MATRIX=1 $(PY) -m pytest -n 2 tests/test_line_budget.py tests/test_slow_line.py
 
 bench: $(STAMP)
 	$(PY) benchmarks/run_all.py

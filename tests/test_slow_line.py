@@ -99,3 +99,54 @@ def test_a_faulty_vehicle_behind_a_slow_line_still_fails_its_clause(tmp_path):
     failed = {c["id"] for c in out.results["clauses"] if c["verdict"] == "fail"}
     assert mutant.clause in failed, out.reason
     assert out.exit_code == 1
+
+
+# ============================================================================ make matrix
+
+#: The line-timing freedoms at their bounds (docs/freedoms.md), each on the emulator as a process.
+FREEDOMS = {
+    "reply-0.6": ["reply_delay_s=0.6"],
+    "reply-drawn": ["reply_delay_s=[0.05, 0.6]", "seed=3"],
+    "paced-9600": [],  # the baud below
+    "tick-and-late-timers": ["control_tick_s=0.2", "timer_offset_s=0.3"],
+    "all-together": ["reply_delay_s=[0.05, 0.6]", "control_tick_s=0.2", "timer_offset_s=0.3"],
+}
+GRID = [(name, k) for name in FREEDOMS for k in (5.0, 20.0, 40.0)]
+
+
+@pytest.mark.skipif(not MATRIX, reason="make matrix (HELMCHECK_MATRIX=1): whole certifications, about an hour")
+@pytest.mark.parametrize("name,k", GRID, ids=[f"{n}-x{k:g}" for n, k in GRID])
+def test_matrix_a_whole_certification_on_a_slow_line_is_a_certificate(name, k, tmp_path):
+    """Every case and the exploration (its default budget) on the emulator at one freedom's bound:
+    PASS with a certificate, or a clause NOT-TESTED before it ran because this line cannot carry it
+    at this time scale (said so, with the time scale that would) — never INCONCLUSIVE, never FAIL."""
+    from helmcheck.emulator.process import EmulatorProcess
+    baud = 9600 if name == "paced-9600" else 19200
+    profile = emulator_profile().replace(baud=baud)
+    with EmulatorProcess([x for a in FREEDOMS[name] for x in ("--set", a)], time_scale=k, baud=baud) as emu:
+        out = _certify(emu.port, profile, k, tmp_path / "r", examples=None)
+    bad = {c["id"]: c["reason"] for c in out.results["clauses"]
+           if c["verdict"] not in ("pass", "not-tested") or (c["verdict"] == "not-tested" and "run at" not in c["reason"])}
+    assert not bad, bad
+    assert out.exit_code in (0, 2) and (out.exit_code == 0) == out.results["certificate"], out.reason
+
+
+@pytest.mark.skipif(not MATRIX, reason="make matrix (HELMCHECK_MATRIX=1)")
+def test_matrix_a_short_selection_at_x1_on_a_slow_line(tmp_path):
+    """Real time (x1): the timing clauses on the emulator answering 0.6 s late at 19200 baud."""
+    from helmcheck.emulator.process import EmulatorProcess
+    with EmulatorProcess(["--set", "reply_delay_s=0.6"], time_scale=1.0, baud=19200) as emu:
+        out = _certify(emu.port, emulator_profile(), 1.0, tmp_path / "r", select=["RH-SRV-3", "RH-SRV-4", "RH-PRM-4"])
+    _judged_pass(out, ["RH-SRV-3", "RH-SRV-4", "RH-PRM-4"])
+
+
+@pytest.mark.skipif(not MATRIX or not SIM.is_file(), reason="make matrix (HELMCHECK_MATRIX=1), with ../shared")
+@pytest.mark.parametrize("k", (5.0, 20.0))
+def test_matrix_the_simulator_behind_a_slow_line_is_a_certificate(k, tmp_path):
+    """``uvc_sim.py`` behind the relay (19200 baud, lines held 0.6 s): every case and the exploration."""
+    from tests.test_third_party_vehicle import uvc_sim
+    with uvc_sim(tmp_path, k) as port, impaired_line(port, SLOW, link=tmp_path / "vehicle") as line:
+        out = _certify(str(line.port), _sim_profile(tmp_path), k, tmp_path / "r", examples=None)
+    bad = {c["id"]: c["reason"] for c in out.results["clauses"]
+           if c["verdict"] not in ("pass", "not-tested") or (c["verdict"] == "not-tested" and "run at" not in c["reason"])}
+    assert not bad, bad
