@@ -226,9 +226,9 @@ def run(args: argparse.Namespace) -> int:  # noqa: C901 - argument checks, then 
     finally:
         if link is not None:
             link.close()
-    from ..reports.scope import headline, what_to_change
-    change = what_to_change(out.results)
-    print(f"{headline(out.results)}. {out.reason}{' ' + change if change else ''} — report: "
+    from ..reports.scope import headline, precision_note, what_to_change
+    notes = [x for x in (what_to_change(out.results), precision_note(out.results)) if x]
+    print(f"{headline(out.results)}. {out.reason}{''.join(' ' + x for x in notes)} — report: "
           f"{out.report_dir / 'report.html'}")
     sys.stdout.flush()
     restore = out.results.get("restore")

@@ -71,11 +71,19 @@ class ClauseVerdict:
     lines: tuple[int, ...] = ()
     offending_count: int = 0
     observations: int = 0
+    #: a timing clause's precision: the coarsest RH-TIM-1 tolerance it was judged with (the
+    #: nominal ``max(0.5 s, 5 %)`` and the tolerance widened by what the observer could not see),
+    #: vehicle seconds, and the time scale (:meth:`Ledger.precision`); None for other clauses
+    precision: Optional[tuple[float, float, float]] = None
 
     def as_entry(self) -> dict:
-        return {"id": self.id, "verdict": self.verdict, "reason": self.reason, "level": self.level,
-                "cases": list(self.cases), "evidence": [e.as_dict() for e in self.evidence],
-                "lines": list(self.lines), "offending_count": self.offending_count, "replay": None}
+        out = {"id": self.id, "verdict": self.verdict, "reason": self.reason, "level": self.level,
+               "cases": list(self.cases), "evidence": [e.as_dict() for e in self.evidence],
+               "lines": list(self.lines), "offending_count": self.offending_count, "replay": None}
+        if self.precision is not None:
+            nominal, widened, k = self.precision
+            out["precision"] = {"nominal_s": round(nominal, 3), "widened_s": round(widened, 3), "time_scale": k}
+        return out
 
 
 @dataclass(slots=True)
@@ -94,6 +102,7 @@ class _Entry:
     cases: dict = field(default_factory=dict)
     remarks: list = field(default_factory=list)
     withdrawn: Optional[tuple[str, str]] = None  #: (reason, prefix of an observed violation's reason)
+    precision: Optional[tuple[float, float, float]] = None  #: the coarsest (nominal, widened, k) so far
 
 
 class Ledger:
@@ -239,6 +248,16 @@ class Ledger:
             else:
                 self._add(cid, INCONCLUSIVE, f"{why}: {reason}", evidence, case)
 
+    def precision(self, cid: str, nominal: float, widened: float, k: float) -> None:
+        """A duration of ``cid`` was judged within ``widened`` vehicle seconds (RH-TIM-1's nominal
+        ``nominal`` widened by what the observer could not see, at time scale ``k``): the clause
+        keeps the coarsest, the widening its verdict rests on (a PASS holds to that precision)."""
+        e = self._e.get(cid)
+        if e is None:
+            return
+        if e.precision is None or widened - nominal > e.precision[1] - e.precision[0]:
+            e.precision = (nominal, widened, k)
+
     def remark(self, cid: str, text: str) -> None:
         """A remark appended to the clause's reason (an inference its verdict rests on)."""
         e = self._e.get(cid)
@@ -305,14 +324,21 @@ class Ledger:
             n = lv[NOT_TESTED]
             reason = n.reason or "no occasion to exercise this clause"
             out = ClauseVerdict(cid, NOT_TESTED, reason, level, cases, (), (), 0, 0)
+        if e.precision is not None and out.verdict in (PASS, NON_STRICT, FAIL):
+            nominal, widened, k = e.precision
+            out = ClauseVerdict(out.id, out.verdict, out.reason + f" Timing judged within ±{widened:.2f} s of vehicle time "
+                                f"at ×{k:g} (RH-TIM-1's nominal tolerance ±{nominal:g} s, widened by what the observer "
+                                f"could not see).", out.level, out.cases, out.evidence, out.lines, out.offending_count,
+                                out.observations, (nominal, widened, k))
         if e.remarks and out.verdict != NOT_TESTED:
             out = ClauseVerdict(out.id, out.verdict, out.reason + " Note: " + " ".join(e.remarks), out.level,
-                                out.cases, out.evidence, out.lines, out.offending_count, out.observations)
+                                out.cases, out.evidence, out.lines, out.offending_count, out.observations,
+                                out.precision)
         if e.withdrawn is not None:
             why, observed = e.withdrawn
             if out.verdict in (FAIL, NON_STRICT):
                 out = ClauseVerdict(out.id, out.verdict, observed + out.reason, out.level, out.cases, out.evidence,
-                                    out.lines, out.offending_count, out.observations)
+                                    out.lines, out.offending_count, out.observations, out.precision)
             else:
                 out = ClauseVerdict(cid, NOT_TESTED, why, level, (), (), (), 0, 0)
         return out

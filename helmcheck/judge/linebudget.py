@@ -58,7 +58,7 @@ from ..model.timers import tolerance
 from .timing import JITTER_S
 
 __all__ = ["LineBudget", "MARGIN", "POLL_PAUSE_S", "OSI_BYTES", "POLL_BYTES", "ACK_BYTES", "planning_latency",
-           "planning_spread",
+           "planning_spread", "NOMINAL_WIDENING_S", "from_settings",
            "parse_budget", "BAUDS", "assumed"]
 
 #: Every uncertainty a tester's choice rests on is taken 1.25 times (a choice that only just fits
@@ -71,6 +71,10 @@ OSI_BYTES = 170
 #: ``$OSD,S*27`` CR LF, and an ``$ACK,8,0,0*hh`` CR LF.
 POLL_BYTES = 11
 ACK_BYTES = 15
+#: Timing judged to *nominal precision*: what the observer adds to RH-TIM-1's tolerance is at most
+#: this (vehicle seconds), so a duration off by more than the tolerance and 0.3 s is certain to fail.
+#: Coarser than that a timing PASS says how coarse (:meth:`LineBudget.nominal_scale`, ``--precision``).
+NOMINAL_WIDENING_S = 0.3
 #: The baud rates RH-FRM-9 names, for advice.
 BAUDS = (9600, 19200, 57600, 115200)
 #: The reply latency assumed before the link check has measured one (wall seconds).
@@ -173,6 +177,21 @@ class LineBudget:
         """The widened tolerance a duration ``d`` is judged with here (module docstring)."""
         return tolerance(d) + self.observe_v + self.poll_v
 
+    def widening_v(self) -> float:
+        """What the observer adds to RH-TIM-1's tolerance on this line (:meth:`precision_v` less
+        the tolerance): a duration off by more than the tolerance and this is certain to fail."""
+        return self.observe_v + self.poll_v
+
+    def nominal_scale(self) -> Optional[float]:
+        """The largest whole time scale (at most this one) at which the observer judges durations to
+        nominal precision (:data:`NOMINAL_WIDENING_S`) on this line, or None (not even at x1)."""
+        k = math.floor(self.k)
+        while k >= 1:
+            if self.at(k=float(k)).widening_v() <= NOMINAL_WIDENING_S:
+                return float(k)
+            k -= 1
+        return None
+
     def at(self, k: Optional[float] = None, baud: Optional[int] = None) -> "LineBudget":
         """The same line at another time scale or baud (the latency and the host stay)."""
         return replace(self, k=self.k if k is None else k, baud=self.baud if baud is None else baud)
@@ -223,6 +242,16 @@ class LineBudget:
                 "samples": self.samples, "jitter_s": round(self.jitter_s, 4), "osi_bytes": self.osi_bytes,
                 "round_trip_s": round(self.rtt_s, 4), "observe_v": round(self.observe_v, 3),
                 "poll_v": round(self.poll_v, 3), "describe": self.describe()}
+
+
+def from_settings(d: dict) -> Optional[LineBudget]:
+    """The budget ``results.json`` recorded (``settings.line_budget``, :meth:`LineBudget.as_dict`)."""
+    try:
+        return LineBudget(k=float(d["time_scale"]), baud=int(d["baud"]), latency_s=float(d["latency_planned_s"]),
+                          jitter_s=float(d["jitter_s"]), osi_bytes=int(d["osi_bytes"]),
+                          spread_s=float(d.get("spread_planned_s", d["latency_planned_s"])), measured=True)
+    except (KeyError, TypeError, ValueError):
+        return None
 
 
 def assumed(k: float, baud: int, window_s: float = 1.0) -> LineBudget:

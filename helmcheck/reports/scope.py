@@ -40,7 +40,7 @@ from ..judge.verdict import Verdict
 from .view import VERDICT_LABEL
 
 __all__ = ["JUDGED", "Gap", "Scope", "claimed_clauses", "scope_of", "headline", "id_ranges", "model_coverage_note",
-           "what_to_change"]
+           "what_to_change", "precision_note"]
 
 JUDGED = (Verdict.PASS, Verdict.NON_STRICT, Verdict.FAIL)
 _GAPS_SHOWN = 4
@@ -151,6 +151,34 @@ def what_to_change(results: Mapping[str, Any]) -> str:
         if m:
             out.append(f"run at {m.group(1).rstrip('.')} to judge {id_ranges(g.clauses)}")
     return ("On this line: " + "; ".join(out) + ".") if out else ""
+
+
+def precision_note(results: Mapping[str, Any]) -> str:
+    """How many timing clauses were judged coarser than nominal precision (their tolerance widened
+    by more than :data:`~helmcheck.judge.linebudget.NOMINAL_WIDENING_S` by what the observer could
+    not see), and the time scale at which this line would judge them to it; ``""`` when none was."""
+    from ..judge.linebudget import NOMINAL_WIDENING_S, from_settings
+
+    coarse = []
+    k = None
+    for c in results.get("clauses") or []:
+        pr = c.get("precision") if isinstance(c, Mapping) else None
+        if c.get("verdict") in JUDGED and isinstance(pr, Mapping) and \
+                pr.get("widened_s", 0) - pr.get("nominal_s", 0) > NOMINAL_WIDENING_S:
+            coarse.append((c["id"], pr))
+            k = pr.get("time_scale", k)
+    if not coarse:
+        return ""
+    worst = max(coarse, key=lambda x: x[1]["widened_s"] - x[1]["nominal_s"])
+    text = (f"{len(coarse)} timing clause(s) judged coarser than RH-TIM-1's tolerance at ×{k:g} "
+            f"({worst[0]} within ±{worst[1]['widened_s']:g} s, nominal ±{worst[1]['nominal_s']:g} s)")
+    budget = from_settings(((results.get("settings") or {}).get("line_budget")) or {})
+    nominal = budget.nominal_scale() if budget is not None else None
+    if nominal is not None and nominal < (k or 0):
+        text += f": run at ×{nominal:g} for nominal precision on this line"
+    elif budget is not None and nominal is None:
+        text += ": even at ×1 this line is coarser (a faster baud or a vehicle that answers sooner)"
+    return text + "."
 
 
 def model_coverage_note(results: Mapping[str, Any]) -> str:

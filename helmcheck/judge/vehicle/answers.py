@@ -21,6 +21,7 @@ from __future__ import annotations
 
 from ...grammar import sentences as s
 from ...grammar.wirelog import escape
+from ...model.timers import tolerance
 from ..ledger import Evidence
 from ..timing import ack_allowance, ack_uncertainty, ack_verdict, transmit_time
 from .blame import command_clauses, looked_up, passable, stated_by
@@ -346,6 +347,8 @@ class Answers:
             if verdict == "pass":
                 text = reason if cid != "RH-TIM-2" else f"{reason} at the declared time scale {self.k:g}"
                 self.ledger.passed(cid, text, ev, self.case)
+                if tt.widened is not None:
+                    self.ledger.precision(cid, tolerance(tt.duration), tt.widened, self.k)
             elif verdict == "not-tested":
                 self.ledger.not_tested(cid, reason, self.case)
             else:

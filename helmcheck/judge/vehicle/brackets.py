@@ -49,6 +49,10 @@ def bracket(tt: Timed, v_new: float, slack_v: float) -> tuple:
                                   f"started, so its timing was not exercised")
     u = max(0.0, (tt.deadline - tol) - tt.t_old, v_new - (tt.deadline + tol)) + own
     if judgeable(tt.duration, u):
+        # the precision it was judged with: a transition later (or earlier) than the tolerance,
+        # the observer's own uncertainty and the spacing of the reports around the deadline is
+        # certain to be seen on the wrong side (RH-TIM-1)
+        tt.widened = tol + own + max(0.0, v_new - tt.t_old)
         return (tt, "pass", f"{what} ended within max(0.5 s, 5 %) = {tol:g} s, bracketed to ±{u:.2f} s "
                             f"of vehicle time by the observations")
     return (tt, "not-tested", f"{what} ended, but observations {u:.1f} s of vehicle time from its end "

@@ -67,6 +67,7 @@ class Timed:
     pre_mode: str
     t_old: Optional[float]
     extra_v: float = 0.0
+    widened: Optional[float] = None  #: the precision it was judged with (:func:`~.brackets.bracket`)
 
     @property
     def clauses(self) -> tuple[str, ...]:
