@@ -22,6 +22,7 @@ from pathlib import Path
 
 from .. import exitcodes
 from ..failures import UsageError
+from .messages import report_line
 
 EPILOG = """\
 formats (detected): helmcheck wire-log 1 (helmcheck emulate --log), socat -v, socat -x, socat -v -x.
@@ -63,16 +64,19 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p.add_argument("files", nargs="+", metavar="FILE|DIR|GLOB",
                    help="log file(s) to check; a directory or a quoted pattern ('archive/**/*.log') checks a "
                         "whole archive (below)")
-    p.add_argument("--profile", metavar="FILE", help="TOML profile (default: rh5)")
+    p.add_argument("--profile", metavar="FILE",
+                   help="TOML profile (default: the profile.toml of the run directory the log sits in, else the "
+                        "profile the log's header names, else rh5)")
     p.add_argument("--report-dir", metavar="DIR",
                    help="results directory (default reports/check-log-<stem>; with several files, "
                         "DIR/<stem> each; for an archive, DIR/<path of each log below the archive> and "
                         "DIR/summary.md, default reports/check-log-<archive directory's name>)")
-    p.add_argument("--role", choices=("vehicle", "backseat", "both"), default="both",
-                   help="whose behaviour to judge (default both)")
+    p.add_argument("--role", choices=("vehicle", "backseat", "both"), default=None,
+                   help="whose behaviour to judge (default: the role the run that wrote the log tested, as its "
+                        "header names it: certify vehicle → vehicle, certify backseat → backseat; else both)")
     p.add_argument("--missions", metavar="DIR",
-                   help="the vehicle's mission directory (mission-dependent answers are otherwise "
-                        "inconclusive)")
+                   help="the vehicle's mission directory (default: those the log's header names; "
+                        "mission-dependent answers are otherwise inconclusive)")
     p.add_argument("--time-scale", type=float, metavar="K",
                    help="vehicle clock rate (default: the log header's, else the profile's)")
     p.add_argument("--swap-directions", action="store_true",
@@ -121,19 +125,14 @@ def run(args: argparse.Namespace) -> int:  # noqa: C901 - argument checks, then 
     from ..profile import load_profile
     from ..reports import results as R
     from ..reports.results import ReportError
-    from ..checklog.checker import LogFormatError, check_log
+    from ..checklog.checker import LogFormatError, check_log, log_meta
+    from ..checklog.origin import resolve
     from ..checklog.report import write_report_dir
 
-    profile = load_profile(args.profile)  # a ProfileError is exit 64 (helmcheck.cli)
-    if args.profile is None:
-        # Without a declared profile, $OXFLT is taken as honoured, as helmcheck emulate does.
-        profile = profile.replace(fault_injection="oxflt")
-    catalog = None
-    if args.missions is not None:
-        from ..emulator.missionfile import DirectoryCatalog
-        if not Path(args.missions).is_dir():
-            raise PathError(f"--missions: {args.missions} is not a directory")
-        catalog = DirectoryCatalog([Path(args.missions)])
+    if args.profile is not None:
+        load_profile(args.profile)  # a ProfileError is exit 64 (helmcheck.cli), before anything is read
+    if args.missions is not None and not Path(args.missions).is_dir():
+        raise PathError(f"--missions: {args.missions} is not a directory")
     files = [Path(f) for f in args.files]
     for f in files:
         if not f.is_file() or not os.access(f, os.R_OK):
@@ -150,23 +149,33 @@ def run(args: argparse.Namespace) -> int:  # noqa: C901 - argument checks, then 
     command = "helmcheck check-log " + " ".join(shlex.quote(a) for a in sys.argv[2:])
     for f, rdir in zip(files, rdirs):
         try:
+            _, meta = log_meta(f)
+            how = resolve(f, meta, role=args.role, profile_arg=args.profile, missions_arg=args.missions,
+                          time_scale=args.time_scale)
+            catalog = None
+            if how.missions:
+                from ..emulator.missionfile import DirectoryCatalog
+                catalog = DirectoryCatalog(how.missions)
             with _progress(f, args.progress) as prog:
-                out = check_log(f, profile=profile, role=args.role, catalog=catalog,
-                                time_scale=args.time_scale, swap=args.swap_directions, progress=prog)
+                out = check_log(f, profile=how.profile, role=how.role, catalog=catalog,
+                                time_scale=how.time_scale, swap=args.swap_directions, progress=prog)
         except LogFormatError as e:
             raise PathError(str(e)) from None
         except OSError as e:
             raise PathError(f"cannot read {f}: {e.strerror or e}") from None
         prepare_report_dir(rdir, args.overwrite)
         args.current_report_dir = str(rdir)
+        settings = {"swap_directions": bool(args.swap_directions)}
+        if how.missions:
+            settings["missions"] = [str(Path(d).resolve()) for d in how.missions]
         try:
-            res = write_report_dir(rdir, out, profile, command, strict=args.strict, render=not args.no_render)
+            res = write_report_dir(rdir, out, how.profile, command, strict=args.strict, render=not args.no_render,
+                                   settings=settings, origin=how.as_dict())
         except (OSError, ReportError) as e:
             if isinstance(e, OSError):
                 raise OutputLost(f"cannot write {e.filename or rdir}: {e.strerror or e}") from None
             raise OutputLost(f"report not written: {e}") from None
-        _summary(f, out, res, rdir)
-        _hint_run_profile(f, args, res)
+        _summary(f, out, res, rdir, how, rendered=not args.no_render)
         worst = max(worst, R.exit_code(res["verdict"], args.strict), key=_rank)
     return worst
 
@@ -175,11 +184,14 @@ def _rank(code: int) -> int:
     return {0: 0, 2: 1, 1: 2}.get(code, 3)
 
 
-def _summary(f: Path, out, res: dict, rdir: Path) -> None:
+def _summary(f: Path, out, res: dict, rdir: Path, how, rendered: bool = True) -> None:
     counts: dict[str, int] = {}
     for c in res["clauses"]:
         counts[c["verdict"]] = counts.get(c["verdict"], 0) + 1
     print(f"{f}: {res['verdict'].upper()} — {res['verdict_reason']}")
+    print(f"  {how.describe()}")
+    if how.lacking:
+        print(f"  note: {how.lacking}")
     print(f"  format {out.format}, {out.stats['records']} records, time scale {out.time_scale:g}, "
           f"timestamp step {out.resolution:g} s; clauses: "
           + ", ".join(f"{v} {n}" for v, n in sorted(counts.items())))
@@ -189,16 +201,7 @@ def _summary(f: Path, out, res: dict, rdir: Path) -> None:
         if c["verdict"] in ("fail", "non-strict"):
             lines = ", ".join(map(str, c.get("lines", [])[:8]))
             print(f"  {c['id']} {c['verdict']}: lines {lines}")
-    print(f"  report: {rdir}")
-
-
-def _hint_run_profile(f: Path, args: argparse.Namespace, res: dict) -> None:
-    """A log from a ``certify`` results directory is judged with the default profile unless told;
-    when that left something unjudged, say where the run's own profile is."""
-    prof = f.parent / "profile.toml"
-    if args.profile is None and res["verdict"] != "pass" and prof.is_file():
-        print(f"  hint: {f} sits beside the profile it was certified with: --profile {prof} judges it "
-              f"with that profile (helmcheck verify {f.parent} re-judges the whole run)")
+    print(report_line(rdir, rendered))
 
 
 class _progress:

@@ -19,7 +19,7 @@ import sys
 from datetime import datetime, timezone
 from pathlib import Path
 
-from .. import exitcodes
+from .. import __version__, exitcodes
 from ..failures import UsageError
 
 EPILOG = """\
@@ -188,7 +188,7 @@ def _serve(args, profile, link, baud, missions_dir, log_file, main_log_file, cho
         from ..emulator.core import EmulatorCore, MainLog
         from ..emulator.missionfile import DirectoryCatalog, builtin_dir
         from ..emulator.server import Server
-        from ..grammar.wirelog import WireLogWriter
+        from ..grammar.wirelog import WireLogWriter, run_header
         dirs = ([missions_dir] if missions_dir is not None else []) + [builtin_dir()]
         catalog = DirectoryCatalog(dirs)
         started = datetime.now(timezone.utc)
@@ -196,7 +196,9 @@ def _serve(args, profile, link, baud, missions_dir, log_file, main_log_file, cho
             # monotonic=False: a plant or model event is logged at the wall time it happened,
             # which may come before bytes already logged (the core catches up in vehicle time)
             log = WireLogWriter(log_file, meta=(f"started {started.strftime('%Y-%m-%dT%H:%M:%S.%fZ')}  "
-                                                f"port {link.name}  baud {baud}  time_scale {profile.time_scale:g}",),
+                                                f"port {link.name}  baud {baud}  time_scale {profile.time_scale:g}",
+                                                run_header(__version__, "emulate", profile.name,
+                                                           [str(Path(d).resolve()) for d in dirs])),
                                 monotonic=False)
         core = EmulatorCore(profile, catalog, start=time.monotonic(), baud=baud, log=log, settings=choices,
                             main_log=MainLog(main_log_file) if main_log_file is not None else None,

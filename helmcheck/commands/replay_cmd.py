@@ -39,7 +39,11 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
 
 
 def run(args: argparse.Namespace) -> int:
+    import time
+
+    from .. import __version__
     from ..clauses import vehicle_clauses
+    from ..grammar.wirelog import run_header
     from ..line.recorder import Recorder
     from ..certify.vehicle.flow import LinkLost
     from ..certify.vehicle.link import TesterLink
@@ -89,7 +93,10 @@ def run(args: argparse.Namespace) -> int:
         from ..certify.vehicle.replay import redrive
         ledger = Ledger([c.id for c in vehicle_clauses()])
         observer = VehicleObserver(profile, ledger, time_scale=k, baud=profile.baud)
-        recorder = Recorder(log, [f"replay {args.file} port {args.port} time_scale {k:g}"], [observer])
+        recorder = Recorder(log, [f"started {time.strftime('%Y-%m-%dT%H:%M:%SZ', time.gmtime())}  port {args.port}  "
+                                  f"baud {profile.baud}  time_scale {k:g}",
+                                  run_header(__version__, "replay", profile.name, more=f" {args.file}".replace(";", ","))],
+                            [observer])
         link = TesterLink(raw, profile, recorder)
         session = Session(link, profile, k, observer)
         try:

@@ -67,11 +67,19 @@ def verify_run(directory: Path | str, public_key=None, *, public_key_name: str =
         profile = check_profile(out, directory, results)
         job = rejudging(out, directory, results, profile) if profile is not None else None
         if job is not None:
+            catalog = None
+            if job.missions:
+                from ..emulator.missionfile import DirectoryCatalog
+                catalog = DirectoryCatalog(list(job.missions))
             try:
-                outcome = check_log(job.wire_path, profile=profile, role=job.role, time_scale=job.time_scale)
+                outcome = check_log(job.wire_path, profile=profile, role=job.role, time_scale=job.time_scale,
+                                    swap=job.swap, catalog=catalog)
             except (LogFormatError, OSError, ValueError) as e:
                 out.add(job.wire_name, f"cannot be re-judged: {e}")
             else:
+                if job.sha256 is not None and outcome.sha256 != job.sha256:
+                    out.add(job.wire_name, f"SHA-256 {outcome.sha256} differs from the {job.sha256} recorded in "
+                                           f"results.json (log.sha256)")
                 compare_rejudged(out, results, outcome.clauses, outcome.facts, job.role)
     check_signature(out, directory, results, public_key, public_key_name)
     return out

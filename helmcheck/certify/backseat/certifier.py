@@ -21,7 +21,9 @@ from datetime import datetime, timezone
 from pathlib import Path
 from typing import IO, Any, Callable, Optional
 
+from ... import __version__
 from ...failures import OutputLost, describe_interrupt
+from ...grammar.wirelog import run_header
 from ...judge.timing import JITTER_S
 from ...line.transport import BAUD_RATES, Link, open_link, parse_port_spec
 from ...profile import Profile
@@ -152,7 +154,8 @@ def _run(opts: Options, profile: Profile, plan, report_dir: Path, link: Link, lo
     progress = Progress(enabled=opts.progress)
     try:
         meta = [f"started {started_dt.strftime('%Y-%m-%dT%H:%M:%S.%fZ')}  port {link.name}  "
-                f"baud {profile.baud}  time_scale {profile.time_scale:g}"]
+                f"baud {profile.baud}  time_scale {profile.time_scale:g}",
+                run_header(__version__, "certify backseat", profile.name)]
         if opts.progress:
             print(f"helmcheck certify backseat: {link.description}, profile {profile.name}, time scale "
                   f"{profile.time_scale:g}, baud {profile.baud}, scenarios {', '.join(s.name for s in plan.slots)} "
