@@ -4,7 +4,7 @@ VENV   := .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 
-.PHONY: demo test fuzz bench docs clean explore-reach
+.PHONY: demo example-report test fuzz bench docs clean explore-reach
 
 #: The property tests, for `make fuzz`.
 FUZZ_TESTS := tests/test_grammar_fastpath.py tests/test_grammar_framer.py tests/test_grammar_roundtrip.py \
@@ -17,8 +17,13 @@ $(STAMP): pyproject.toml
 	$(PY) -m pip install --quiet -e '.[test]'
 	touch $(STAMP)
 
+# Certifies the built-in emulator into demo-out/ (ignored by git: the checkout stays clean).
 demo: $(STAMP)
 	$(PY) -m helmcheck.demo
+
+# Regenerates the example report committed under reports/demo/ (the same run as make demo).
+example-report: $(STAMP)
+	$(PY) -m helmcheck.demo --out reports/demo
 
 # The suite mostly waits on ptys and scaled time, so it runs on more workers than cores.
 TEST_WORKERS ?= 4
@@ -43,4 +48,4 @@ docs: $(STAMP)
 	$(PY) -m helmcheck docs
 
 clean:
-	rm -rf $(VENV) .pytest_cache .hypothesis
+	rm -rf $(VENV) .pytest_cache .hypothesis demo-out
