@@ -22,7 +22,9 @@ tester error, 64 usage. Subcommand modules are imported only when used, so ``--h
 from __future__ import annotations
 
 import argparse
+import ast
 import importlib
+import re
 import sys
 from pathlib import Path
 from typing import Optional
@@ -77,8 +79,30 @@ def one_line(text: str) -> str:
     return "".join(c if c.isprintable() or c == " " else repr(c)[1:-1] for c in " ".join(text.split(" ")))
 
 
+_INVALID_CHOICE = re.compile(r"^argument (?P<arg>[^:]+): invalid choice: (?P<got>'.*?') \(choose from (?P<known>.*)\)$")
+
+
+def _did_you_mean_choice(message: str) -> str:
+    """argparse's "invalid choice" message with the closest choices named first: ``checklog`` →
+    ``unknown command 'checklog' (did you mean 'check-log'?)``, the choices after."""
+    from .spelling import did_you_mean
+
+    m = _INVALID_CHOICE.match(message)
+    if m is None:
+        return message
+    try:
+        got = ast.literal_eval(m.group("got"))
+        known = [ast.literal_eval(k.strip()) for k in m.group("known").split(",")]
+    except (ValueError, SyntaxError):
+        return message
+    what = {"COMMAND": "command", "ROLE": "role", "ACTION": "action"}.get(m.group("arg"), None)
+    head = f"unknown {what} {got!r}" if what else f"argument {m.group('arg')}: invalid choice {got!r}"
+    return f"{head}{did_you_mean(str(got), map(str, known))}; choose from {', '.join(map(str, known))}"
+
+
 class _Parser(argparse.ArgumentParser):
     def error(self, message: str):  # usage errors exit 64 (not argparse's 2), in one line
+        message = _did_you_mean_choice(message)
         self.exit(exitcodes.USAGE, one_line(f"{self.prog}: error: {message} (see '{self.prog} --help')") + "\n")
 
 

@@ -1,8 +1,9 @@
 """Did you mean …: the known words closest to a mistyped one.
 
 A usage error about an unknown word (a subcommand, a profile key) names the closest known ones
-instead of listing them all: :func:`close_matches` finds them (by :mod:`difflib`'s ratio, and a
-known word that starts with or contains the given one), :func:`did_you_mean` says it.
+instead of listing them all: :func:`close_matches` finds them (by :mod:`difflib`'s ratio: the
+closest and those nearly as close; else a known word that starts with or contains the given
+one), :func:`did_you_mean` says it.
 """
 
 from __future__ import annotations
@@ -10,7 +11,12 @@ from __future__ import annotations
 import difflib
 from typing import Iterable
 
-__all__ = ["close_matches", "did_you_mean"]
+__all__ = ["close_matches", "did_you_mean", "CUTOFF", "BAND"]
+
+#: How alike (:class:`difflib.SequenceMatcher` ratio) a known word must be to be named …
+CUTOFF = 0.75
+#: … and how much less alike than the closest one it may be.
+BAND = 0.1
 
 
 def _squash(word: str) -> str:
@@ -27,8 +33,10 @@ def close_matches(word: str, known: Iterable[str], n: int = 3) -> list[str]:
         return []
     if w in squashed:
         return [squashed[w]]
-    scored = difflib.get_close_matches(w, list(squashed), n=n, cutoff=0.75)
-    found = [squashed[s] for s in scored]
+    ratios = sorted(((difflib.SequenceMatcher(None, w, s).ratio(), s) for s in squashed), reverse=True)
+    best = ratios[0][0] if ratios else 0.0
+    # the closest, and those nearly as close (a tie is named, a distant runner-up is not)
+    found = [squashed[s] for r, s in ratios[:n] if r >= CUTOFF and r >= best - BAND]
     if not found:  # a prefix or a part of a longer word (``name`` of ``vehicle_name``)
         found = [k for s, k in squashed.items() if len(w) >= 3 and (s.startswith(w) or w in s)][:n]
     return found

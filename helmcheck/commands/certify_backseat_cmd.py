@@ -9,7 +9,7 @@ the scenarios of :mod:`helmcheck.certify.backseat.scenarios` with the driver's
 At the end (also after Ctrl-C, SIGTERM or SIGHUP — :mod:`helmcheck.signals` raises them as
 ``KeyboardInterrupt`` —, a backseat that never connected or one that went away) it writes
 ``results.json``, ``wire.log`` and every report format into ``--report-dir``, prints one verdict
-line on standard output and exits 0 (pass; non-strict without ``--strict``), 1 (fail), 2
+line and ``report: DIR/report.html`` on standard output and exits 0 (pass; non-strict without ``--strict``), 1 (fail), 2
 (inconclusive; or a report, wire log or ``--wire-log`` copy that could not be written) or 64
 (usage: bad option or profile, a port that cannot be opened, a report directory holding an
 earlier run without ``--overwrite``). Progress goes to standard error.
@@ -145,8 +145,9 @@ def run(args: argparse.Namespace, *, on_port: Optional[Callable[[str], None]] = 
 
     opts.on_port = announce
     out = certify(opts)
+    from .messages import report_line
     print(f"{headline(out.results)}. {out.reason}")  # the headline says when the run was cut short
-    print(f"helmcheck certify backseat: report in {out.report_dir}", file=sys.stderr)
+    print(report_line(out.report_dir))
     sys.stdout.flush()
     if hasattr(opts.log, "check"):
         opts.log.check()  # the wire log lost on the way is exit 2, after the verdict line

@@ -223,7 +223,9 @@ def run(args: argparse.Namespace) -> int:  # noqa: C901 - argument checks, then 
         if link is not None:
             link.close()
     from ..reports.scope import headline
-    print(f"{headline(out.results)}. {out.reason} — report: {out.report_dir / 'report.html'}")
+    from .messages import report_line
+    print(f"{headline(out.results)}. {out.reason}")
+    print(report_line(out.report_dir))
     sys.stdout.flush()
     restore = out.results.get("restore")
     if restore is not None and restore.get("attempted") and not restore.get("verified"):

@@ -182,7 +182,7 @@ def run_fleet(args: argparse.Namespace) -> int:
     for f in doc["files"]:
         if f["status"] in ("unreadable", "error"):
             print(f"{f['path']}: {f['status']}: {f.get('message', '')}")
-    print(f"summary: {summary_md} ({report_dir / 'summary.json'})")
+    print(f"report: {summary_md} (also {report_dir / 'summary.json'}, {report_dir / 'matrix.html'})")
     print(doc["verdict_line"])
     if partial is not None:
         print(f"helmcheck check-log: {partial}: the summary is partial; files finished keep their results",

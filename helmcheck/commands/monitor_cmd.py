@@ -169,8 +169,9 @@ def run(args: argparse.Namespace) -> int:
                           rotate_bytes=int(args.rotate_mb * 1024 * 1024), strict=bool(args.strict),
                           command=command, certificate=cert, on_finding=on_finding, on_port=on_port,
                           view=screen, links=links, realtime=not args.no_realtime, on_relay=on_relay))
-    print(f"{headline(out.results)}. {out.reason} ({out.ended}; {out.findings} finding(s))", flush=True)
-    print(f"helmcheck monitor: report in {out.report_dir}", file=sys.stderr)
+    from .messages import report_line
+    print(f"{headline(out.results)}. {out.reason} ({out.ended}; {out.findings} finding(s))")
+    print(report_line(out.report_dir), flush=True)
     return out.exit_code
 
 

@@ -44,6 +44,14 @@ exit status: 0 written, 64 usage (bad option or value, existing file without --o
   unwritable path), 2 the write failed.
 """
 
+KEYS_EPILOG = """\
+examples:
+  helmcheck profile keys
+  helmcheck profile keys | grep -i mission
+
+exit status: 0 listed.
+"""
+
 #: option -> profile key, for the common identity fields.
 SHORTCUTS = {"name": "vehicle_name", "serial": "vehicle_serial", "uvc_version": "uvc_version",
              "mission": "mission", "baud": "baud"}
@@ -72,6 +80,11 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
                     help="start from the built-in emulator's profile ($OXFLT, its missions) instead of a "
                          "real vehicle's safe values")
     ip.set_defaults(func=run_init)
+    kp = actions.add_parser("keys", help="list every profile key with what it is and its default",
+                            description="List every key a profile file may hold: its name, what it is, the "
+                                        "clauses it serves and its rh5 default, one line each.",
+                            epilog=KEYS_EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
+    kp.set_defaults(func=run_keys)
     p.set_defaults(func=_no_action)
     return p
 
@@ -79,7 +92,7 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
 def _no_action(args: argparse.Namespace) -> int:
     from ..failures import UsageError
 
-    raise UsageError("choose an action: init (see 'helmcheck profile --help')")
+    raise UsageError("choose an action: init or keys (see 'helmcheck profile --help')")
 
 
 def _keys() -> dict[str, Any]:
@@ -105,7 +118,8 @@ def _parse_set(item: str, keys: dict[str, Any]) -> tuple[str, Any]:
     if not eq or not key:
         raise UsageError(f"--set {item!r}: expected KEY=VALUE")
     if key not in keys:
-        raise UsageError(f"--set: unknown key {key!r}; known keys: {', '.join(keys)}")
+        from ..spelling import did_you_mean
+        raise UsageError(f"--set: unknown key {key!r}{did_you_mean(key, keys)}; every key: helmcheck profile keys")
     try:
         value = tomllib.loads(f"v = {text}")["v"]
     except tomllib.TOMLDecodeError:
@@ -128,6 +142,35 @@ def _emulator_values() -> dict[str, Any]:
         else:
             flat[k] = v
     return flat
+
+
+def run_keys(args: argparse.Namespace) -> int:  # noqa: ARG001 - the command's signature
+    """``profile keys``: every key, one line each (the profile's own key table)."""
+    import dataclasses
+
+    from ..profile import BenchSafety, profile_keys
+
+    rows = []
+    for f in profile_keys():
+        fields = ([(f"bench_safety.{g.name}", g) for g in dataclasses.fields(BenchSafety)]
+                  if f.name == "bench_safety" else [(f.name, f)])
+        for name, g in fields:
+            meta = g.metadata
+            default = g.default if g.default is not dataclasses.MISSING else g.default_factory()  # type: ignore[misc]
+            where = "; ".join(x for x in (meta.get("group", ""), meta.get("clause", "")) if x)
+            rows.append((name, f"{meta.get('doc', '')} ({where}; default {_toml(default)})"))
+    width = max(len(n) for n, _ in rows)
+    for name, text in rows:
+        print(f"{name:<{width}}  {text}")
+    return exitcodes.OK
+
+
+def _toml(value: Any) -> str:
+    from ..profile_toml import toml_value
+    try:
+        return toml_value(value)
+    except (TypeError, ValueError):
+        return repr(value)
 
 
 def run_init(args: argparse.Namespace) -> int:

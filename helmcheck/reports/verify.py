@@ -377,15 +377,17 @@ def check_signature(out: Verification, directory: Path, results: Optional[Mappin
     if results is not None and not declared:
         out.add(_SIGNATURE_NAME, "present, but results.json does not say the run was signed")
     from .signing import check
-    key = embedded
     if public_key is not None:
         trusted = key_id(public_key)
-        if trusted != signer:
-            out.add("signature", f"made with key {signer}, not with {public_key_name} (key {trusted})")
-        key = public_key
         out.trusted_key = trusted == signer
-    if not check(key, doc["manifest"], doc["signature"]):
-        out.add("signature", "does not verify: the signed manifest was changed or the signature is not this key's")
+        if not out.trusted_key:
+            # another key: say so, and check the signature with the key it names (whether the
+            # files were changed is a question of its own, answered below)
+            out.add("signature", f"made with key {signer}, not with the given key {public_key_name} (key {trusted}): "
+                                 f"the run was signed by another key")
+    if not check(embedded, doc["manifest"], doc["signature"]):
+        out.add("signature", f"does not verify with the key it names ({signer}): the signed manifest or the "
+                             f"signature was changed after signing")
         out.trusted_key = False
         return
     files = doc["manifest"].get("files")
