@@ -96,6 +96,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="start the backseat under test on the port ({port} is replaced, or the port appended)")
     p.add_argument("--exec-grace", type=float, default=5.0, metavar="S",
                    help="seconds between SIGTERM and SIGKILL when stopping it (default 5)")
+    p.add_argument("--no-progress", action="store_true",
+                   help="no progress on standard error (by default: a bar on a terminal, else a line per "
+                        "scenario and at least every 10 s)")
     p.add_argument("--overwrite", action="store_true",
                    help="replace an earlier run in --report-dir (its results, wire log and reports are "
                         "removed first); without it such a directory is refused")
@@ -117,7 +120,7 @@ def run(args: argparse.Namespace, *, on_port: Optional[Callable[[str], None]] = 
     opts = Options(profile=profile, report_dir=Path("."), port=args.port, time_scale=args.time_scale,
                    baud=args.baud, duration=args.duration, scenarios=args.scenario, strict=bool(args.strict),
                    connect_timeout=args.connect_timeout, exec_cmd=getattr(args, "exec_cmd", None),
-                   exec_grace_s=args.exec_grace)
+                   exec_grace_s=args.exec_grace, progress=not getattr(args, "no_progress", False))
     wrong = problems(opts)
     if wrong:
         raise UsageError(wrong[0])

@@ -18,6 +18,7 @@ import math
 import os
 import shlex
 import sys
+import time
 from pathlib import Path
 
 from .. import exitcodes
@@ -87,8 +88,9 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
                    help="replace an earlier check in the report directory (its results, log copy and "
                         "reports are removed first); without it such a directory is refused")
     p.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None,
-                   help="progress on stderr (default: for files over 4 MiB on a terminal; for an archive, "
-                        "files done, lines/s and ETA whenever stderr is a terminal)")
+                   help="progress on stderr (default: for files over 4 MiB, a bar on a terminal, else a line every "
+                        "10 s; for an archive, files done, lines/s and ETA: redrawn on a terminal, else a line "
+                        "every 10 s, or one per file with --progress)")
     a = p.add_argument_group("archives (a DIR or GLOB argument, or any of these options)")
     a.add_argument("--jobs", type=int, metavar="N",
                    help="judge N files at a time, each in its own process (default: the cores)")
@@ -204,22 +206,49 @@ def _summary(f: Path, out, res: dict, rdir: Path, how, rendered: bool = True) ->
     print(report_line(rdir, rendered))
 
 
+#: From this size on a check shows its progress without --progress.
+PROGRESS_BYTES = 4 * 1024 * 1024
+#: Seconds between two progress lines when standard error is not a terminal.
+PLAIN_EVERY_S = 10.0
+
+
 class _progress:
-    """A rich progress bar on stderr, by bytes read; a no-op for small files or no terminal."""
+    """Progress on stderr, by bytes read (files over :data:`PROGRESS_BYTES`, or any with
+    ``--progress``; none with ``--no-progress``): a rich bar on a terminal, else a line at most
+    every :data:`PLAIN_EVERY_S` seconds."""
 
     def __init__(self, path: Path, wanted):
+        self.path = path
         self.size = path.stat().st_size
-        self.on = wanted if wanted is not None else (self.size > 4 * 1024 * 1024 and sys.stderr.isatty())
+        self.on = wanted if wanted is not None else self.size > PROGRESS_BYTES
         self.bar = None
         self._acc = 0
+        self._done = 0
 
     def __enter__(self):
         if not self.on:
             return None
+        if not sys.stderr.isatty():
+            t0 = time.monotonic()
+            said = [t0]
+
+            def line(n: int) -> None:
+                self._done += n
+                now = time.monotonic()
+                if now - said[0] >= PLAIN_EVERY_S:
+                    said[0] = now
+                    pct = 100.0 * self._done / self.size if self.size else 100.0
+                    print(f"helmcheck check-log: {self.path}: {pct:.0f} % ({self._done / 2**20:.0f} of "
+                          f"{self.size / 2**20:.0f} MiB) in {now - t0:.0f} s", file=sys.stderr, flush=True)
+            return line
         from rich.console import Console
         from rich.progress import BarColumn, DownloadColumn, Progress, TimeRemainingColumn
-        self.bar = Progress("[progress.description]{task.description}", BarColumn(), DownloadColumn(),
-                            TimeRemainingColumn(), console=Console(stderr=True), transient=True)
+        from rich.table import Column
+        self.bar = Progress("[progress.description]{task.description}",
+                            BarColumn(bar_width=20, table_column=Column(min_width=20, no_wrap=True)),
+                            DownloadColumn(table_column=Column(no_wrap=True)),
+                            TimeRemainingColumn(table_column=Column(no_wrap=True)),
+                            console=Console(stderr=True), transient=True)
         self.bar.start()
         self.task = self.bar.add_task("checking", total=self.size)
 

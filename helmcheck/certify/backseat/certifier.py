@@ -55,7 +55,7 @@ class Options:
     exec_grace_s: float = 5.0  #: SIGTERM → SIGKILL when stopping it
     certificate: Optional[RunDeclaration] = None  #: identity and signing key
     command: str = ""  #: the command line recorded in ``results.json``
-    progress: bool = True  #: a progress bar on standard error (on a terminal)
+    progress: bool = True  #: progress on standard error (a bar on a terminal, else plain lines)
     render: bool = True  #: write report.html, junit.xml, report.md
     on_port: Optional[Callable[[str], None]] = None  #: called with the port's name once it is open
     # Command-line hooks (helmcheck.commands.certify_backseat_cmd): the link the command opened
