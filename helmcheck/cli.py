@@ -34,20 +34,21 @@ from .failures import TRACEBACK_NAME, Failure, UsageError, describe_interrupt
 from .signals import ending_signals
 from .streams import GuardedStream
 
-#: subcommand -> (module, one-line help). Each module has add_parser(sub) and run(args).
+#: subcommand -> (module, one-line help). Each module has add_parser(sub) and run(args); its
+#: parser's ``help`` is this same text (tests/test_cli_help.py).
 SUBCOMMANDS = {
     "parse": ("helmcheck.commands.parse_cmd", "validate sentences line by line"),
     "emulate": ("helmcheck.commands.emulate_cmd", "run the reference vehicle emulator on a serial port"),
     "certify": ("helmcheck.commands.certify_cmd", "certify a vehicle or a backseat over a serial port"),
     "replay": ("helmcheck.commands.replay_cmd", "re-drive a saved failing sequence against a vehicle"),
     "diff": ("helmcheck.commands.diff_cmd", "drive two vehicles with the same sequences; report their first divergence"),
-    "check-log": ("helmcheck.commands.checklog_cmd", "check a recorded serial log against the model"),
+    "check-log": ("helmcheck.commands.checklog_cmd", "judge a recorded serial log against the reference model"),
     "monitor": ("helmcheck.commands.monitor_cmd", "judge a live backseat-vehicle session (tap or in line)"),
-    "report": ("helmcheck.commands.report_cmd", "render a results directory as HTML, JUnit, Markdown"),
+    "report": ("helmcheck.commands.report_cmd", "render a results directory as HTML, JUnit XML and Markdown"),
     "matrix": ("helmcheck.commands.matrix_cmd", "one overview of several runs: clauses x implementations"),
-    "verify": ("helmcheck.commands.verify_cmd", "check a results directory against its evidence and signature"),
+    "verify": ("helmcheck.commands.verify_cmd", "re-judge a results directory from its evidence; check its signature"),
     "keygen": ("helmcheck.commands.keygen_cmd", "make an Ed25519 key pair for signing results"),
-    "profile": ("helmcheck.commands.profile_cmd", "write a commented profile for a vehicle to fill in"),
+    "profile": ("helmcheck.commands.profile_cmd", "write a commented profile for a vehicle; list the profile keys"),
     "docs": ("helmcheck.commands.docs_cmd", "regenerate the generated documentation"),
 }
 
@@ -57,20 +58,22 @@ INTERRUPT_CODE = {"emulate": exitcodes.OK}
 DESCRIPTION = """\
 helmcheck — the formal model and conformance suite for the Iver3 remote helm protocol.
 
-Typical use:
-  helmcheck emulate --port pty                     # a reference vehicle on a pseudo-terminal
-  helmcheck certify vehicle --port /dev/pts/5      # certify whatever answers on that port
-  helmcheck certify backseat --port pty            # play the vehicle, judge a backseat
-  helmcheck diff --port /dev/pts/5 --port /dev/pts/7  # two vehicles, same sequences: first divergence
-  helmcheck report reports/demo                    # render results.json to HTML/JUnit/Markdown
-  helmcheck matrix out/a out/b --out out/          # several runs side by side, clause by clause
-  helmcheck verify reports/demo                    # re-judge the wire log; check the signature
+typical use:
+  helmcheck emulate --port pty --time-scale 20 &     # a reference vehicle; prints port: /dev/pts/N
+  helmcheck certify vehicle --port /dev/pts/N --time-scale 20 --profile helmcheck/profiles/emulator.toml
+  helmcheck certify backseat --duration 10 --time-scale 10 \\
+      --exec 'python3 tests/backseats/good_backseat.py {port} --time-scale {time_scale}'
+  helmcheck check-log reports/vehicle/wire.log      # judge a recorded log as the run that wrote it did
   helmcheck monitor --tap /dev/ttyUSB0 /dev/ttyUSB1  # judge a live session from a Y-cable, live
-  helmcheck parse wire.log                         # validate a capture line by line
-  helmcheck profile init iver3.toml                # a commented profile for a vehicle to fill in
+  helmcheck diff --port /dev/pts/5 --port /dev/pts/7 # two vehicles, same sequences: first divergence
+  helmcheck report reports/vehicle                  # render results.json to HTML/JUnit/Markdown again
+  helmcheck verify reports/vehicle                  # re-judge the wire log; check the signature
+  helmcheck matrix reports/vehicle reports/check-log-wire --out matrix/   # runs side by side
+  helmcheck parse reports/vehicle/wire.log          # validate a capture line by line
+  helmcheck profile init iver3.toml                 # a commented profile for a vehicle to fill in
 
-Exit codes: 0 conformant, 1 non-conformant, 2 inconclusive or tester error, 64 usage error.
-Run 'helmcheck COMMAND --help' for each command's options.
+exit status: 0 conformant, 1 non-conformant, 2 inconclusive or tester error, 64 usage error.
+Run 'helmcheck COMMAND --help' for each command's options and examples.
 """
 
 

@@ -50,13 +50,6 @@ RH-BS-3 preconditions, RH-BS-4 line budget (baud/10 bytes in any second), RH-BS-
 to rejections and lockouts, RH-BS-6 servo refresh, RH-BS-7 upper-case hex and CR LF,
 RH-BS-8 $OSD polling every 5 s. A SHOULD missed is NON-STRICT (exit 0; 1 with --strict).
 
-examples:
-  helmcheck certify backseat                          # pty: prints 'port: /dev/pts/N'
-  helmcheck certify backseat --duration 30 --time-scale 10 --report-dir out/
-  helmcheck certify backseat --port socket://127.0.0.1:4001 --scenario lockout
-  helmcheck certify backseat --port /dev/ttyUSB0 --profile site.toml --strict
-  helmcheck certify backseat --time-scale 10 --exec 'python3 my_backseat.py --port {port} --k {time_scale}'
-
 --exec CMD starts the backseat under test on the port once it is open: CMD is split like a
 shell line and run without a shell; {port} becomes the pty path (or socket://HOST:PORT; {host}
 and {tcp_port} its halves), {time_scale} the time scale; without {port} the port is appended.
@@ -66,12 +59,21 @@ process group), then SIGKILL after --exec-grace seconds. A backseat that exits o
 before the end fails the run: results.json "process" has its exit and last output, the clauses
 whose scenarios had not finished are NOT-TESTED.
 
-  helmcheck certify backseat --implementation moos-ivp-helm@2.1.0 --sign-key lab.key --operator "J. Doe"
-
 certificate: --implementation names the backseat in every report; --sign-key signs the run
   (helmcheck keygen); helmcheck verify DIR --public-key lab.pub checks it against its evidence.
 
-exit status: 0 conformant, 1 non-conformant, 2 inconclusive, 64 usage.
+examples:
+  helmcheck certify backseat                          # pty: prints 'port: /dev/pts/N', waits for a backseat
+  helmcheck certify backseat --duration 10 --time-scale 10 \\
+      --exec 'python3 tests/backseats/good_backseat.py {port} --time-scale {time_scale}'
+  helmcheck certify backseat --port socket://127.0.0.1:0 --scenario lockout   # a TCP server; prints its port
+  helmcheck certify backseat --port /dev/ttyUSB0 --profile iver3.toml --strict
+  helmcheck keygen --out lab                          # a signing key pair, once
+  helmcheck certify backseat --implementation moos-ivp-helm@2.1.0 --sign-key lab.key --operator "J. Doe"
+
+exit status: 0 conformant (or non-strict without --strict), 1 non-conformant, 2 inconclusive (the
+  backseat never connected, went away, or an output could not be written), 64 usage (bad option
+  or profile, a port that cannot be opened, a report directory holding an earlier run).
 """
 
 

@@ -26,20 +26,31 @@ from ..failures import UsageError
 from .messages import report_line
 
 EPILOG = """\
-formats (detected): helmcheck wire-log 1 (helmcheck emulate --log), socat -v, socat -x, socat -v -x.
+formats (detected): helmcheck wire-log 1 (certify, emulate --log, monitor), socat -v, socat -x,
+socat -v -x.
 
-examples:
-  helmcheck check-log wire.log
-  helmcheck check-log capture.txt --missions missions/ --time-scale 1
-  socat -v /dev/ttyUSB0,raw,b19200 PTY,link=/tmp/vehicle 2> capture.txt   # record a capture
-  helmcheck check-log capture.txt --role backseat --report-dir reports/bs
+what is judged, unless the options say: a wire log names the run that wrote it in its header,
+and is judged as that run judged it — a certify vehicle log as the vehicle's (helmcheck's own
+lines there, some malformed on purpose, are not a backseat's), a certify backseat log as the
+backseat's, a monitor or emulator log as both sides' — under the profile.toml of the results
+directory it sits in (else the profile its header names, else rh5), at its header's time scale,
+with the mission directories its header names. A capture that names none of this is judged as
+both sides', under rh5; one line says what the header did not say.
 
 The report directory (default reports/check-log-<stem>) gets results.json (role "log"), a copy
-of the log, report.html, junit.xml and report.md. Each violation names its log line numbers.
+of the log, profile.toml, report.html, junit.xml and report.md: a results directory that
+'helmcheck verify' re-judges like any run's. Each violation names its log line numbers.
+
+examples:
+  helmcheck check-log reports/vehicle/wire.log      # a certification's log, judged as the run judged it
+  helmcheck check-log reports/vehicle/wire.log --role both --report-dir reports/both   # helmcheck's lines too
+  helmcheck check-log capture.txt --missions missions/ --time-scale 1   # a socat capture of a session
+  socat -v /dev/ttyUSB0,raw,b19200 PTY,link=/tmp/vehicle 2> capture.txt   # how to record one
+  helmcheck check-log capture.txt --role backseat --report-dir reports/bs
 
 whole archives (a DIR or a quoted GLOB; logs found by content, recursively):
   helmcheck check-log archive/ --report-dir out/            # out/<path of each log>/, out/summary.md
-  helmcheck check-log 'archive/2026-*/**/*.log' --jobs 4 --profile iver3.toml
+  helmcheck check-log 'archive/2026-*/**/*.log' --jobs 4 --profile iver3.toml --report-dir out-iver3/
   helmcheck check-log archive/ --report-dir out/            # again: only new or changed logs are judged
   helmcheck check-log archive/ --report-dir out/ --force    # judge every log again
   dask scheduler --port 8786                    # a cluster: the scheduler on one machine,
@@ -49,18 +60,23 @@ whole archives (a DIR or a quoted GLOB; logs found by content, recursively):
 Each log gets its own results directory, mirroring the archive's tree, with check-key.json: a
 log whose key (helmcheck version, profile hash, log hash, role, time scale, missions, strict)
 is unchanged is not judged again. out/summary.json is the source of truth; out/summary.md has
-the per-file verdicts, clause x file counts and the matrix (also out/matrix.html). Exit status:
-the worst over the files (1 over 2 over 0); a file that cannot be read counts as 2, so the run
-cannot exit 0; Ctrl-C keeps the finished files and writes the summary marked partial (exit 2,
-or 1 if a file failed). --cluster needs: pip install 'helmcheck[cluster]'.
+the per-file verdicts, clause x file counts and the matrix (also out/matrix.html). A file that
+cannot be read counts as 2, so the run cannot exit 0; Ctrl-C keeps the finished files and writes
+the summary marked partial. --cluster needs: pip install 'helmcheck[cluster]'.
+
+exit status: 0 conformant (every judged clause passes; non-strict without --strict), 1 a clause
+  failed, 2 inconclusive (nothing failed, something could not be judged; a report that could not
+  be written), 64 usage (bad option or profile, an unreadable or unrecognised log, a report
+  directory holding an earlier check without --overwrite). Several files or an archive: the
+  worst over the files (1 over 2 over 0).
 """
 
 
 def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
-    p = sub.add_parser("check-log", help="check a recorded serial log against the model",
-                       description="Replay a two-direction capture through the reference model and "
-                                   "report per clause. Exit 0 conformant, 1 non-conformant, "
-                                   "2 inconclusive, 64 usage.",
+    p = sub.add_parser("check-log", help="judge a recorded serial log against the reference model",
+                       description="Judge a recorded serial log (a helmcheck wire log or a socat capture) "
+                                   "against the reference model, clause by clause, with the judges the "
+                                   "certifiers use.",
                        epilog=EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("files", nargs="+", metavar="FILE|DIR|GLOB",
                    help="log file(s) to check; a directory or a quoted pattern ('archive/**/*.log') checks a "

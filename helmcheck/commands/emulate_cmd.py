@@ -23,13 +23,6 @@ from .. import __version__, exitcodes
 from ..failures import UsageError
 
 EPILOG = """\
-examples:
-  helmcheck emulate                                   # pty, prints 'port: /dev/pts/N'
-  helmcheck emulate --time-scale 50 --log wire.log    # 50x faster vehicle clock (RH-TIM-2)
-  helmcheck emulate --port socket://127.0.0.1:4001    # a serial server, one client at a time
-  helmcheck emulate --port /dev/ttyUSB0 --baud 19200  # a real serial line, 8N1
-  helmcheck emulate --tui                             # live view: traffic, fins, mode, timers
-
 --baud paces the output at the line rate (10 bits per byte); --baud 0 sends unpaced (pty and
 socket only). Built-in missions: conformance.mis (the profile's test mission), short.mis,
 srp.mis; --missions DIR adds a directory that overrides them. $OXFLT,<code> (RH-SAF-5) is
@@ -47,12 +40,25 @@ choices the profile leaves a conforming vehicle (docs/freedoms.md): the [emulato
   helmcheck emulate --set timer_factor=1.03 --set pacing=burst --set decimals.lat=6
 A setting outside the profile's bounds is warned about and still obeyed (a non-conforming
 vehicle, for testing a tester).
+
+examples:
+  helmcheck emulate                                   # pty, prints 'port: /dev/pts/N'
+  helmcheck emulate --time-scale 50 --log emulator.log  # 50x faster vehicle clock (RH-TIM-2)
+  helmcheck emulate --port socket://127.0.0.1:0       # a serial server on a free TCP port, one client
+  helmcheck emulate --port /dev/ttyUSB0 --baud 19200  # a real serial line, 8N1
+  helmcheck emulate --tui                             # live view: traffic, fins, mode, timers
+  helmcheck emulate --profile helmcheck/profiles/emulator.toml --time-scale 20 &   # in the background
+  kill %1                                             # … and stopped (SIGTERM: exit 0)
+
+exit status: 0 stopped (Ctrl-C, SIGTERM or SIGHUP), 2 the link failed or a log could not be written,
+  64 usage (bad option or profile, a port or file that cannot be opened).
 """
 
 
 def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p = sub.add_parser("emulate", help="run the reference vehicle emulator on a serial port",
-                       description=__doc__.split("\n\n")[0].split(": ", 1)[1],
+                       description="Run the reference vehicle on a pty, a serial device or a TCP serial "
+                                   "server, answering as the reference model does, until stopped.",
                        epilog=EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--port", default="pty", metavar="PORT",
                    help="pty (default), a device path, or socket://HOST:PORT (port 0: any free port)")

@@ -42,13 +42,18 @@ wire.002.log, … (judged as one session); at the end (and a check of the sessio
 rotation) results.json and the reports, exactly as check-log gives them for that log, signable
 with --sign-key and checked by 'helmcheck verify'.
 
+end: --duration S, --until HH:MM[:SS] (local time) or an ISO date-time, Ctrl-C or SIGTERM.
+
 examples:
   helmcheck monitor --tap /dev/ttyUSB0 /dev/ttyUSB1 --profile iver3.toml --report-dir sea-trial/
   helmcheck monitor --between /dev/ttyUSB0 /dev/ttyUSB1 --duration 3600
-  helmcheck monitor --between pty socket://127.0.0.1:5555 --time-scale 20     # a simulator
+  helmcheck emulate --port socket://127.0.0.1:5555 --time-scale 20 &   # a simulated vehicle on TCP
+  helmcheck monitor --between pty socket://127.0.0.1:5555 --time-scale 20 --duration 30   # prints the
+                                                    # backseat's pty: point the backseat at it
 
-end: --duration S, --until HH:MM[:SS] (local time) or an ISO date-time, Ctrl-C or SIGTERM.
-exit status: 0 conformant, 1 non-conformant, 2 inconclusive, 64 usage.
+exit status: 0 conformant (non-strict without --strict), 1 a clause failed, 2 inconclusive (or a
+  report that could not be written), 64 usage (bad option or profile, a port that cannot be
+  opened, a report directory holding an earlier run without --overwrite).
 """
 
 

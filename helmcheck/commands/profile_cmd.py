@@ -1,4 +1,5 @@
-"""``helmcheck profile init [PATH]``: write a commented profile for a real vehicle to fill in.
+"""``helmcheck profile init [PATH]``: write a commented profile for a real vehicle to fill in;
+``helmcheck profile keys``: list every key.
 
 The text is :func:`helmcheck.profile_template.render` — every key of
 :class:`~helmcheck.profile.Profile` with its documentation, allowed values and a safe starting
@@ -31,17 +32,25 @@ what you get:
   FILL IN need a value from the vehicle (its name, serial, UVC version, baud, test mission …).
   The file loads as it is; a key you delete takes the rh5 default.
 
+--set KEY=VALUE takes a TOML value (a string may be given bare: --set mission=survey.mis);
+bench_safety.KEY for the [bench_safety] table; 'helmcheck profile keys' lists every key.
+
 examples:
   helmcheck profile init iver3-042.toml --name IVER3-042 --serial 3042 --uvc-version 5.2.1
   helmcheck profile init --set baud=57600 --set 'commands=["OMS","OMP","OSD","OMSTOP","OMSTART"]'
   helmcheck profile init --emulator emu.toml       # the built-in emulator's claims, all keys
   helmcheck certify vehicle --port /dev/ttyUSB0 --profile iver3-042.toml
 
-  --set KEY=VALUE takes a TOML value (a string may be given bare: --set mission=survey.mis);
-  bench_safety.KEY for the [bench_safety] table.
-
 exit status: 0 written, 64 usage (bad option or value, existing file without --overwrite,
   unwritable path), 2 the write failed.
+"""
+
+PROFILE_EPILOG = """\
+examples:
+  helmcheck profile init iver3.toml                 # a commented profile to fill in
+  helmcheck profile keys                            # every key, one line each
+
+exit status: 0 written or listed, 64 usage, 2 a write that failed.
 """
 
 KEYS_EPILOG = """\
@@ -58,8 +67,11 @@ SHORTCUTS = {"name": "vehicle_name", "serial": "vehicle_serial", "uvc_version": 
 
 
 def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
-    p = sub.add_parser("profile", help="write a commented profile for a vehicle to fill in",
-                       description="Profiles declare what an implementation claims (reference profile §10).")
+    p = sub.add_parser("profile", help="write a commented profile for a vehicle; list the profile keys",
+                       description="Write a commented profile for a vehicle to fill in, or list every profile "
+                                   "key. A profile declares what an implementation claims (reference "
+                                   "profile §10).",
+                       epilog=PROFILE_EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
     actions = p.add_subparsers(dest="action", metavar="ACTION", parser_class=type(p))
     ip = actions.add_parser("init", help="write a commented TOML profile for a real vehicle to fill in",
                             description="Write a commented TOML profile for a real vehicle: every key with "

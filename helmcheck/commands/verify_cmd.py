@@ -21,7 +21,7 @@ from .. import exitcodes
 from ..failures import UsageError
 
 EPILOG = """\
-what is checked:
+what is checked (in any results directory: certify vehicle, certify backseat, check-log, monitor):
   results.json    a valid results document whose digests match wire.log and profile.toml
   profile.toml    the profile the run recorded, key by key
   clause verdicts re-judged from wire.log under profile.toml (same observer as check-log);
@@ -31,17 +31,17 @@ what is checked:
 
 examples:
   helmcheck verify reports/vehicle
-  helmcheck verify reports/vehicle --public-key lab.pub
+  helmcheck verify reports/vehicle --public-key lab.pub    # the run must be signed by this key
 
-exit status: 0 verified, 1 mismatch (each difference named), 64 usage.
+exit status: 0 verified, 1 mismatch (one line per difference, each naming the clause or file),
+  64 usage (no such results directory, an unreadable public key).
 """
 
 
 def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
-    p = sub.add_parser("verify", help="check a results directory against its wire log, profile and signature",
+    p = sub.add_parser("verify", help="re-judge a results directory from its evidence; check its signature",
                        description="Re-judge a results directory's wire log under its recorded profile and "
-                                   "check that results.json follows from it; check the signature if signed. "
-                                   "Exit 0 verified, 1 mismatch, 64 usage.",
+                                   "check that results.json follows from it; check the signature if signed.",
                        epilog=EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("directory", metavar="DIR", help="results directory (results.json, wire.log, profile.toml)")
     p.add_argument("--public-key", metavar="PUB",
