@@ -4,7 +4,7 @@ VENV   := .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 
-.PHONY: demo example-report test fuzz bench docs clean explore-reach
+.PHONY: demo example-report test fuzz bench docs clean explore-reach help-examples
 
 #: The property tests, for `make fuzz`.
 FUZZ_TESTS := tests/test_grammar_fastpath.py tests/test_grammar_framer.py tests/test_grammar_roundtrip.py \
@@ -40,6 +40,11 @@ fuzz: $(STAMP)
 # suite (tests/test_explore_reach.py, benchmarks/explore_reach.py).
 explore-reach: $(STAMP)
 	HELMCHECK_REACH=1 $(PY) -m pytest -q tests/test_explore_reach.py
+
+# Not run by CI (several minutes): every --help example, the slow ones and those that need a
+# vehicle too (run against the emulator on their port); make test runs the others.
+help-examples: $(STAMP)
+	HELMCHECK_HELP_EXAMPLES=1 $(PY) -m pytest -q -n 2 tests/test_cli_help.py
 
 bench: $(STAMP)
 	$(PY) benchmarks/run_all.py

@@ -70,7 +70,7 @@ typical use:
   helmcheck verify reports/vehicle                  # re-judge the wire log; check the signature
   helmcheck matrix reports/vehicle reports/check-log-wire --out matrix/   # runs side by side
   helmcheck parse reports/vehicle/wire.log          # validate a capture line by line
-  helmcheck profile init iver3.toml                 # a commented profile for a vehicle to fill in
+  helmcheck profile init my-vehicle.toml            # a commented profile for a vehicle to fill in
 
 exit status: 0 conformant, 1 non-conformant, 2 inconclusive or tester error, 64 usage error.
 Run 'helmcheck COMMAND --help' for each command's options and examples.

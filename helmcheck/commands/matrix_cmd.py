@@ -25,7 +25,7 @@ clause's verdict, linking to the clause in the run's report.html. — marks a cl
 no entry for (a backseat run has no vehicle clauses).
 
 examples:
-  helmcheck matrix reports/vehicle reports/servo --out matrix/
+  helmcheck matrix reports/vehicle reports/previous --out matrix/
   helmcheck matrix reports/*/ --title 'vehicles, nightly' --out matrix/   # every run under reports/
 
 exit status: 0 written, 2 a results directory could not be read or a file not written (one line

@@ -79,7 +79,8 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p.add_argument("--rotate-mb", type=float, default=64.0, metavar="MB",
                    help="start a new wire-log segment every MB megabytes (default 64)")
     p.add_argument("--strict", action="store_true", help="a SHOULD not met fails the session")
-    p.add_argument("--no-tui", action="store_true", help="plain finding lines even on a terminal")
+    p.add_argument("--no-tui", action="store_true",
+                   help="plain lines even on a terminal: each finding, and a status line every 10 s")
     p.add_argument("--no-realtime", action="store_true",
                    help="do not ask for real-time priority for the relay (by default it does, where permitted)")
     p.add_argument("--vehicle", metavar="NAME", help="the vehicle's name in the report (default: the profile's)")
@@ -111,7 +112,7 @@ def _until(text: str) -> float:
 def run(args: argparse.Namespace) -> int:
     from ..line.transport import BAUD_RATES
     from ..monitor.session import Options, monitor
-    from ..monitor.view import LiveScreen, finding_line
+    from ..monitor.view import LiveScreen, StatusLines, finding_line
     from ..outputs import prepare_report_dir
     from ..profile import load_profile
     from ..reports.scope import headline
@@ -151,10 +152,10 @@ def run(args: argparse.Namespace) -> int:
         raise
     args.report_dir = str(report_dir)  # where a tester error's traceback goes
     tui = sys.stderr.isatty() and not args.no_tui
-    screen = LiveScreen(f"helmcheck monitor --{mode}") if tui else None
+    screen = LiveScreen(f"helmcheck monitor --{mode}") if tui else StatusLines("helmcheck monitor")
 
     def on_finding(f) -> None:  # a live screen gets its findings from the session (it is the view)
-        if screen is None and f.first:
+        if not tui and f.first:
             print(finding_line(f), flush=True)
 
     def on_port(side: str, name: str) -> None:

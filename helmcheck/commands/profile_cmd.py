@@ -47,7 +47,7 @@ exit status: 0 written, 64 usage (bad option or value, existing file without --o
 
 PROFILE_EPILOG = """\
 examples:
-  helmcheck profile init iver3.toml                 # a commented profile to fill in
+  helmcheck profile init my-vehicle.toml            # a commented profile to fill in
   helmcheck profile keys                            # every key, one line each
 
 exit status: 0 written or listed, 64 usage, 2 a write that failed.

@@ -27,7 +27,7 @@ EPILOG = """\
 examples:
   helmcheck report reports/vehicle                  # report.html, junit.xml and report.md again
   helmcheck report reports/vehicle --format html    # one format
-  helmcheck report reports/vehicle --compare reports/servo --fail-on-regression   # against an earlier run
+  helmcheck report reports/vehicle --compare reports/previous --fail-on-regression   # against an earlier run
 
 exit status: 0 written; 1 with --fail-on-regression, when a clause regressed or lost coverage;
   2 a report could not be written; 64 usage (bad option, an unreadable or invalid results

@@ -31,7 +31,10 @@ what is checked (in any results directory: certify vehicle, certify backseat, ch
 
 examples:
   helmcheck verify reports/vehicle
-  helmcheck verify reports/vehicle --public-key lab.pub    # the run must be signed by this key
+  helmcheck keygen --out lab                        # once: lab.key signs, lab.pub checks
+  helmcheck certify vehicle --port /dev/pts/N --time-scale 20 --profile helmcheck/profiles/emulator.toml \\
+      --sign-key lab.key --report-dir reports/signed
+  helmcheck verify reports/signed --public-key lab.pub   # the run must be signed by this key
 
 exit status: 0 verified, 1 mismatch (one line per difference, each naming the clause or file),
   64 usage (no such results directory, an unreadable public key).
