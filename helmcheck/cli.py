@@ -52,6 +52,10 @@ SUBCOMMANDS = {
     "docs": ("helmcheck.commands.docs_cmd", "regenerate the generated documentation"),
 }
 
+#: Commands that record the tester's revision in their results (``identity.tester.revision``):
+#: it is read before the command writes anything, so a run's own outputs never make it ``-dirty``.
+RECORDS_REVISION = ("certify", "check-log", "monitor", "diff")
+
 #: Exit code of a command stopped by a signal before it could end its run itself.
 INTERRUPT_CODE = {"emulate": exitcodes.OK}
 
@@ -186,6 +190,9 @@ def _dispatch(argv: list[str]) -> int:
         if not getattr(args, "func", None):
             raise UsageError(f"no command given; choose one of {', '.join(SUBCOMMANDS)} "
                              f"(see 'helmcheck --help')")
+        if args.command in RECORDS_REVISION:
+            from .reports.identity import source_revision
+            source_revision()  # the checkout as the run found it (cached for the run)
         return int(args.func(args))
     except Failure as f:
         _say(prog_of(args), f.message)

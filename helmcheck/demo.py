@@ -26,6 +26,7 @@ from pathlib import Path
 from .certify.vehicle.runner import Options, certify
 from .emulator.process import EmulatorProcess
 from .profile import EMULATOR_PROFILE, emulator_profile
+from .reports.identity import source_revision
 
 TIME_SCALE = 40.0
 BAUD = 115200
@@ -52,6 +53,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--out", type=Path, default=DEMO_DIR,
                         help=f"the results directory, replaced if it exists (default {DEMO_DIR}/)")
     out = parser.parse_args(argv).out
+    source_revision()  # the checkout as found, before the run rewrites anything (make example-report)
     if out.exists():
         shutil.rmtree(out)
     out.mkdir(parents=True)

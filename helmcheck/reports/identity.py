@@ -17,7 +17,10 @@
   profile the judges used); ``profile_file`` the path and SHA-256 of the file given with
   ``--profile``, if any, so it can be matched with the owner's copy.
 * ``revision`` is ``git describe --always --dirty --tags`` of the checkout the running helmcheck
-  package lives in, or ``unknown`` when it is not in a git checkout (an installed wheel).
+  package lives in, or ``unknown`` when it is not in a git checkout (an installed wheel). It is
+  read once per process (:func:`source_revision`), by the commands that record it before they
+  write anything (:data:`helmcheck.cli.RECORDS_REVISION`, ``make demo``): a run whose results go
+  into a tracked directory (``make example-report``) is not ``-dirty`` by its own files.
 
 Empty declared values are ``null``. :func:`identity_rows` is the one list of labelled rows every
 rendering shows, so the HTML, Markdown and JUnit reports name the implementation alike.
