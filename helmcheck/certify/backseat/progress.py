@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import sys
 import time
-from typing import IO, Optional
+from typing import IO, Callable, Optional
 
 __all__ = ["Progress", "BAR_WIDTH", "PLAIN_EVERY_S"]
 
@@ -25,8 +25,10 @@ _PREFIX = "helmcheck certify backseat:"
 
 
 class Progress:
-    def __init__(self, enabled: bool = True, stream: Optional[IO[str]] = None) -> None:
+    def __init__(self, enabled: bool = True, stream: Optional[IO[str]] = None,
+                 clock: Callable[[], float] = time.monotonic) -> None:
         self.enabled = enabled
+        self.clock = clock  #: when lines are due (plain) and redraws (bar)
         self.stream = stream if stream is not None else sys.stderr
         self.task = None
         self.bar = None
@@ -57,13 +59,13 @@ class Progress:
             self.task = self.bar.add_task("connected", total=total, extra="")
             return
         self.task = True
-        self._said_at = time.monotonic()
+        self._said_at = self.clock()
         self._say(f"the backseat connected; the judged run takes {total:.1f} s")
 
     def update(self, elapsed: float, scenario: str, counts: dict) -> None:
         if self.task is None:
             return
-        now = time.monotonic()
+        now = self.clock()
         bad = ", ".join(f"{c} ×{n}" for c, n in counts.items() if n)
         if self.bar is None:
             if scenario != self._scenario or now - self._said_at >= PLAIN_EVERY_S:

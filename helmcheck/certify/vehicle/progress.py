@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import sys
 import time
-from typing import IO, Optional
+from typing import IO, Callable, Optional
 
 __all__ = ["Progress", "BAR_WIDTH", "PLAIN_EVERY_S", "budget_text"]
 
@@ -45,8 +45,10 @@ class Progress:
     vehicle_budget_s)``, ``note(text)``, ``alert(text)``, ``stop()``. The verdict shown for a case is
     its subject clause's verdict as the ledger has it — the word the report will use."""
 
-    def __init__(self, stream: Optional[IO[str]] = None, enabled: bool = True):
+    def __init__(self, stream: Optional[IO[str]] = None, enabled: bool = True,
+                 clock: Callable[[], float] = time.monotonic):
         self.stream = stream or sys.stderr
+        self.clock = clock  #: when plain exploration lines are due
         self.enabled = enabled
         self.rich = None
         self.task = None
@@ -98,7 +100,7 @@ class Progress:
         if self.rich is not None:
             self.rich.update(self.task, completed=self.n + used, last=text)
             return
-        now = time.monotonic()
+        now = self.clock()
         if self._plain_at is None or now - self._plain_at >= PLAIN_EVERY_S:
             self._plain_at = now
             print(text, file=self.stream, flush=True)
