@@ -154,12 +154,13 @@ def resolve(path: Path, meta: LogMeta, *, role: Optional[str] = None, profile_ar
     src: dict[str, str] = {}
     missing: list[str] = []
     named = f"a {origin.run} run, as its header says" if origin.run else ""
+    recorded = _run_role(path) if role is None and origin.role is None else None
     if role is not None:
         src["role"] = "--role"
     elif origin.role is not None:
         role, src["role"] = origin.role, named
-    elif _run_role(path) is not None:
-        role, src["role"] = _run_role(path), "the run's results.json"
+    elif recorded is not None:
+        role, src["role"] = recorded, "the run's results.json"
     else:
         role, src["role"] = "both", "the default: the log names no run"
         missing.append("which run wrote it")
@@ -168,12 +169,13 @@ def resolve(path: Path, meta: LogMeta, *, role: Optional[str] = None, profile_ar
         profile, src["profile"], profile_path = load_profile(profile_arg), "--profile", profile_arg
     else:
         profile = None
+        unusable = ""
         run_prof = _run_profile(path, origin)
         if run_prof is not None:
             try:
                 profile, src["profile"], profile_path = load_profile(run_prof), "the run's", str(run_prof)
-            except ProfileError:
-                profile = None
+            except ProfileError as e:
+                unusable = f"; the run's {run_prof} cannot be used: {e}"
         if profile is None and origin.profile:
             profile, profile_path = _named_profile(origin.profile)
             if profile is not None:
@@ -182,10 +184,10 @@ def resolve(path: Path, meta: LogMeta, *, role: Optional[str] = None, profile_ar
             # Without a declared profile, $OXFLT is taken as honoured, as helmcheck emulate does.
             profile = DEFAULT.replace(fault_injection="oxflt")
             if origin.profile:
-                src["profile"] = f"the default: the header's {origin.profile} is not here"
+                src["profile"] = f"the default: the header's {origin.profile} is not here{unusable}"
                 missing.append(f"a profile that can be read here ({origin.profile})")
             else:
-                src["profile"] = "the default"
+                src["profile"] = f"the default{unusable}"
                 missing.append("the profile")
     if time_scale is not None:
         src["time_scale"] = f"{time_scale:g} (--time-scale)"
