@@ -4,7 +4,7 @@ VENV   := .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 
-.PHONY: demo test fuzz bench docs clean explore-reach matrix
+.PHONY: demo example-report test fuzz bench docs clean explore-reach matrix help-examples
 
 #: The property tests, for `make fuzz`.
 FUZZ_TESTS := tests/test_grammar_fastpath.py tests/test_grammar_framer.py tests/test_grammar_roundtrip.py \
@@ -17,8 +17,13 @@ $(STAMP): pyproject.toml
 	$(PY) -m pip install --quiet -e '.[test]'
 	touch $(STAMP)
 
+# Certifies the built-in emulator into demo-out/ (ignored by git: the checkout stays clean).
 demo: $(STAMP)
 	$(PY) -m helmcheck.demo
+
+# Regenerates the example report committed under reports/demo/ (the same run as make demo).
+example-report: $(STAMP)
+	$(PY) -m helmcheck.demo --out reports/demo
 
 # The suite mostly waits on ptys and scaled time, so it runs on more workers than cores.
 TEST_WORKERS ?= 4
@@ -44,6 +49,11 @@ explore-reach: $(STAMP)
 matrix: $(STAMP)
 	HELMCHECK_MATRIX=1 $(PY) -m pytest -n 2 tests/test_line_budget.py tests/test_slow_line.py
 
+# Not run by CI (several minutes): every --help example, the slow ones and those that need a
+# vehicle too (run against the emulator on their port); make test runs the others.
+help-examples: $(STAMP)
+	HELMCHECK_HELP_EXAMPLES=1 $(PY) -m pytest -q -n 2 tests/test_cli_help.py
+
 bench: $(STAMP)
 	$(PY) benchmarks/run_all.py
 
@@ -55,4 +65,4 @@ docs: $(STAMP)
 	@echo "site: site/index.html"
 
 clean:
-	rm -rf $(VENV) .pytest_cache .hypothesis site
+	rm -rf $(VENV) .pytest_cache .hypothesis site demo-out

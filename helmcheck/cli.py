@@ -22,7 +22,9 @@ tester error, 64 usage. Subcommand modules are imported only when used, so ``--h
 from __future__ import annotations
 
 import argparse
+import ast
 import importlib
+import re
 import sys
 from pathlib import Path
 from typing import Optional
@@ -32,23 +34,28 @@ from .failures import TRACEBACK_NAME, Failure, UsageError, describe_interrupt
 from .signals import ending_signals
 from .streams import GuardedStream
 
-#: subcommand -> (module, one-line help). Each module has add_parser(sub) and run(args).
+#: subcommand -> (module, one-line help). Each module has add_parser(sub) and run(args); its
+#: parser's ``help`` is this same text (tests/test_cli_help.py).
 SUBCOMMANDS = {
     "parse": ("helmcheck.commands.parse_cmd", "validate sentences line by line"),
     "emulate": ("helmcheck.commands.emulate_cmd", "run the reference vehicle emulator on a serial port"),
     "certify": ("helmcheck.commands.certify_cmd", "certify a vehicle or a backseat over a serial port"),
     "replay": ("helmcheck.commands.replay_cmd", "re-drive a saved failing sequence against a vehicle"),
     "diff": ("helmcheck.commands.diff_cmd", "drive two vehicles with the same sequences; report their first divergence"),
-    "check-log": ("helmcheck.commands.checklog_cmd", "check a recorded serial log against the model"),
+    "check-log": ("helmcheck.commands.checklog_cmd", "judge a recorded serial log against the reference model"),
     "monitor": ("helmcheck.commands.monitor_cmd", "judge a live backseat-vehicle session (tap or in line)"),
     "relay": ("helmcheck.commands.relay_cmd", "relay between two ports through a line with faults (for testing on a bad line)"),
-    "report": ("helmcheck.commands.report_cmd", "render a results directory as HTML, JUnit, Markdown"),
+    "report": ("helmcheck.commands.report_cmd", "render a results directory as HTML, JUnit XML and Markdown"),
     "matrix": ("helmcheck.commands.matrix_cmd", "one overview of several runs: clauses x implementations"),
-    "verify": ("helmcheck.commands.verify_cmd", "check a results directory against its evidence and signature"),
+    "verify": ("helmcheck.commands.verify_cmd", "re-judge a results directory from its evidence; check its signature"),
     "keygen": ("helmcheck.commands.keygen_cmd", "make an Ed25519 key pair for signing results"),
-    "profile": ("helmcheck.commands.profile_cmd", "write a commented profile for a vehicle to fill in"),
+    "profile": ("helmcheck.commands.profile_cmd", "write a commented profile for a vehicle; list the profile keys"),
     "docs": ("helmcheck.commands.docs_cmd", "regenerate the generated documentation"),
 }
+
+#: Commands that record the tester's revision in their results (``identity.tester.revision``):
+#: it is read before the command writes anything, so a run's own outputs never make it ``-dirty``.
+RECORDS_REVISION = ("certify", "check-log", "monitor", "diff")
 
 #: Exit code of a command stopped by a signal before it could end its run itself.
 INTERRUPT_CODE = {"emulate": exitcodes.OK, "relay": exitcodes.OK}
@@ -56,21 +63,25 @@ INTERRUPT_CODE = {"emulate": exitcodes.OK, "relay": exitcodes.OK}
 DESCRIPTION = """\
 helmcheck — the formal model and conformance suite for the Iver3 remote helm protocol.
 
-Typical use:
-  helmcheck emulate --port pty                     # a reference vehicle on a pseudo-terminal
-  helmcheck certify vehicle --port /dev/pts/5      # certify whatever answers on that port
-  helmcheck certify backseat --port pty            # play the vehicle, judge a backseat
-  helmcheck diff --port /dev/pts/5 --port /dev/pts/7  # two vehicles, same sequences: first divergence
-  helmcheck report reports/demo                    # render results.json to HTML/JUnit/Markdown
-  helmcheck matrix out/a out/b --out out/          # several runs side by side, clause by clause
-  helmcheck verify reports/demo                    # re-judge the wire log; check the signature
+typical use:
+  helmcheck emulate --port pty --time-scale 20 &     # a reference vehicle; prints port: /dev/pts/N
+  helmcheck certify vehicle --port /dev/pts/N --time-scale 20 --profile helmcheck/profiles/emulator.toml
+  helmcheck certify backseat --duration 10 --time-scale 10 \\
+      --exec 'python3 tests/backseats/good_backseat.py {port} --time-scale {time_scale}'
+  helmcheck check-log reports/vehicle/wire.log      # judge a recorded log as the run that wrote it did
   helmcheck monitor --tap /dev/ttyUSB0 /dev/ttyUSB1  # judge a live session from a Y-cable, live
   helmcheck relay --between pty /dev/ttyUSB0 --impair 'flip=1e-5,cut=5s@60'  # test on a bad line
   helmcheck parse wire.log                         # validate a capture line by line
   helmcheck profile init iver3.toml                # a commented profile for a vehicle to fill in
+  helmcheck diff --port /dev/pts/5 --port /dev/pts/7 # two vehicles, same sequences: first divergence
+  helmcheck report reports/vehicle                  # render results.json to HTML/JUnit/Markdown again
+  helmcheck verify reports/vehicle                  # re-judge the wire log; check the signature
+  helmcheck matrix reports/vehicle reports/check-log-wire --out matrix/   # runs side by side
+  helmcheck parse reports/vehicle/wire.log          # validate a capture line by line
+  helmcheck profile init my-vehicle.toml            # a commented profile for a vehicle to fill in
 
-Exit codes: 0 conformant, 1 non-conformant, 2 inconclusive or tester error, 64 usage error.
-Run 'helmcheck COMMAND --help' for each command's options.
+exit status: 0 conformant, 1 non-conformant, 2 inconclusive or tester error, 64 usage error.
+Run 'helmcheck COMMAND --help' for each command's options and examples.
 """
 
 
@@ -79,8 +90,30 @@ def one_line(text: str) -> str:
     return "".join(c if c.isprintable() or c == " " else repr(c)[1:-1] for c in " ".join(text.split(" ")))
 
 
+_INVALID_CHOICE = re.compile(r"^argument (?P<arg>[^:]+): invalid choice: (?P<got>'.*?') \(choose from (?P<known>.*)\)$")
+
+
+def _did_you_mean_choice(message: str) -> str:
+    """argparse's "invalid choice" message with the closest choices named first: ``checklog`` →
+    ``unknown command 'checklog' (did you mean 'check-log'?)``, the choices after."""
+    from .spelling import did_you_mean
+
+    m = _INVALID_CHOICE.match(message)
+    if m is None:
+        return message
+    try:
+        got = ast.literal_eval(m.group("got"))
+        known = [ast.literal_eval(k.strip()) for k in m.group("known").split(",")]
+    except (ValueError, SyntaxError):
+        return message
+    what = {"COMMAND": "command", "ROLE": "role", "ACTION": "action"}.get(m.group("arg"), None)
+    head = f"unknown {what} {got!r}" if what else f"argument {m.group('arg')}: invalid choice {got!r}"
+    return f"{head}{did_you_mean(str(got), map(str, known))}; choose from {', '.join(map(str, known))}"
+
+
 class _Parser(argparse.ArgumentParser):
     def error(self, message: str):  # usage errors exit 64 (not argparse's 2), in one line
+        message = _did_you_mean_choice(message)
         self.exit(exitcodes.USAGE, one_line(f"{self.prog}: error: {message} (see '{self.prog} --help')") + "\n")
 
 
@@ -161,6 +194,9 @@ def _dispatch(argv: list[str]) -> int:
         if not getattr(args, "func", None):
             raise UsageError(f"no command given; choose one of {', '.join(SUBCOMMANDS)} "
                              f"(see 'helmcheck --help')")
+        if args.command in RECORDS_REVISION:
+            from .reports.identity import source_revision
+            source_revision()  # the checkout as the run found it (cached for the run)
         return int(args.func(args))
     except Failure as f:
         _say(prog_of(args), f.message)

@@ -3,7 +3,8 @@
 Reference profile §10 fixes the public key names; every ``[D]`` decision of §1–8b is a key here,
 never a constant in code. A key left out takes the ``rh5`` default. ``load_profile(path)`` reads
 a TOML file and rejects unknown keys and bad values with a :class:`ProfileError` that names the
-file, the key and what was wrong.
+file, the key and what was wrong (an unknown key with the closest known ones,
+:mod:`helmcheck.spelling`; ``helmcheck profile keys`` lists them all).
 
 Each field's documentation is its metadata (:func:`_key`: what it is, its clauses, whether a
 real vehicle's file must fill it in, and a safe starting value); ``helmcheck profile init``
@@ -42,6 +43,8 @@ import math
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
+
+from .spelling import did_you_mean
 
 __all__ = ["Profile", "BenchSafety", "ProfileError", "load_profile", "profile_from_dict", "DEFAULT", "PROTOCOLS",
            "OSI_FIELD_RANGE", "COMMAND_IDS", "SAFETY_CODES", "emulator_profile", "EMULATOR_PROFILE",
@@ -305,7 +308,8 @@ def _check(where: str, key: str, value: Any, default: Any) -> Any:
         if key == "commands":
             unknown = [c for c in value if c not in COMMAND_IDS]
             if unknown:
-                raise bad(f"unknown command {unknown[0]!r}; known: {', '.join(COMMAND_IDS)}")
+                raise bad(f"unknown command {unknown[0]!r}{did_you_mean(unknown[0], COMMAND_IDS)}; "
+                          f"known: {', '.join(COMMAND_IDS)}")
         return tuple(value)
     raise bad("is not supported")  # pragma: no cover - every key is handled above
 
@@ -317,7 +321,8 @@ def _bench(where: str, value: Any) -> BenchSafety:
     out = {}
     for k, v in value.items():
         if k not in known:
-            raise ProfileError(f"{where}: unknown key 'bench_safety.{k}'; known: {', '.join(known)}")
+            raise ProfileError(f"{where}: unknown key 'bench_safety.{k}'{did_you_mean(k, known)}; "
+                               f"[bench_safety] has {', '.join(known)}")
         out[k] = _check(where, f"bench_safety.{k}", v, known[k])
     if not 0 <= out.get("max_motor_byte", 0x90) <= 255:
         raise ProfileError(f"{where}: key 'bench_safety.max_motor_byte' must be 0..255")
@@ -337,7 +342,8 @@ def profile_from_dict(data: dict[str, Any], where: str = "<profile>") -> Profile
                 raise ProfileError(f"{where}: [{EMULATOR_TABLE}] must be a table")
             continue  # the emulator's own choices (helmcheck emulate reads them); not part of the claim
         if key not in known:
-            raise ProfileError(f"{where}: unknown key {key!r}; known keys: {', '.join(sorted(known))}")
+            raise ProfileError(f"{where}: unknown key {key!r}{did_you_mean(key, [*known, EMULATOR_TABLE])}; "
+                               f"every key: helmcheck profile keys")
         kwargs[key] = _check(where, key, value, known[key])
     protocol = kwargs.get("protocol", "rh5")
     lo, hi = OSI_FIELD_RANGE[protocol]

@@ -93,8 +93,8 @@ _VERIFIED: dict[Path, tuple] = {}
 
 def results_directories(base: Path) -> list[Path]:
     """Every results directory of a run under *base*: a ``results.json`` beside the
-    ``profile.toml`` of a certification (a report fixture or a check-log directory has none),
-    in a directory no ``unverifiable`` or failed test owns."""
+    ``profile.toml`` of a certification, a monitored session or a log check (a report fixture
+    has none), in a directory no ``unverifiable`` or failed test owns."""
     out = []
     for res in sorted(Path(base).rglob("results.json")):
         d = res.parent

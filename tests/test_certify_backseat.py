@@ -190,6 +190,23 @@ def test_rh_bs_1_to_8_check_log_of_the_wire_log_agrees_with_the_certification(ru
         assert not (pair & {"fail", "non-strict"} and "pass" in pair), (c, pair)
 
 
+@pytest.mark.parametrize("name", ["good", "short-omp"])
+def test_check_log_with_no_options_judges_a_backseat_certification_as_the_backseat(runs, name, tmp_path, capsys):
+    """A ``certify backseat`` log names its run: ``check-log wire.log`` with no option judges it
+    as the backseat's, under the run's profile.toml, with the run's verdicts (RH-BS-1..8) and
+    no vehicle clause (helmcheck's vehicle is not the implementation under test)."""
+    from helmcheck.cli import main as cli_main
+
+    run = runs[name, K]
+    code = cli_main(["check-log", str(run["dir"] / "wire.log"), "--report-dir", str(tmp_path / "c"), "--no-render"])
+    out = capsys.readouterr().out
+    assert "judged as: backseat (a certify backseat run, as its header says)" in out, out
+    offline = {c["id"]: c["verdict"] for c in load_results(tmp_path / "c")["clauses"]}
+    assert set(offline) == {f"RH-BS-{i}" for i in range(1, 9)}
+    assert offline == {cid: c["verdict"] for cid, c in clauses(run).items()}
+    assert code == run["rc"]
+
+
 def test_backseat_that_crashes_mid_run_is_inconclusive(runs):
     run = runs["crash", K]
     r = run["results"]

@@ -110,7 +110,8 @@ def test_backseat_that_exits_after_2_s_fails_with_its_exit_quoted(runs):
     assert all(c["verdict"] == "not-tested" for c in r["clauses"])  # even nominal had not finished
     md = (run["dir"] / "report.md").read_text()
     assert "crashing on purpose" in md and "**FAIL**" in md
-    assert run["out"].splitlines()[-1].startswith("FAIL")
+    assert run["out"].splitlines()[-2].startswith("FAIL")
+    assert run["out"].splitlines()[-1] == f"report: {run['dir'] / 'report.html'}"
     _no_traceback(run)
 
 

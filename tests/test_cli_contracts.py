@@ -284,7 +284,7 @@ TESTER_BUG = {  # (argv, the function a bug is planted in)
     "certify vehicle": (["certify", "vehicle", "--port", "/dev/null"], "helmcheck.profile.load_profile"),
     "certify backseat": (["certify", "backseat"], "helmcheck.profile.load_profile"),
     "replay": (["replay", "REPLAY", "--port", "/dev/null"], "helmcheck.certify.vehicle.replay.load_replay"),
-    "check-log": (["check-log", LOGS / "nominal.log"], "helmcheck.profile.load_profile"),
+    "check-log": (["check-log", LOGS / "nominal.log"], "helmcheck.checklog.checker.check_log"),
     "monitor": (["monitor", "--tap", "pty", "pty"], "helmcheck.profile.load_profile"),
     "report": (["report", PASS_RUN], "helmcheck.reports.rundir.load_run"),
     "docs": (["docs", "--check"], "helmcheck.grammar.docs.render_markdown"),

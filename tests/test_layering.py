@@ -63,6 +63,7 @@ TOP_LEVEL = {
     "profile": "foundation",  # the profile (grammar and model read it); standard library only
     "profile_toml": "foundation",  # the TOML emitter; imports profile
     "profile_template": "foundation",  # the `profile init` template; imports profile, profile_toml
+    "spelling": "foundation",  # did you mean …: the closest known words; standard library only
     "clauses": "foundation",  # the clause catalogue; standard library and the spec package data
     "reference_docs": "foundation",  # the site's generated reference pages; imports profile*, clauses
     "outputs": "reports",  # report directories and output files; imports failures, reports.atomic

@@ -176,11 +176,16 @@ def test_a_swapped_profile_is_caught(runs, tmp_path, capsys):
 
 
 def test_a_wrong_public_key_is_caught(runs, capsys):
+    """Another key than the signer's: one line naming the key problem, and nothing suggesting the
+    files were changed (they were not: the signature holds with the key that made it)."""
     root, _ = runs
     code, lines = verify(capsys, str(root / "full"), "--public-key", str(root / "other.pub"))
     assert code == 1
+    assert [ln for ln in lines if ln.startswith("MISMATCH ")] == mismatches(lines, "signature")
     sig = mismatches(lines, "signature")
-    assert sig and "not with" in sig[0] and "other.pub" in sig[0], lines
+    assert len(sig) == 1, lines
+    assert "not with the given key" in sig[0] and "other.pub" in sig[0] and "signed by another key" in sig[0]
+    assert not any("changed" in ln for ln in lines), lines
 
 
 def test_an_unsigned_run_fails_against_a_public_key(runs, capsys):

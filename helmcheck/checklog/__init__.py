@@ -12,6 +12,9 @@ Modules, one concern each:
   log by the one wire-log reader, :func:`helmcheck.grammar.wirelog.read_wire_log`);
 * :mod:`.socat` — the ``socat -v`` / ``-x`` / ``-v -x`` reader and its timestamp unit;
 * :mod:`.records` — what the readers yield (:data:`~.records.Chunk`) and learn (:class:`~.records.LogMeta`);
+* :mod:`.origin` — what the log's header says about the run that wrote it, and from it how a
+  check judges the log when the command line does not say (the role that run tested, the run's
+  profile, the header's time scale and missions);
 * :mod:`.checker` — :func:`~.checker.check_log`: one pass over the records, each fed to the role's
   observer (:mod:`helmcheck.judge`: the vehicle observer for §1–8, the backseat observer for §9,
   the same ones the certifiers use), bounded bookkeeping;

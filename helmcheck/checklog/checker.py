@@ -53,6 +53,7 @@ from ..profile import DEFAULT, Profile
 from ..reports.segments import session_files
 from .readers import (HEAD_BYTES, NOTE, UNREADABLE, Chunk, LogMeta, Unreadable, detect_format, header_comment, read_chunks,
                       timestamp_resolution)
+from .origin import read_origin
 from .sidejob import SideJob, SideJobLost, cores
 
 __all__ = ["check_log", "log_meta", "CheckOutcome", "LogFormatError", "SessionJudge", "ROLES", "VEHICLE_CLAUSES"]
@@ -93,7 +94,7 @@ class CheckOutcome:
     segments: list = field(default_factory=list)  #: the names of the session's further segments
 
 
-def check_log(path: Path | str, *, profile: Profile = DEFAULT, role: str = "both",
+def check_log(path: Path | str, *, profile: Profile = DEFAULT, role: Optional[str] = "both",
               catalog: Optional[MissionCatalog] = None, time_scale: Optional[float] = None,
               swap: bool = False, progress: Optional[Callable[[int], None]] = None,
               parallel: Optional[bool] = None) -> CheckOutcome:
@@ -104,9 +105,12 @@ def check_log(path: Path | str, *, profile: Profile = DEFAULT, role: str = "both
     independent; the verdicts are the same either way). ``None`` decides by itself: for a log of
     at least :data:`PARALLEL_BYTES` on a machine with more than one core.
 
+    ``role=None``: the role the run that wrote the log tested, as its header names it
+    (:mod:`.origin`), else both.
+
     The file is judged as it was when the check began: a log still being written is checked up
     to the size it had then (in both processes alike)."""
-    if role not in ROLES:
+    if role is not None and role not in ROLES:
         raise ValueError(f"role must be one of {ROLES}")
     path = Path(path)
     started = time.monotonic()
@@ -115,6 +119,8 @@ def check_log(path: Path | str, *, profile: Profile = DEFAULT, role: str = "both
         files = [stack.enter_context(open(p, "rb")) for p in session.files]
         sizes = [os.fstat(f.fileno()).st_size for f in files]
         fmt, meta = _head(files[0], path, sizes[0])
+        if role is None:
+            role = read_origin(meta).role or "both"
         scale = time_scale if time_scale is not None else (meta.time_scale or profile.time_scale or 1.0)
         baud = meta.baud or profile.baud
         if parallel is None:

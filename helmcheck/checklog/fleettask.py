@@ -8,11 +8,16 @@ data) and returns a plain ``dict`` (JSON-able) saying what happened. The judging
 :func:`~.checker.check_log` and the writing :func:`~.report.write_report_dir`, as for
 ``check-log FILE``.
 
+**Each log's own run.** What the archive's options do not say is each log's own, as for
+``check-log FILE`` (:mod:`.origin`): the role its header's run tested, the profile of the run
+directory it sits in (or the one its header names), the mission directories its header names;
+without any, the archive's defaults.
+
 **The cache.** Each results directory gets ``check-key.json`` beside ``results.json``: the
-helmcheck version and revision, the SHA-256 of the resolved profile (canonical JSON), the SHA-256
-of the log (every segment, as the checker hashes it), and every option that changes a verdict or
-the files written (role, time scale, the missions directory's content hash, swapped directions,
-strict, rendered reports). A log whose directory holds the same key and a readable
+helmcheck version and revision, the SHA-256 of the profile the log is judged under (canonical
+JSON), the SHA-256 of the log (every segment, as the checker hashes it), and every option that
+changes a verdict or the files written (the role judged, time scale, the mission directories'
+content hash, swapped directions, strict, rendered reports). A log whose directory holds the same key and a readable
 ``results.json`` is not judged again (``cached``); ``force`` judges it anyway. The key is written
 last, after the results and reports, so a check cut short leaves no key and is judged next time.
 
@@ -51,7 +56,7 @@ class Options:
 
     profile: Profile
     profile_sha256: str
-    role: str = "both"
+    role: Optional[str] = None  #: ``None``: each log's own (the role its header's run tested, else both)
     missions: Optional[str] = None
     missions_sha256: Optional[str] = None
     time_scale: Optional[float] = None
@@ -69,7 +74,7 @@ class Options:
 
     def command(self, path: str) -> str:
         """``helmcheck check-log`` of this one file with these options."""
-        words = ["helmcheck", "check-log", path, "--role", self.role]
+        words = ["helmcheck", "check-log", path] + (["--role", self.role] if self.role is not None else [])
         if self.profile_arg is not None:
             words += ["--profile", self.profile_arg]
         if self.missions is not None:
@@ -115,9 +120,39 @@ def _log_sha256(path: Path) -> str:
     return h.hexdigest()
 
 
-def _key(opts: Options, log_sha: str) -> bytes:
+@dataclass(frozen=True)
+class _Judging:
+    """How one log of the archive is judged: the archive's options where given, else the log's
+    own (:func:`helmcheck.checklog.origin.resolve`, as ``check-log FILE`` does)."""
+
+    profile: Profile
+    profile_sha256: str
+    role: Optional[str]
+    missions: Optional[list]
+    missions_sha256: Optional[str]
+    origin: Optional[dict] = None
+
+
+def _judging(path: Path, opts: Options) -> _Judging:
+    from .checker import log_meta
+    from .origin import resolve
+
+    if opts.profile_arg is not None and opts.role is not None and opts.missions is not None:
+        return _Judging(opts.profile, opts.profile_sha256, opts.role, [Path(opts.missions)], opts.missions_sha256)
+    _, meta = log_meta(path)
+    how = resolve(path, meta, role=opts.role, profile_arg=opts.profile_arg, missions_arg=opts.missions,
+                  time_scale=opts.time_scale)
+    profile = opts.profile if opts.profile_arg is not None else how.profile
+    msha = opts.missions_sha256
+    if how.missions and opts.missions is None:
+        msha = hashlib.sha256("".join(tree_sha256(d) for d in how.missions).encode()).hexdigest()
+    return _Judging(profile, profile_sha256(profile), how.role, how.missions, msha, how.as_dict())
+
+
+def _key(opts: Options, how: _Judging, log_sha: str) -> bytes:
+    options = {**opts.key_options(), "role": how.role, "missions_sha256": how.missions_sha256}
     doc = {"format": KEY_FORMAT, "helmcheck": {"version": opts.version, "revision": opts.revision},
-           "profile_sha256": opts.profile_sha256, "log_sha256": log_sha, "options": opts.key_options()}
+           "profile_sha256": how.profile_sha256, "log_sha256": log_sha, "options": options}
     return (json.dumps(doc, indent=2, sort_keys=True) + "\n").encode()
 
 
@@ -134,14 +169,14 @@ def _from_results(task: FileTask, status: str, res: dict[str, Any], seconds: flo
                   seconds=round(seconds, 3), clauses={c["id"]: c["verdict"] for c in res.get("clauses", ())})
 
 
-def _cached(task: FileTask, opts: Options, out: Path) -> Optional[dict[str, Any]]:
+def _cached(task: FileTask, opts: Options, how: _Judging, out: Path) -> Optional[dict[str, Any]]:
     """The entry of a log judged already with this key, else None."""
     from ..reports.results import ReportError, load_results
     try:
         stored = (out / KEY_NAME).read_bytes()
     except OSError:
         return None
-    if stored != _key(opts, _log_sha256(Path(task.path))):
+    if stored != _key(opts, how, _log_sha256(Path(task.path))):
         return None
     try:
         res = load_results(out)
@@ -169,15 +204,16 @@ def judge_file(task: FileTask, opts: Options) -> dict[str, Any]:
     out = Path(task.out_dir)
     path = Path(task.path)
     try:
+        how = _judging(path, opts)
         if not opts.force:
-            hit = _cached(task, opts, out)
+            hit = _cached(task, opts, how, out)
             if hit is not None:
                 return hit
         catalog = None
-        if opts.missions is not None:
+        if how.missions:
             from ..emulator.missionfile import DirectoryCatalog
-            catalog = DirectoryCatalog([Path(opts.missions)])
-        outcome = check_log(path, profile=opts.profile, role=opts.role, catalog=catalog,
+            catalog = DirectoryCatalog(list(how.missions))
+        outcome = check_log(path, profile=how.profile, role=how.role, catalog=catalog,
                             time_scale=opts.time_scale, swap=opts.swap, parallel=False)
     except (OSError, LogFormatError) as e:
         why = f"cannot read: {e.strerror or e}" if isinstance(e, OSError) else str(e)
@@ -187,9 +223,12 @@ def judge_file(task: FileTask, opts: Options) -> dict[str, Any]:
     try:
         (out / KEY_NAME).unlink(missing_ok=True)
         prepare_report_dir(out, overwrite=True)
-        res = write_report_dir(out, outcome, opts.profile, opts.command(task.path), strict=opts.strict,
-                               render=opts.render)
-        write_bytes_atomic(out / KEY_NAME, _key(opts, outcome.sha256))
+        settings: dict[str, Any] = {"swap_directions": opts.swap}
+        if how.missions:
+            settings["missions"] = [str(Path(d).resolve()) for d in how.missions]
+        res = write_report_dir(out, outcome, how.profile, opts.command(task.path), strict=opts.strict,
+                               render=opts.render, settings=settings, origin=how.origin)
+        write_bytes_atomic(out / KEY_NAME, _key(opts, how, outcome.sha256))
     except (OSError, ReportError, PathError) as e:
         what = f"cannot write {getattr(e, 'filename', None) or out}: {getattr(e, 'strerror', None) or e}"
         return _entry(task, "error", message=what)

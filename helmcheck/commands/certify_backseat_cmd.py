@@ -9,7 +9,7 @@ the scenarios of :mod:`helmcheck.certify.backseat.scenarios` with the driver's
 At the end (also after Ctrl-C, SIGTERM or SIGHUP — :mod:`helmcheck.signals` raises them as
 ``KeyboardInterrupt`` —, a backseat that never connected or one that went away) it writes
 ``results.json``, ``wire.log`` and every report format into ``--report-dir``, prints one verdict
-line on standard output and exits 0 (pass; non-strict without ``--strict``), 1 (fail), 2
+line and ``report: DIR/report.html`` on standard output and exits 0 (pass; non-strict without ``--strict``), 1 (fail), 2
 (inconclusive; or a report, wire log or ``--wire-log`` copy that could not be written) or 64
 (usage: bad option or profile, a port that cannot be opened, a report directory holding an
 earlier run without ``--overwrite``). Progress goes to standard error.
@@ -50,13 +50,6 @@ RH-BS-3 preconditions, RH-BS-4 line budget (baud/10 bytes in any second), RH-BS-
 to rejections and lockouts, RH-BS-6 servo refresh, RH-BS-7 upper-case hex and CR LF,
 RH-BS-8 $OSD polling every 5 s. A SHOULD missed is NON-STRICT (exit 0; 1 with --strict).
 
-examples:
-  helmcheck certify backseat                          # pty: prints 'port: /dev/pts/N'
-  helmcheck certify backseat --duration 30 --time-scale 10 --report-dir out/
-  helmcheck certify backseat --port socket://127.0.0.1:4001 --scenario lockout
-  helmcheck certify backseat --port /dev/ttyUSB0 --profile site.toml --strict
-  helmcheck certify backseat --time-scale 10 --exec 'python3 my_backseat.py --port {port} --k {time_scale}'
-
 --exec CMD starts the backseat under test on the port once it is open: CMD is split like a
 shell line and run without a shell; {port} becomes the pty path (or socket://HOST:PORT; {host}
 and {tcp_port} its halves), {time_scale} the time scale; without {port} the port is appended.
@@ -66,12 +59,21 @@ process group), then SIGKILL after --exec-grace seconds. A backseat that exits o
 before the end fails the run: results.json "process" has its exit and last output, the clauses
 whose scenarios had not finished are NOT-TESTED.
 
-  helmcheck certify backseat --implementation moos-ivp-helm@2.1.0 --sign-key lab.key --operator "J. Doe"
-
 certificate: --implementation names the backseat in every report; --sign-key signs the run
   (helmcheck keygen); helmcheck verify DIR --public-key lab.pub checks it against its evidence.
 
-exit status: 0 conformant, 1 non-conformant, 2 inconclusive, 64 usage.
+examples:
+  helmcheck certify backseat                          # pty: prints 'port: /dev/pts/N', waits for a backseat
+  helmcheck certify backseat --duration 10 --time-scale 10 \\
+      --exec 'python3 tests/backseats/good_backseat.py {port} --time-scale {time_scale}'
+  helmcheck certify backseat --port socket://127.0.0.1:0 --scenario lockout   # a TCP server; prints its port
+  helmcheck certify backseat --port /dev/ttyUSB0 --profile iver3.toml --strict
+  helmcheck keygen --out lab                          # a signing key pair, once
+  helmcheck certify backseat --implementation moos-ivp-helm@2.1.0 --sign-key lab.key --operator "J. Doe"
+
+exit status: 0 conformant (or non-strict without --strict), 1 non-conformant, 2 inconclusive (the
+  backseat never connected, went away, or an output could not be written), 64 usage (bad option
+  or profile, a port that cannot be opened, a report directory holding an earlier run).
 """
 
 
@@ -96,6 +98,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="start the backseat under test on the port ({port} is replaced, or the port appended)")
     p.add_argument("--exec-grace", type=float, default=5.0, metavar="S",
                    help="seconds between SIGTERM and SIGKILL when stopping it (default 5)")
+    p.add_argument("--no-progress", action="store_true",
+                   help="no progress on standard error (by default: a bar on a terminal, else a line per "
+                        "scenario and at least every 10 s)")
     p.add_argument("--overwrite", action="store_true",
                    help="replace an earlier run in --report-dir (its results, wire log and reports are "
                         "removed first); without it such a directory is refused")
@@ -117,7 +122,7 @@ def run(args: argparse.Namespace, *, on_port: Optional[Callable[[str], None]] = 
     opts = Options(profile=profile, report_dir=Path("."), port=args.port, time_scale=args.time_scale,
                    baud=args.baud, duration=args.duration, scenarios=args.scenario, strict=bool(args.strict),
                    connect_timeout=args.connect_timeout, exec_cmd=getattr(args, "exec_cmd", None),
-                   exec_grace_s=args.exec_grace)
+                   exec_grace_s=args.exec_grace, progress=not getattr(args, "no_progress", False))
     wrong = problems(opts)
     if wrong:
         raise UsageError(wrong[0])
@@ -145,8 +150,9 @@ def run(args: argparse.Namespace, *, on_port: Optional[Callable[[str], None]] = 
 
     opts.on_port = announce
     out = certify(opts)
+    from .messages import report_line
     print(f"{headline(out.results)}. {out.reason}")  # the headline says when the run was cut short
-    print(f"helmcheck certify backseat: report in {out.report_dir}", file=sys.stderr)
+    print(report_line(out.report_dir))
     sys.stdout.flush()
     if hasattr(opts.log, "check"):
         opts.log.check()  # the wire log lost on the way is exit 2, after the verdict line

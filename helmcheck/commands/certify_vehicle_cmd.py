@@ -52,14 +52,6 @@ safety violations (§7, RH-SAF-5), per the profile's violation_trigger:
 bench safety: unless the profile says [bench_safety] in_water = true, no $OMP motor byte above
   max_motor_byte and no speed above max_speed_kn is ever sent, whatever a case or hypothesis asks.
 
-examples:
-  helmcheck emulate --port pty --time-scale 20 &        # prints port: /dev/pts/N
-  helmcheck certify vehicle --port /dev/pts/N --time-scale 20 --profile emu.toml
-  helmcheck certify vehicle --port /dev/ttyUSB0 --profile iver3.toml --hypothesis-profile patient
-  helmcheck certify vehicle --port socket://10.0.0.5:4001 --select 'RH-SRV-*' --select RH-ACK-2
-  helmcheck certify vehicle --exec './uvc-sim --serial {port}' --time-scale 20   # start the vehicle too
-  helmcheck certify vehicle --port /dev/ttyUSB0 --resume reports/vehicle   # go on after an interruption
-
 --exec CMD starts the vehicle under test (a simulator, a firmware build on the host) on a new
 pty ({port} is its path; without {port} the path is appended), or with --port socket://HOST:0
 on a free TCP port ({port} is socket://HOST:N, {host} and {tcp_port} its halves); {time_scale}
@@ -72,7 +64,6 @@ plan: --plan prints every selected case with its estimated vehicle and wall time
   are run on the reference vehicle in virtual time, so the estimate includes the protocol's waits
   and the ACK windows sat out for discarded lines; the exploration counts at its wall budget.
   --missions DIR names the vehicle's mission files (default: the emulator's built-in ones).
-  helmcheck certify vehicle --plan --time-scale 1 --profile iver3.toml
 
 certificate: a run that judges every vehicle clause is a certificate; --select runs and runs with a
   NOT-TESTED or INCONCLUSIVE clause say "partial: N of 60 claimed clauses judged; not a certificate".
@@ -88,6 +79,19 @@ results: DIR/results.json (schema 1), DIR/wire.log, DIR/profile.toml, DIR/signat
   DIR/report.html, DIR/junit.xml, DIR/report.md. A DIR that holds an earlier run is refused
   unless --overwrite. SIGINT, SIGTERM and SIGHUP end the run early: results marked partial,
   reports rendered.
+
+examples:
+  helmcheck emulate --port pty --time-scale 20 &        # a vehicle to certify; prints port: /dev/pts/N
+  helmcheck certify vehicle --port /dev/pts/N --time-scale 20 --profile helmcheck/profiles/emulator.toml
+  helmcheck certify vehicle --exec 'helmcheck emulate --port {port} --time-scale {time_scale}' \\
+      --time-scale 20 --profile helmcheck/profiles/emulator.toml --select 'RH-SRV-*' --examples 0 \\
+      --report-dir reports/servo                        # start the vehicle too; four clauses, no exploration
+  helmcheck certify vehicle --plan --time-scale 1 --profile iver3.toml   # how long a run takes; no port
+  helmcheck certify vehicle --port /dev/ttyUSB0 --profile iver3.toml --hypothesis-profile patient
+  helmcheck certify vehicle --port socket://10.0.0.5:4001 --profile iver3.toml --select 'RH-SRV-*' \\
+      --select RH-ACK-2
+  helmcheck certify vehicle --port /dev/ttyUSB0 --resume reports/vehicle   # go on after an interruption
+
 exit status: 0 pass (or non-strict without --strict), 1 fail, 2 inconclusive, link fault, tester
   error, a vehicle not verified as restored after a run that did not fail, or an output that could
   not be written, 64 usage
@@ -227,9 +231,10 @@ def run(args: argparse.Namespace) -> int:  # noqa: C901 - argument checks, then 
         if link is not None:
             link.close()
     from ..reports.scope import headline, precision_note, what_to_change
+    from .messages import report_line
     notes = [x for x in (what_to_change(out.results), precision_note(out.results)) if x]
-    print(f"{headline(out.results)}. {out.reason}{''.join(' ' + x for x in notes)} — report: "
-          f"{out.report_dir / 'report.html'}")
+    print(f"{headline(out.results)}. {out.reason}{''.join(' ' + x for x in notes)}")
+    print(report_line(out.report_dir))
     sys.stdout.flush()
     restore = out.results.get("restore")
     if restore is not None and restore.get("attempted") and not restore.get("verified"):

@@ -30,18 +30,26 @@ from ..failures import OutputLost, PathError, UsageError, describe_interrupt
 __all__ = ["run_fleet", "Progress"]
 
 
+#: Seconds between two progress lines when standard error is not a terminal (without --progress).
+PLAIN_EVERY_S = 10.0
+
+
 class Progress:
     """Files done of the total, lines judged per second and the time left, on standard error:
-    one line redrawn in place on a terminal, one line per finished file otherwise (with
-    ``--progress``), nothing when off. The rate counts the files judged now (not cached ones);
-    the time left is the bytes not yet done at the bytes-per-second of the files judged so far."""
+    one line redrawn in place on a terminal; otherwise a line at most every
+    :data:`PLAIN_EVERY_S` seconds (and for the last file), or one per finished file with
+    ``--progress``; nothing with ``--no-progress``. The rate counts the files judged now (not
+    cached ones); the time left is the bytes not yet done at the bytes-per-second of the files
+    judged so far."""
 
     def __init__(self, total_files: int, total_bytes: int, wanted: Optional[bool]):
         self.tty = sys.stderr.isatty()
-        self.on = wanted if wanted is not None else self.tty
+        self.on = wanted is not False
+        self.every = 0.0 if (wanted or self.tty) else PLAIN_EVERY_S
         self.total_files, self.total_bytes = total_files, total_bytes
         self.files = self.lines = self.bytes_done = self.bytes_judged = 0
         self.t0 = time.monotonic()
+        self._said: Optional[float] = None
 
     def done(self, entry: dict[str, Any], size: int) -> None:
         self.files += 1
@@ -59,7 +67,10 @@ class Progress:
                 f"{entry['path']}: {entry.get('verdict', entry['status'])}")
         if self.tty:
             print("\r\x1b[2K" + text[:max(20, _width() - 1)], end="", file=sys.stderr, flush=True)
-        else:
+            return
+        now = time.monotonic()
+        if self._said is None or now - self._said >= self.every or self.files == self.total_files:
+            self._said = now
             print(text, file=sys.stderr, flush=True)
 
     def close(self) -> None:
@@ -182,7 +193,7 @@ def run_fleet(args: argparse.Namespace) -> int:
     for f in doc["files"]:
         if f["status"] in ("unreadable", "error"):
             print(f"{f['path']}: {f['status']}: {f.get('message', '')}")
-    print(f"summary: {summary_md} ({report_dir / 'summary.json'})")
+    print(f"report: {summary_md} (also {report_dir / 'summary.json'}, {report_dir / 'matrix.html'})")
     print(doc["verdict_line"])
     if partial is not None:
         print(f"helmcheck check-log: {partial}: the summary is partial; files finished keep their results",

@@ -38,17 +38,20 @@ what is compared:
   failed it in that sequence: the result names that side and the clause.
 
 results: DIR/diff.json (result, the divergence, both sides' findings), DIR/A/wire.log and
-  DIR/B/wire.log, and for a divergence one replay per side, DIR/replays/A-*.json and B-*.json:
-  helmcheck replay DIR/replays/B-RH-SRV-2.json --port /dev/pts/N re-drives it on one vehicle.
-
-exit status: 0 no divergence within the budget, 1 a divergence, 2 inconclusive (link fault,
-  a clock not at its time scale, nothing ran) or tester error, 64 usage.
+  DIR/B/wire.log, and for a divergence one replay per side, DIR/replays/A-*.json and B-*.json,
+  which 'helmcheck replay DIR/replays/B-RH-SRV-2.json --port URL' re-drives on one vehicle.
 
 examples:
   helmcheck diff --port /dev/pts/5 --port /dev/pts/7 --time-scale 20 --budget 120
-  helmcheck diff --exec './uvc-sim-N --serial {port}' --exec './uvc-sim-N-1 --serial {port}' --seed 1
+  helmcheck diff --exec 'helmcheck emulate --port {port} --time-scale {time_scale}' \\
+      --exec 'helmcheck emulate --port {port} --time-scale {time_scale} --set pacing=burst' \\
+      --time-scale 20 --budget 10 --seed 1            # two vehicles helmcheck starts itself
   helmcheck diff --port /dev/ttyUSB0 --profile iver3.toml --time-scale 1 \\
-                 --exec './backseat-sim --vehicle {port}' --profile-b sim.toml --time-scale-b 20
+      --exec 'helmcheck emulate --port {port} --time-scale {time_scale}' \\
+      --profile-b helmcheck/profiles/emulator.toml --time-scale-b 20   # a vehicle against the emulator
+
+exit status: 0 no divergence within the budget, 1 a divergence, 2 inconclusive (link fault,
+  a clock not at its time scale, nothing ran) or tester error, 64 usage.
 """
 
 

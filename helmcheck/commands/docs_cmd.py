@@ -23,9 +23,24 @@ from .. import exitcodes
 EMULATOR_EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "emulator.toml"
 
 
+EPILOG = """\
+generated: docs/grammar.md and helmcheck/grammar/derived.py (from remote_helm.lark), and
+docs/model/ (from helmcheck/model/transitions.py), in the checkout helmcheck runs from.
+
+examples:
+  helmcheck docs --check                            # is every generated file current?
+  helmcheck docs                                    # regenerate them
+
+exit status: 0 written (with --check: every file current), 1 with --check: a file is stale (each
+  named), 2 a file could not be written.
+"""
+
+
 def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p = sub.add_parser("docs", help="regenerate the generated documentation",
-                       description=__doc__.split("\n\n")[0].split(": ", 1)[1])
+                       description="Regenerate every generated document, or with --check verify that the "
+                                   "checked-in copies are current.",
+                       epilog=EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--check", action="store_true", help="exit 1 if a checked-in copy is stale")
     p.set_defaults(func=run)
     return p

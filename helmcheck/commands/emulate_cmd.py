@@ -19,17 +19,10 @@ import sys
 from datetime import datetime, timezone
 from pathlib import Path
 
-from .. import exitcodes
+from .. import __version__, exitcodes
 from ..failures import UsageError
 
 EPILOG = """\
-examples:
-  helmcheck emulate                                   # pty, prints 'port: /dev/pts/N'
-  helmcheck emulate --time-scale 50 --log wire.log    # 50x faster vehicle clock (RH-TIM-2)
-  helmcheck emulate --port socket://127.0.0.1:4001    # a serial server, one client at a time
-  helmcheck emulate --port /dev/ttyUSB0 --baud 19200  # a real serial line, 8N1
-  helmcheck emulate --tui                             # live view: traffic, fins, mode, timers
-
 --baud paces the output at the line rate (10 bits per byte); --baud 0 sends unpaced (pty and
 socket only). Built-in missions: conformance.mis (the profile's test mission), short.mis,
 srp.mis; --missions DIR adds a directory that overrides them. $OXFLT,<code> (RH-SAF-5) is
@@ -47,12 +40,25 @@ choices the profile leaves a conforming vehicle (docs/freedoms.md): the [emulato
   helmcheck emulate --set timer_factor=1.03 --set pacing=burst --set decimals.lat=6
 A setting outside the profile's bounds is warned about and still obeyed (a non-conforming
 vehicle, for testing a tester).
+
+examples:
+  helmcheck emulate                                   # pty, prints 'port: /dev/pts/N'
+  helmcheck emulate --time-scale 50 --log emulator.log  # 50x faster vehicle clock (RH-TIM-2)
+  helmcheck emulate --port socket://127.0.0.1:0       # a serial server on a free TCP port, one client
+  helmcheck emulate --port /dev/ttyUSB0 --baud 19200  # a real serial line, 8N1
+  helmcheck emulate --tui                             # live view: traffic, fins, mode, timers
+  helmcheck emulate --profile helmcheck/profiles/emulator.toml --time-scale 20 &   # in the background
+  kill %1                                             # … and stopped (SIGTERM: exit 0)
+
+exit status: 0 stopped (Ctrl-C, SIGTERM or SIGHUP), 2 the link failed or a log could not be written,
+  64 usage (bad option or profile, a port or file that cannot be opened).
 """
 
 
 def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p = sub.add_parser("emulate", help="run the reference vehicle emulator on a serial port",
-                       description=__doc__.split("\n\n")[0].split(": ", 1)[1],
+                       description="Run the reference vehicle on a pty, a serial device or a TCP serial "
+                                   "server, answering as the reference model does, until stopped.",
                        epilog=EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--port", default="pty", metavar="PORT",
                    help="pty (default), a device path, or socket://HOST:PORT (port 0: any free port)")
@@ -188,7 +194,7 @@ def _serve(args, profile, link, baud, missions_dir, log_file, main_log_file, cho
         from ..emulator.core import EmulatorCore, MainLog
         from ..emulator.missionfile import DirectoryCatalog, builtin_dir
         from ..emulator.server import Server
-        from ..grammar.wirelog import WireLogWriter
+        from ..grammar.wirelog import WireLogWriter, run_header
         dirs = ([missions_dir] if missions_dir is not None else []) + [builtin_dir()]
         catalog = DirectoryCatalog(dirs)
         started = datetime.now(timezone.utc)
@@ -196,7 +202,9 @@ def _serve(args, profile, link, baud, missions_dir, log_file, main_log_file, cho
             # monotonic=False: a plant or model event is logged at the wall time it happened,
             # which may come before bytes already logged (the core catches up in vehicle time)
             log = WireLogWriter(log_file, meta=(f"started {started.strftime('%Y-%m-%dT%H:%M:%S.%fZ')}  "
-                                                f"port {link.name}  baud {baud}  time_scale {profile.time_scale:g}",),
+                                                f"port {link.name}  baud {baud}  time_scale {profile.time_scale:g}",
+                                                run_header(__version__, "emulate", profile.name,
+                                                           [str(Path(d).resolve()) for d in dirs])),
                                 monotonic=False)
         core = EmulatorCore(profile, catalog, start=time.monotonic(), baud=baud, log=log, settings=choices,
                             main_log=MainLog(main_log_file) if main_log_file is not None else None,

@@ -16,8 +16,10 @@ from ..failures import UsageError
 EPILOG = """\
 examples:
   helmcheck keygen --out lab                         # lab.key (keep it secret), lab.pub (hand it out)
-  helmcheck certify vehicle --port /dev/ttyUSB0 --sign-key lab.key --report-dir out/
-  helmcheck verify out/ --public-key lab.pub
+  helmcheck certify vehicle --port /dev/ttyUSB0 --profile iver3.toml --sign-key lab.key --report-dir signed/
+  helmcheck verify signed/ --public-key lab.pub
+
+exit status: 0 written, 64 usage (a key file exists without --force, or cannot be written).
 """
 
 

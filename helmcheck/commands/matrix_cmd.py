@@ -19,21 +19,24 @@ from .. import exitcodes
 from ..failures import UsageError
 
 EPILOG = """\
-examples:
-  helmcheck matrix reports/uvc-3.2 reports/uvc-3.3 reports/emulator --out reports/matrix
-  helmcheck matrix out/*/ --title 'backseats, nightly'
-
 Each column is one run, labelled by its identity (the profile's implementation name and version,
 else the vehicle name, else the program --exec started), plus its start date. Each cell is that
 clause's verdict, linking to the clause in the run's report.html. — marks a clause the run has
 no entry for (a backseat run has no vehicle clauses).
+
+examples:
+  helmcheck matrix reports/vehicle reports/previous --out matrix/
+  helmcheck matrix reports/*/ --title 'vehicles, nightly' --out matrix/   # every run under reports/
+
+exit status: 0 written, 2 a results directory could not be read or a file not written (one line
+  naming it), 64 usage.
 """
 
 
 def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p = sub.add_parser("matrix", help="one overview of several runs: clauses x implementations",
-                       description="Render the verdicts of several results directories side by side "
-                                   "(HTML and Markdown).",
+                       description="Render the verdicts of several results directories side by side, "
+                                   "clause by clause (HTML and Markdown); nothing is re-run.",
                        epilog=EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("directories", nargs="+", metavar="DIR", type=Path,
                    help="results directories (each with results.json), one column each, in this order")

@@ -42,13 +42,18 @@ wire.002.log, … (judged as one session); at the end (and a check of the sessio
 rotation) results.json and the reports, exactly as check-log gives them for that log, signable
 with --sign-key and checked by 'helmcheck verify'.
 
+end: --duration S, --until HH:MM[:SS] (local time) or an ISO date-time, Ctrl-C or SIGTERM.
+
 examples:
   helmcheck monitor --tap /dev/ttyUSB0 /dev/ttyUSB1 --profile iver3.toml --report-dir sea-trial/
   helmcheck monitor --between /dev/ttyUSB0 /dev/ttyUSB1 --duration 3600
-  helmcheck monitor --between pty socket://127.0.0.1:5555 --time-scale 20     # a simulator
+  helmcheck emulate --port socket://127.0.0.1:5555 --time-scale 20 &   # a simulated vehicle on TCP
+  helmcheck monitor --between pty socket://127.0.0.1:5555 --time-scale 20 --duration 30   # prints the
+                                                    # backseat's pty: point the backseat at it
 
-end: --duration S, --until HH:MM[:SS] (local time) or an ISO date-time, Ctrl-C or SIGTERM.
-exit status: 0 conformant, 1 non-conformant, 2 inconclusive, 64 usage.
+exit status: 0 conformant (non-strict without --strict), 1 a clause failed, 2 inconclusive (or a
+  report that could not be written), 64 usage (bad option or profile, a port that cannot be
+  opened, a report directory holding an earlier run without --overwrite).
 """
 
 
@@ -74,7 +79,8 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p.add_argument("--rotate-mb", type=float, default=64.0, metavar="MB",
                    help="start a new wire-log segment every MB megabytes (default 64)")
     p.add_argument("--strict", action="store_true", help="a SHOULD not met fails the session")
-    p.add_argument("--no-tui", action="store_true", help="plain finding lines even on a terminal")
+    p.add_argument("--no-tui", action="store_true",
+                   help="plain lines even on a terminal: each finding, and a status line every 10 s")
     p.add_argument("--no-realtime", action="store_true",
                    help="do not ask for real-time priority for the relay (by default it does, where permitted)")
     p.add_argument("--vehicle", metavar="NAME", help="the vehicle's name in the report (default: the profile's)")
@@ -106,7 +112,7 @@ def _until(text: str) -> float:
 def run(args: argparse.Namespace) -> int:
     from ..line.transport import BAUD_RATES
     from ..monitor.session import Options, monitor
-    from ..monitor.view import LiveScreen, finding_line
+    from ..monitor.view import LiveScreen, StatusLines, finding_line
     from ..outputs import prepare_report_dir
     from ..profile import load_profile
     from ..reports.scope import headline
@@ -146,10 +152,10 @@ def run(args: argparse.Namespace) -> int:
         raise
     args.report_dir = str(report_dir)  # where a tester error's traceback goes
     tui = sys.stderr.isatty() and not args.no_tui
-    screen = LiveScreen(f"helmcheck monitor --{mode}") if tui else None
+    screen = LiveScreen(f"helmcheck monitor --{mode}") if tui else StatusLines("helmcheck monitor")
 
     def on_finding(f) -> None:  # a live screen gets its findings from the session (it is the view)
-        if screen is None and f.first:
+        if not tui and f.first:
             print(finding_line(f), flush=True)
 
     def on_port(side: str, name: str) -> None:
@@ -169,8 +175,9 @@ def run(args: argparse.Namespace) -> int:
                           rotate_bytes=int(args.rotate_mb * 1024 * 1024), strict=bool(args.strict),
                           command=command, certificate=cert, on_finding=on_finding, on_port=on_port,
                           view=screen, links=links, realtime=not args.no_realtime, on_relay=on_relay))
-    print(f"{headline(out.results)}. {out.reason} ({out.ended}; {out.findings} finding(s))", flush=True)
-    print(f"helmcheck monitor: report in {out.report_dir}", file=sys.stderr)
+    from .messages import report_line
+    print(f"{headline(out.results)}. {out.reason} ({out.ended}; {out.findings} finding(s))")
+    print(report_line(out.report_dir), flush=True)
     return out.exit_code
 
 

@@ -34,14 +34,16 @@ from .. import exitcodes
 from ..failures import PathError
 
 EPILOG = """\
-examples:
-  helmcheck parse capture.txt               # one sentence per line
-  helmcheck parse wire.log --json           # a wire log written by emulate/certify --log
-  printf '$OMSTOP,0*06\\r\\n' | helmcheck parse -
-
 A line is judged against the reference profile: framing and checksum (RH-FRM-*), the grammar,
 and value ranges from the profile (--profile FILE; default rh5). Wire-log comment lines (#) and
-notes (!) are skipped.
+notes (!) are skipped. Invalid lines print as FILE:LINE: CLAUSE: message.
+
+examples:
+  helmcheck parse reports/vehicle/wire.log          # a wire log (certify, emulate --log, monitor)
+  helmcheck parse reports/vehicle/wire.log --json   # one JSON object per line
+  printf '$OMSTOP,0*06\\r\\n$OMSTOP,0*07\\r\\n' | helmcheck parse -   # one sentence per line
+
+exit status: 0 every line valid, 1 an invalid line, 64 usage (bad option or profile, unreadable file).
 """
 
 _BLOCK = 512  #: output lines collected before one write
@@ -52,7 +54,7 @@ _LINE = re.compile(rb"[^\n]*\n|[^\n]+")  #: a line as a binary file's iterator g
 
 def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p = sub.add_parser("parse", help="validate sentences line by line",
-                       description=__doc__.split("\n\n")[0].split(": ", 1)[1],
+                       description="Validate sentences line by line, from files, standard input or wire logs.",
                        epilog=EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("files", nargs="*", default=["-"], metavar="FILE",
                    help="files to read ('-' or nothing: standard input)")

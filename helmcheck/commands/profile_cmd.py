@@ -1,4 +1,5 @@
-"""``helmcheck profile init [PATH]``: write a commented profile for a real vehicle to fill in.
+"""``helmcheck profile init [PATH]``: write a commented profile for a real vehicle to fill in;
+``helmcheck profile keys``: list every key.
 
 The text is :func:`helmcheck.profile_template.render` — every key of
 :class:`~helmcheck.profile.Profile` with its documentation, allowed values and a safe starting
@@ -31,17 +32,33 @@ what you get:
   FILL IN need a value from the vehicle (its name, serial, UVC version, baud, test mission …).
   The file loads as it is; a key you delete takes the rh5 default.
 
+--set KEY=VALUE takes a TOML value (a string may be given bare: --set mission=survey.mis);
+bench_safety.KEY for the [bench_safety] table; 'helmcheck profile keys' lists every key.
+
 examples:
   helmcheck profile init iver3-042.toml --name IVER3-042 --serial 3042 --uvc-version 5.2.1
   helmcheck profile init --set baud=57600 --set 'commands=["OMS","OMP","OSD","OMSTOP","OMSTART"]'
   helmcheck profile init --emulator emu.toml       # the built-in emulator's claims, all keys
   helmcheck certify vehicle --port /dev/ttyUSB0 --profile iver3-042.toml
 
-  --set KEY=VALUE takes a TOML value (a string may be given bare: --set mission=survey.mis);
-  bench_safety.KEY for the [bench_safety] table.
-
 exit status: 0 written, 64 usage (bad option or value, existing file without --overwrite,
   unwritable path), 2 the write failed.
+"""
+
+PROFILE_EPILOG = """\
+examples:
+  helmcheck profile init my-vehicle.toml            # a commented profile to fill in
+  helmcheck profile keys                            # every key, one line each
+
+exit status: 0 written or listed, 64 usage, 2 a write that failed.
+"""
+
+KEYS_EPILOG = """\
+examples:
+  helmcheck profile keys
+  helmcheck profile keys | grep -i mission
+
+exit status: 0 listed.
 """
 
 #: option -> profile key, for the common identity fields.
@@ -50,8 +67,11 @@ SHORTCUTS = {"name": "vehicle_name", "serial": "vehicle_serial", "uvc_version": 
 
 
 def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
-    p = sub.add_parser("profile", help="write a commented profile for a vehicle to fill in",
-                       description="Profiles declare what an implementation claims (reference profile §10).")
+    p = sub.add_parser("profile", help="write a commented profile for a vehicle; list the profile keys",
+                       description="Write a commented profile for a vehicle to fill in, or list every profile "
+                                   "key. A profile declares what an implementation claims (reference "
+                                   "profile §10).",
+                       epilog=PROFILE_EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
     actions = p.add_subparsers(dest="action", metavar="ACTION", parser_class=type(p))
     ip = actions.add_parser("init", help="write a commented TOML profile for a real vehicle to fill in",
                             description="Write a commented TOML profile for a real vehicle: every key with "
@@ -72,6 +92,11 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
                     help="start from the built-in emulator's profile ($OXFLT, its missions) instead of a "
                          "real vehicle's safe values")
     ip.set_defaults(func=run_init)
+    kp = actions.add_parser("keys", help="list every profile key with what it is and its default",
+                            description="List every key a profile file may hold: its name, what it is, the "
+                                        "clauses it serves and its rh5 default, one line each.",
+                            epilog=KEYS_EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
+    kp.set_defaults(func=run_keys)
     p.set_defaults(func=_no_action)
     return p
 
@@ -79,7 +104,7 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
 def _no_action(args: argparse.Namespace) -> int:
     from ..failures import UsageError
 
-    raise UsageError("choose an action: init (see 'helmcheck profile --help')")
+    raise UsageError("choose an action: init or keys (see 'helmcheck profile --help')")
 
 
 def _keys() -> dict[str, Any]:
@@ -105,7 +130,8 @@ def _parse_set(item: str, keys: dict[str, Any]) -> tuple[str, Any]:
     if not eq or not key:
         raise UsageError(f"--set {item!r}: expected KEY=VALUE")
     if key not in keys:
-        raise UsageError(f"--set: unknown key {key!r}; known keys: {', '.join(keys)}")
+        from ..spelling import did_you_mean
+        raise UsageError(f"--set: unknown key {key!r}{did_you_mean(key, keys)}; every key: helmcheck profile keys")
     try:
         value = tomllib.loads(f"v = {text}")["v"]
     except tomllib.TOMLDecodeError:
@@ -128,6 +154,35 @@ def _emulator_values() -> dict[str, Any]:
         else:
             flat[k] = v
     return flat
+
+
+def run_keys(args: argparse.Namespace) -> int:  # noqa: ARG001 - the command's signature
+    """``profile keys``: every key, one line each (the profile's own key table)."""
+    import dataclasses
+
+    from ..profile import BenchSafety, profile_keys
+
+    rows = []
+    for f in profile_keys():
+        fields = ([(f"bench_safety.{g.name}", g) for g in dataclasses.fields(BenchSafety)]
+                  if f.name == "bench_safety" else [(f.name, f)])
+        for name, g in fields:
+            meta = g.metadata
+            default = g.default if g.default is not dataclasses.MISSING else g.default_factory()  # type: ignore[misc]
+            where = "; ".join(x for x in (meta.get("group", ""), meta.get("clause", "")) if x)
+            rows.append((name, f"{meta.get('doc', '')} ({where}; default {_toml(default)})"))
+    width = max(len(n) for n, _ in rows)
+    for name, text in rows:
+        print(f"{name:<{width}}  {text}")
+    return exitcodes.OK
+
+
+def _toml(value: Any) -> str:
+    from ..profile_toml import toml_value
+    try:
+        return toml_value(value)
+    except (TypeError, ValueError):
+        return repr(value)
 
 
 def run_init(args: argparse.Namespace) -> int:

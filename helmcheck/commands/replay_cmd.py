@@ -16,18 +16,23 @@ import sys
 from .. import exitcodes
 
 EPILOG = """\
+A replay file is what certify vehicle writes into DIR/replays/ for each failure its exploration
+found (and diff for each divergence): the exact bytes sent and the protocol's waits. --time-scale
+defaults to the one the replay was recorded at; waits are vehicle seconds divided by it.
+
 examples:
-  helmcheck replay reports/vehicle/replays/RH-SRV-4-1.json --port /dev/pts/5 --time-scale 20
+  helmcheck replay failing.json --port /dev/pts/N --time-scale 20   # e.g. reports/vehicle/replays/*.json
   helmcheck replay failing.json --port socket://10.0.0.5:4001 --profile iver3.toml
 
---time-scale defaults to the one the replay was recorded at; waits are vehicle seconds divided by it.
+exit status: 1 it still fails, 0 it passes now, 2 it cannot be judged (a link fault, or the vehicle
+  went another way), 64 usage (bad option, replay file or profile, a port that cannot be opened).
 """
 
 
 def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p = sub.add_parser("replay", help="re-drive a saved failing sequence against a vehicle",
                        description="Re-drive a saved failing sequence against a vehicle and say whether it "
-                                   "still fails (exit 1), passes now (0) or cannot be judged (2).",
+                                   "still fails, passes now, or cannot be judged.",
                        epilog=EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("file", metavar="FILE", help="a replay file (replays/*.json in a results directory)")
     p.add_argument("--port", required=True, metavar="URL", help="the vehicle's port (what pyserial opens)")
@@ -39,7 +44,11 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
 
 
 def run(args: argparse.Namespace) -> int:
+    import time
+
+    from .. import __version__
     from ..clauses import vehicle_clauses
+    from ..grammar.wirelog import run_header
     from ..line.recorder import Recorder
     from ..certify.vehicle.flow import LinkLost
     from ..certify.vehicle.link import TesterLink
@@ -89,7 +98,10 @@ def run(args: argparse.Namespace) -> int:
         from ..certify.vehicle.replay import redrive
         ledger = Ledger([c.id for c in vehicle_clauses()])
         observer = VehicleObserver(profile, ledger, time_scale=k, baud=profile.baud)
-        recorder = Recorder(log, [f"replay {args.file} port {args.port} time_scale {k:g}"], [observer])
+        recorder = Recorder(log, [f"started {time.strftime('%Y-%m-%dT%H:%M:%SZ', time.gmtime())}  port {args.port}  "
+                                  f"baud {profile.baud}  time_scale {k:g}",
+                                  run_header(__version__, "replay", profile.name, more=f" {args.file}".replace(";", ","))],
+                            [observer])
         link = TesterLink(raw, profile, recorder)
         session = Session(link, profile, k, observer)
         try:

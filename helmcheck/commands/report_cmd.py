@@ -23,15 +23,24 @@ def _formats(value: str) -> list[str]:
     return names
 
 
+EPILOG = """\
+examples:
+  helmcheck report reports/vehicle                  # report.html, junit.xml and report.md again
+  helmcheck report reports/vehicle --format html    # one format
+  helmcheck report reports/vehicle --compare reports/previous --fail-on-regression   # against an earlier run
+
+exit status: 0 written; 1 with --fail-on-regression, when a clause regressed or lost coverage;
+  2 a report could not be written; 64 usage (bad option, an unreadable or invalid results
+  directory).
+"""
+
+
 def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
-    p = sub.add_parser("report", help="render results.json to HTML, JUnit XML and Markdown",
+    p = sub.add_parser("report", help="render a results directory as HTML, JUnit XML and Markdown",
                        description="Rebuild the compliance reports of a results directory (nothing is "
                                    "re-run): DIR/report.html, DIR/junit.xml and DIR/report.md, each "
                                    "written atomically.",
-                       formatter_class=argparse.RawDescriptionHelpFormatter,
-                       epilog="exit status: 0 written; 1 with --fail-on-regression, when a clause "
-                              "regressed or lost coverage; 2 a report could not be written; 64 usage "
-                              "(bad option, an unreadable or invalid results directory).")
+                       formatter_class=argparse.RawDescriptionHelpFormatter, epilog=EPILOG)
     p.add_argument("directory", metavar="DIR", type=Path, help="results directory holding results.json and wire.log")
     p.add_argument("--format", dest="formats", type=_formats, default=list(render.FORMATS),
                    metavar="LIST", help="comma-separated formats to write: html,junit,md (default: all)")

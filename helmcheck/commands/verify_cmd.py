@@ -21,7 +21,7 @@ from .. import exitcodes
 from ..failures import UsageError
 
 EPILOG = """\
-what is checked:
+what is checked (in any results directory: certify vehicle, certify backseat, check-log, monitor):
   results.json    a valid results document whose digests match wire.log and profile.toml
   profile.toml    the profile the run recorded, key by key
   clause verdicts re-judged from wire.log under profile.toml (same observer as check-log);
@@ -31,17 +31,20 @@ what is checked:
 
 examples:
   helmcheck verify reports/vehicle
-  helmcheck verify reports/vehicle --public-key lab.pub
+  helmcheck keygen --out lab                        # once: lab.key signs, lab.pub checks
+  helmcheck certify vehicle --port /dev/pts/N --time-scale 20 --profile helmcheck/profiles/emulator.toml \\
+      --sign-key lab.key --report-dir reports/signed
+  helmcheck verify reports/signed --public-key lab.pub   # the run must be signed by this key
 
-exit status: 0 verified, 1 mismatch (each difference named), 64 usage.
+exit status: 0 verified, 1 mismatch (one line per difference, each naming the clause or file),
+  64 usage (no such results directory, an unreadable public key).
 """
 
 
 def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
-    p = sub.add_parser("verify", help="check a results directory against its wire log, profile and signature",
+    p = sub.add_parser("verify", help="re-judge a results directory from its evidence; check its signature",
                        description="Re-judge a results directory's wire log under its recorded profile and "
-                                   "check that results.json follows from it; check the signature if signed. "
-                                   "Exit 0 verified, 1 mismatch, 64 usage.",
+                                   "check that results.json follows from it; check the signature if signed.",
                        epilog=EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("directory", metavar="DIR", help="results directory (results.json, wire.log, profile.toml)")
     p.add_argument("--public-key", metavar="PUB",
@@ -67,11 +70,19 @@ def verify_run(directory: Path | str, public_key=None, *, public_key_name: str =
         profile = check_profile(out, directory, results)
         job = rejudging(out, directory, results, profile) if profile is not None else None
         if job is not None:
+            catalog = None
+            if job.missions:
+                from ..emulator.missionfile import DirectoryCatalog
+                catalog = DirectoryCatalog(list(job.missions))
             try:
-                outcome = check_log(job.wire_path, profile=profile, role=job.role, time_scale=job.time_scale)
+                outcome = check_log(job.wire_path, profile=profile, role=job.role, time_scale=job.time_scale,
+                                    swap=job.swap, catalog=catalog)
             except (LogFormatError, OSError, ValueError) as e:
                 out.add(job.wire_name, f"cannot be re-judged: {e}")
             else:
+                if job.sha256 is not None and outcome.sha256 != job.sha256:
+                    out.add(job.wire_name, f"SHA-256 {outcome.sha256} differs from the {job.sha256} recorded in "
+                                           f"results.json (log.sha256)")
                 compare_rejudged(out, results, outcome.clauses, outcome.facts, job.role)
     check_signature(out, directory, results, public_key, public_key_name)
     return out

@@ -12,7 +12,8 @@ one record per line (the full description is in ``docs/contracts.md`` and the RE
 
 This module owns all of it; nothing else in helmcheck writes or parses a record:
 
-* **the format** — the header (:data:`HEADER`, then ``#`` comment lines), the record syntax
+* **the format** — the header (:data:`HEADER`, then ``#`` comment lines, among them the one
+  naming the run that wrote the log: :func:`run_header`, read by :func:`read_run_header`), the record syntax
   (:data:`RECORD_HEAD`, :func:`format_record`, :func:`column`) and the escaping
   (:func:`escape`, :func:`unescape`: bytes outside 0x20–0x7E, and ``\\``, are escaped);
 * **the directions** — :data:`TO_VEHICLE` (``>``, backseat→vehicle) and :data:`FROM_VEHICLE`
@@ -50,7 +51,7 @@ __all__ = ["HEADER", "TAG", "VERSION", "HEADER_LINES", "TO_VEHICLE", "FROM_VEHIC
            "FROM_VEHICLE_RUN", "NOTE", "UNREADABLE", "DIRECTIONS", "SWAPPED", "BITS_PER_BYTE", "transmit_time",
            "WireEvent", "Unreadable", "Record", "WireLogError", "escape", "unescape", "is_line", "column",
            "format_record", "RECORD_HEAD", "read_wire_log", "read_records", "parse_record", "WireLogWriter",
-           "CONTINUED", "continued_in", "segment_name"]
+           "CONTINUED", "continued_in", "segment_name", "RUNS", "MISSIONS_SEP", "RunHeader", "run_header", "read_run_header"]
 
 # ---------------------------------------------------------------------- the format
 TAG = "# helmcheck wire-log"  #: the first line's start, whatever the version
@@ -59,6 +60,45 @@ HEADER = f"{TAG} {VERSION}"  #: the first line of every wire log this version wr
 #: Comment lines among the first this many lines are the log's header (they may carry
 #: ``time_scale K`` and ``baud N``); later comments are skipped.
 HEADER_LINES = 16
+
+#: The runs that name themselves in a log's header (:func:`run_header`).
+RUNS = ("certify vehicle", "certify backseat", "monitor", "emulate", "diff", "replay")
+_RUN_HEADER = re.compile(r"^helmcheck (\S+) (" + "|".join(map(re.escape, RUNS)) + r")(?=[;:\s]|$)")
+_PROFILE_PART = re.compile(r";\s*profile ([^;]+)")
+_MISSIONS_PART = re.compile(r";\s*missions ([^;]+)")
+#: Separates the mission directories of a run header (as ``PATH`` does).
+MISSIONS_SEP = ":"
+
+
+class RunHeader(NamedTuple):
+    """What a run's header line says (:func:`read_run_header`)."""
+
+    version: str  #: the helmcheck that wrote the log
+    run: str  #: one of :data:`RUNS`
+    profile: Optional[str]  #: the profile's name as the run gave it (a path, or ``rh5``)
+    missions: tuple[str, ...]  #: the mission directories the run used
+
+
+def run_header(version: str, run: str, profile: str, missions: Iterable[str] = (), more: str = "") -> str:
+    """The header comment naming the run that writes a log (without ``# ``):
+    ``helmcheck VERSION RUN[MORE]; profile NAME[; missions DIR:DIR]`` — ``MORE`` is free text
+    without ``;`` (``monitor`` names its mode and ports there)."""
+    text = f"helmcheck {version} {run}{more}; profile {profile}"
+    missions = [str(m) for m in missions]
+    return text + (f"; missions {MISSIONS_SEP.join(missions)}" if missions else "")
+
+
+def read_run_header(text: str) -> Optional[RunHeader]:
+    """A header comment (without ``#``) read as :func:`run_header` writes it; ``None`` for any
+    other comment."""
+    m = _RUN_HEADER.match(text.strip())
+    if m is None:
+        return None
+    p = _PROFILE_PART.search(text, m.end())
+    d = _MISSIONS_PART.search(text, m.end())
+    return RunHeader(m.group(1), m.group(2), (p.group(1).strip() or None) if p else None,
+                     tuple(x for x in d.group(1).strip().split(MISSIONS_SEP) if x) if d else ())
+
 
 # ---------------------------------------------------------------------- the directions
 TO_VEHICLE = ">"  #: bytes from the backseat to the vehicle (a CR LF line when alone)

@@ -29,6 +29,7 @@ from typing import Any, Callable, Optional
 
 from .. import __version__
 from ..failures import describe_interrupt
+from ..grammar.wirelog import run_header
 from ..line.link import Link
 from ..line.transport import open_link, parse_port_spec
 from ..profile import Profile
@@ -112,7 +113,8 @@ def monitor(opts: Options) -> Result:
     started = datetime.now(timezone.utc)
     meta = [f"started {started.strftime('%Y-%m-%dT%H:%M:%S.%fZ')}  port {b_link.name} {v_link.name}  "
             f"baud {opts.baud}  time_scale {opts.time_scale:g}",
-            f"helmcheck {__version__} monitor --{opts.mode}: backseat {opts.backseat}, vehicle {opts.vehicle}"]
+            run_header(__version__, "monitor", opts.profile.name,
+                       more=f" --{opts.mode}: backseat {opts.backseat}, vehicle {opts.vehicle}".replace(";", ","))]
     interim = _Interim(d, opts)
     slog = SessionLog(d, meta, rotate_bytes=opts.rotate_bytes, on_rotate=interim.rotated)
     live = LiveJudge(d / slog.name, opts.profile.replace(time_scale=opts.time_scale, baud=opts.baud), role="both",

@@ -5,7 +5,10 @@
 * :class:`LiveScreen` — on a terminal: the session clock, bytes and records each way, the
   vehicle's mode as the judge believes it, the clauses seen so far by verdict, the newest
   finding and the judge's backlog, redrawn a few times a second (rich). It only reads snapshots:
-  neither the relay nor the judge ever waits for it.
+  neither the relay nor the judge ever waits for it;
+* :class:`StatusLines` — off a terminal (or ``--no-tui``): the same snapshot as one line on
+  standard error every :data:`STATUS_EVERY_S` seconds, so a long session piped to a file or
+  run in CI shows it is alive between findings.
 """
 
 from __future__ import annotations
@@ -15,7 +18,10 @@ from typing import IO, Optional
 
 from .live import Finding
 
-__all__ = ["finding_line", "LiveScreen"]
+__all__ = ["finding_line", "LiveScreen", "StatusLines", "STATUS_EVERY_S"]
+
+#: Seconds between two status lines off a terminal.
+STATUS_EVERY_S = 10.0
 
 
 def finding_line(f: Finding) -> str:
@@ -62,3 +68,32 @@ class LiveScreen:
 
     def close(self) -> None:
         self.live.stop()
+
+
+class StatusLines:
+    """A status line on *stream* at most every :data:`STATUS_EVERY_S` seconds (module docstring)."""
+
+    def __init__(self, title: str, stream: Optional[IO[str]] = None, every: float = STATUS_EVERY_S):
+        self.title = title
+        self.stream = stream if stream is not None else sys.stderr
+        self.every = every
+        self.findings = 0
+        self._next = every
+
+    def finding(self, f: Finding) -> None:
+        self.findings += 1
+
+    def refresh(self, state: dict, stats: dict, elapsed: float) -> None:
+        if elapsed < self._next:
+            return
+        self._next = elapsed + self.every
+        b = stats.get("bytes", {})
+        try:
+            print(f"{self.title}: {elapsed:.0f} s, {b.get('>', 0)} bytes to the vehicle, {b.get('<', 0)} from it, "
+                  f"{state.get('records', 0)} records judged, vehicle mode {state.get('mode') or 'not seen yet'}, "
+                  f"{self.findings} finding(s) so far", file=self.stream, flush=True)
+        except (OSError, ValueError):
+            pass
+
+    def close(self) -> None:
+        pass

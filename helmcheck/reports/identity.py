@@ -17,7 +17,10 @@
   profile the judges used); ``profile_file`` the path and SHA-256 of the file given with
   ``--profile``, if any, so it can be matched with the owner's copy.
 * ``revision`` is ``git describe --always --dirty --tags`` of the checkout the running helmcheck
-  package lives in, or ``unknown`` when it is not in a git checkout (an installed wheel).
+  package lives in, or ``unknown`` when it is not in a git checkout (an installed wheel). It is
+  read once per process (:func:`source_revision`), by the commands that record it before they
+  write anything (:data:`helmcheck.cli.RECORDS_REVISION`, ``make demo``): a run whose results go
+  into a tracked directory (``make example-report``) is not ``-dirty`` by its own files.
 
 Empty declared values are ``null``. :func:`identity_rows` is the one list of labelled rows every
 rendering shows, so the HTML, Markdown and JUnit reports name the implementation alike.
@@ -33,7 +36,7 @@ from typing import Any, Mapping, Optional
 
 import helmcheck
 
-__all__ = ["Declared", "parse_implementation", "source_revision", "build_identity", "identity_rows"]
+__all__ = ["Declared", "parse_implementation", "source_revision", "build_identity", "identity_rows", "still_going"]
 
 
 @dataclass(frozen=True)
@@ -110,13 +113,28 @@ def build_identity(results: Mapping[str, Any], profile, *, declared: Declared, p
 _NOT_GIVEN = "not given"
 
 
+def still_going(results: Mapping[str, Any]) -> bool:
+    """A document written while its run was still going (``finished`` null, or a monitor's check
+    of the session so far): the run's end records the certificate."""
+    monitor = results.get("monitor")
+    return results.get("finished") is None or (isinstance(monitor, Mapping) and bool(monitor.get("in_progress")))
+
+
+def _unrecorded(results: Mapping[str, Any]) -> str:
+    """Why a document has no identity, as far as the document itself tells."""
+    if still_going(results):
+        return "not recorded yet: results.json was written while the run was still going (its end records it)"
+    return "not recorded in results.json"
+
+
 def identity_rows(results: Mapping[str, Any], wire_name: Optional[str] = None) -> list[tuple[str, str, bool]]:
     """``(label, value, missing)`` rows naming what was tested; *missing* marks a value that a
     certificate should carry but the run did not record.
 
-    Works for documents without ``identity`` (older runs): the implementation is then taken from
-    ``implementation`` and *wire_name* (the ``$OSI`` name in the wire log), and the rest is shown
-    as not recorded.
+    Works for documents without ``identity`` (a run still going, or a document written by an
+    earlier helmcheck): the implementation is then taken from ``implementation`` and *wire_name*
+    (the ``$OSI`` name in the wire log), and the rest is shown as not recorded, saying why when
+    the document tells (:func:`still_going`).
     """
     ident = results.get("identity") if isinstance(results.get("identity"), Mapping) else None
     role = results.get("role")
@@ -136,7 +154,7 @@ def identity_rows(results: Mapping[str, Any], wire_name: Optional[str] = None) -
         row("port", legacy.get("port"), required=False)
         tool = results.get("tool") or {}
         row("tester", f"{tool.get('name', 'helmcheck')} {tool.get('version', '?')}")
-        rows.append(("identity", "not recorded (a run made before identities were recorded)", True))
+        rows.append(("identity", _unrecorded(results), True))
         return rows
     impl = ident.get("implementation") or {}
     if impl.get("role") == "backseat":

@@ -10,8 +10,11 @@
 3. ``profile.toml`` must load (:func:`helmcheck.profile.load_profile`) and be the profile
    ``results.json`` records (``profile``, key by key) (:func:`check_profile`);
 4. ``settings.time_scale`` must be the ``time_scale`` of ``profile.toml``; :func:`rejudging`
-   says which wire log to re-judge, as which role (``vehicle`` or ``backseat`` as recorded) and
-   at which time scale (the profile's);
+   says which wire log to re-judge, as which role (``vehicle`` or ``backseat`` as recorded; a
+   log check's ``log.role``) and at which time scale (the profile's; a log check's own), and for
+   a log check with its ``--swap-directions`` and mission directories (``settings.missions``;
+   one that is not here is a note) — and a log too large to have been copied is re-judged where
+   the check referenced it, if it still has the SHA-256 recorded;
 5. the wire log is **re-judged** under that profile by the offline observer (the command calls
    :func:`helmcheck.checklog.check_log`: a driver, which this package does not
    import), which also reads the run facts of its notes (:mod:`helmcheck.judge.runfacts`: the
@@ -137,8 +140,10 @@ def check_digests(out: Verification, directory: Path, results: Mapping[str, Any]
     recorded = results.get("digests")
     wire_name, _ = evidence_files(results)
     if not isinstance(recorded, Mapping):
-        out.add(RESULTS_NAME, "records no digests of the wire log and profile (a run made before they were "
-                              "recorded cannot be verified)")
+        from .identity import still_going
+        why = (": it was written while the run was still going (the run's end records them)"
+               if still_going(results) else "")
+        out.add(RESULTS_NAME, f"records no digests of the wire log and profile, so they cannot be checked{why}")
         return
     for name in (wire_name, *recorded_segments(results), PROFILE_NAME):
         if name not in recorded:
@@ -195,6 +200,9 @@ class Rejudging:
     wire_path: Path
     role: str  #: ``vehicle``, ``backseat`` or ``both`` (a log check of both roles)
     time_scale: float
+    swap: bool = False  #: a log check's ``--swap-directions``
+    missions: tuple[Path, ...] = ()  #: a log check's mission directories (``settings.missions``)
+    sha256: Optional[str] = None  #: the SHA-256 the log must have (a log referenced, not copied)
 
 
 def rejudging(out: Verification, directory: Path, results: Mapping[str, Any], profile) -> Optional[Rejudging]:
@@ -211,10 +219,27 @@ def rejudging(out: Verification, directory: Path, results: Mapping[str, Any], pr
         time_scale = float(recorded_k)  # a log check's time scale is its own (no profile.toml holds it)
     wire_name, _ = evidence_files(results)
     wire_path = directory / wire_name
-    if not wire_path.is_file():
+    log = results.get("log") if role == "log" and isinstance(results.get("log"), Mapping) else {}
+    sha = None
+    if not wire_path.is_file() and log.get("copy") is None and log.get("source"):
+        # a log check of a log too large to copy: the log is referenced by path and SHA-256
+        wire_name, wire_path, sha = str(log["source"]), Path(str(log["source"])), log.get("sha256")
+        if not wire_path.is_file():
+            out.add(wire_name, "missing: the checked log was referenced by path (too large to copy into the "
+                               "results directory) and is not there")
+            return None
+    elif not wire_path.is_file():
         out.add(wire_name, "missing: there is no evidence to re-judge")
         return None
-    return Rejudging(wire_name, wire_path, judge_role, time_scale)
+    settings = results["settings"]
+    missions: list[Path] = []
+    for d in (settings.get("missions") or ()) if role == "log" else ():
+        if Path(str(d)).is_dir():
+            missions.append(Path(str(d)))
+        else:
+            out.notes.append(f"the mission directory {d} the check used is not here: re-judged without it")
+    return Rejudging(wire_name, wire_path, judge_role, time_scale, swap=bool(settings.get("swap_directions")),
+                     missions=tuple(missions), sha256=sha)
 
 
 def compare_rejudged(out: Verification, results: Mapping[str, Any], clauses: list, facts: RunFacts,
@@ -352,15 +377,17 @@ def check_signature(out: Verification, directory: Path, results: Optional[Mappin
     if results is not None and not declared:
         out.add(_SIGNATURE_NAME, "present, but results.json does not say the run was signed")
     from .signing import check
-    key = embedded
     if public_key is not None:
         trusted = key_id(public_key)
-        if trusted != signer:
-            out.add("signature", f"made with key {signer}, not with {public_key_name} (key {trusted})")
-        key = public_key
         out.trusted_key = trusted == signer
-    if not check(key, doc["manifest"], doc["signature"]):
-        out.add("signature", "does not verify: the signed manifest was changed or the signature is not this key's")
+        if not out.trusted_key:
+            # another key: say so, and check the signature with the key it names (whether the
+            # files were changed is a question of its own, answered below)
+            out.add("signature", f"made with key {signer}, not with the given key {public_key_name} (key {trusted}): "
+                                 f"the run was signed by another key")
+    if not check(embedded, doc["manifest"], doc["signature"]):
+        out.add("signature", f"does not verify with the key it names ({signer}): the signed manifest or the "
+                             f"signature was changed after signing")
         out.trusted_key = False
         return
     files = doc["manifest"].get("files")

@@ -21,7 +21,9 @@ from datetime import datetime, timezone
 from pathlib import Path
 from typing import IO, Any, Callable, Optional
 
+from ... import __version__
 from ...failures import OutputLost, describe_interrupt
+from ...grammar.wirelog import run_header
 from ...judge.timing import JITTER_S
 from ...line.transport import BAUD_RATES, Link, open_link, parse_port_spec
 from ...profile import Profile
@@ -53,7 +55,7 @@ class Options:
     exec_grace_s: float = 5.0  #: SIGTERM → SIGKILL when stopping it
     certificate: Optional[RunDeclaration] = None  #: identity and signing key
     command: str = ""  #: the command line recorded in ``results.json``
-    progress: bool = True  #: a progress bar on standard error (on a terminal)
+    progress: bool = True  #: progress on standard error (a bar on a terminal, else plain lines)
     render: bool = True  #: write report.html, junit.xml, report.md
     on_port: Optional[Callable[[str], None]] = None  #: called with the port's name once it is open
     # Command-line hooks (helmcheck.commands.certify_backseat_cmd): the link the command opened
@@ -152,7 +154,8 @@ def _run(opts: Options, profile: Profile, plan, report_dir: Path, link: Link, lo
     progress = Progress(enabled=opts.progress)
     try:
         meta = [f"started {started_dt.strftime('%Y-%m-%dT%H:%M:%S.%fZ')}  port {link.name}  "
-                f"baud {profile.baud}  time_scale {profile.time_scale:g}"]
+                f"baud {profile.baud}  time_scale {profile.time_scale:g}",
+                run_header(__version__, "certify backseat", profile.name)]
         if opts.progress:
             print(f"helmcheck certify backseat: {link.description}, profile {profile.name}, time scale "
                   f"{profile.time_scale:g}, baud {profile.baud}, scenarios {', '.join(s.name for s in plan.slots)} "

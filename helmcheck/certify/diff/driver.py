@@ -130,8 +130,8 @@ def diff(opts: DiffOptions) -> DiffOutcome:
                 _say(opts, f"{s.name}: {s.spec.label} (time scale {s.k:g}, profile {s.spec.profile.name})")
             pair.both(lambda s: s.open())
             state = DiffState(pair, opts.budget_s, opts.examples,
-                              lambda n, total, left: _say(opts, f"sequence {n}{f'/{total}' if n <= total else ''}, "
-                                                               f"{left:.0f} s of budget left"))
+                              lambda n, total, left: _say(opts, f"sequence {n}: {opts.budget_s - left:.0f} of "
+                                                               f"{opts.budget_s:g} s of the budget used"))
             _search(opts, pair, state)
             if state.error is not None:
                 error = state.error

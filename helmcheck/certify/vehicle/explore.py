@@ -168,6 +168,13 @@ class _State:
         if self.batch_end >= self.end:
             self.batch_end = min(self.end, time.monotonic() + self.budget.wall_s * SHRINK_SHARE)
 
+    def show_progress(self) -> None:
+        """The share of the budget used and the sequences run so far, to the progress display
+        (at each sequence's start and after each step)."""
+        if self.progress is not None:
+            self.progress.explore(self.executions, time.monotonic() - self.t0, self.budget.wall_s,
+                                  self.vehicle_spent, self.budget.vehicle_s)
+
     def tester_error(self, e: Exception) -> None:
         if self.error is None:
             self.error = e

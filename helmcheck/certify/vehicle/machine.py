@@ -13,7 +13,6 @@ through :func:`machine`'s ``send`` is counted by the model coverage (:mod:`.mode
 
 from __future__ import annotations
 
-import time
 from typing import Optional
 
 from hypothesis import strategies as st
@@ -119,8 +118,7 @@ def machine(state, p, tos, deep: bool = True):
                 state.executions += 1
                 if state.progress is not None:
                     try:
-                        state.progress.explore(state.executions, state.examples,
-                                               max(0.0, state.end - time.monotonic()))
+                        state.show_progress()
                     except Exception as e:  # noqa: BLE001 - a tester error: kept, raised by explore()
                         state.tester_error(e)
                         self.active = False
@@ -133,6 +131,7 @@ def machine(state, p, tos, deep: bool = True):
             try:
                 fn()
                 session.check()
+                state.show_progress()
             except CaseStop as f:
                 if f.outcome == "fail":
                     self._failed(f)

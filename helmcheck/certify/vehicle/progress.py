@@ -1,25 +1,60 @@
-"""The progress display: a rich progress bar on a terminal, plain lines otherwise (stderr)."""
+"""The progress display: a rich progress bar on a terminal, plain lines otherwise (stderr).
+
+On a terminal the bar keeps its width (:data:`BAR_WIDTH`) however narrow the terminal: the
+text after it (the last case and its verdict, the exploration's budget) is cut with an ellipsis
+instead (at 80 columns the bar is 20 characters). Off a terminal (piped, in CI) each case is a
+line, and the exploration a line at its start and then at most one every :data:`PLAIN_EVERY_S`.
+
+The exploration is shown by what its budget allows, not by the examples asked for (the wall
+budget usually ends it long before): the share of the budget used — the wall clock's or the
+vehicle clock's, whichever is further on — and the sequences run so far; on the bar, the
+exploration's step fills as its budget is used.
+"""
 
 from __future__ import annotations
 
 import sys
-from typing import IO, Optional
+import time
+from typing import IO, Callable, Optional
 
-__all__ = ["Progress"]
+__all__ = ["Progress", "BAR_WIDTH", "PLAIN_EVERY_S", "budget_text"]
+
+#: Characters of the bar on a terminal, whatever the terminal's width.
+BAR_WIDTH = 20
+#: Seconds between two plain exploration lines.
+PLAIN_EVERY_S = 10.0
+
+
+def budget_text(ran: int, wall_s: float, wall_budget_s: float, vehicle_s: float, vehicle_budget_s: float,
+                short: bool = False) -> tuple[float, str]:
+    """The share of an exploration's budget used (0..1, whichever clock is further on) and its
+    text: ``45 % of the budget (14 of 30 s wall), 14 sequences``."""
+    wall = wall_s / wall_budget_s if wall_budget_s > 0 else 0.0
+    veh = vehicle_s / vehicle_budget_s if vehicle_budget_s > 0 else 0.0
+    used = min(1.0, max(wall, veh))
+    seqs = f"{ran} sequence{'s' if ran != 1 else ''}"
+    if short:
+        return used, f"exploring: {used * 100:.0f} % of budget, {seqs}"
+    clock = (f"{wall_s:.0f} of {wall_budget_s:g} s wall" if wall >= veh
+             else f"{vehicle_s:.0f} of {vehicle_budget_s:g} s vehicle time")
+    return used, f"exploration: {used * 100:.0f} % of the budget ({clock}), {seqs} so far"
 
 
 class Progress:
-    """``start(total)``, ``step(label, verdict)``, ``explore(ran, total, left_s)``, ``note(text)``,
-    ``alert(text)``, ``stop()``. The verdict shown for a case is its subject clause's verdict as the ledger has it —
-    the word the report will use."""
+    """``start(total)``, ``step(label, verdict)``, ``explore(ran, wall_s, wall_budget_s, vehicle_s,
+    vehicle_budget_s)``, ``note(text)``, ``alert(text)``, ``stop()``. The verdict shown for a case is
+    its subject clause's verdict as the ledger has it — the word the report will use."""
 
-    def __init__(self, stream: Optional[IO[str]] = None, enabled: bool = True):
+    def __init__(self, stream: Optional[IO[str]] = None, enabled: bool = True,
+                 clock: Callable[[], float] = time.monotonic):
         self.stream = stream or sys.stderr
+        self.clock = clock  #: when plain exploration lines are due
         self.enabled = enabled
         self.rich = None
         self.task = None
         self.n = 0
         self.total = 0
+        self._plain_at: Optional[float] = None  #: when the last plain exploration line was printed
 
     def start(self, total: int, title: str = "certify vehicle") -> None:
         self.total = total
@@ -29,10 +64,16 @@ class Progress:
             try:
                 from rich.console import Console
                 from rich.progress import BarColumn, MofNCompleteColumn, Progress as RP, TextColumn, TimeElapsedColumn
+                from rich.table import Column
 
-                self.rich = RP(TextColumn("[bold]{task.description}"), BarColumn(), MofNCompleteColumn(),
-                               TimeElapsedColumn(), TextColumn("{task.fields[last]}"),
-                               console=Console(file=self.stream), transient=True)
+                fixed = Column(no_wrap=True)
+                self.rich = RP(TextColumn("[bold]{task.description}", table_column=fixed),
+                               BarColumn(bar_width=BAR_WIDTH, table_column=Column(min_width=BAR_WIDTH, no_wrap=True)),
+                               MofNCompleteColumn(table_column=Column(no_wrap=True)),
+                               TimeElapsedColumn(table_column=Column(no_wrap=True)),
+                               TextColumn("{task.fields[last]}",
+                                          table_column=Column(ratio=1, no_wrap=True, overflow="ellipsis")),
+                               console=Console(file=self.stream), transient=True, expand=True)
                 self.rich.start()
                 self.task = self.rich.add_task(title, total=total, last="")
                 return
@@ -45,18 +86,23 @@ class Progress:
         if not self.enabled:
             return
         if self.rich is not None:
-            self.rich.update(self.task, advance=1, last=f"{label} {verdict}")
+            self.rich.update(self.task, completed=self.n, last=f"{label} {verdict}")
             return
         print(f"[{self.n}/{self.total}] {label} {verdict}", file=self.stream, flush=True)
 
-    def explore(self, ran: int, total: int, left_s: float) -> None:
-        """Exploration progress: sequences run of the examples asked for, and budget left."""
+    def explore(self, ran: int, wall_s: float, wall_budget_s: float, vehicle_s: float = 0.0,
+                vehicle_budget_s: float = 0.0) -> None:
+        """Exploration progress: the share of its budget used and the sequences run (module docstring)."""
         if not self.enabled:
             return
-        text = f"exploration: sequence {ran}/{total}, {left_s:.0f} s of budget left"
+        short = self.rich is not None
+        used, text = budget_text(ran, wall_s, wall_budget_s, vehicle_s, vehicle_budget_s, short=short)
         if self.rich is not None:
-            self.rich.update(self.task, last=text)
-        else:
+            self.rich.update(self.task, completed=self.n + used, last=text)
+            return
+        now = self.clock()
+        if self._plain_at is None or now - self._plain_at >= PLAIN_EVERY_S:
+            self._plain_at = now
             print(text, file=self.stream, flush=True)
 
     def note(self, text: str) -> None:

@@ -42,6 +42,7 @@ from ... import __version__
 from ...clauses import vehicle_clauses
 from ...failures import describe_interrupt
 from ...grammar import prepare
+from ...grammar.wirelog import run_header
 from ...judge import Ledger
 from ...judge.runfacts import RunFacts, partial_note, selection_note
 from ...judge.vehicle import VehicleObserver
@@ -174,7 +175,7 @@ class Run(ExecChild):
             raise
         meta = [f"started {time.strftime('%Y-%m-%dT%H:%M:%SZ', time.gmtime())}  port "
                 f"{getattr(raw, 'name', None) or self.o.port}  baud {self.p.baud}  time_scale {self.k:g}",
-                f"helmcheck {__version__} {self.o.title}; profile {self.p.name}"]
+                run_header(__version__, self.o.title, self.p.name)]
         if self.resumed is not None:  # the record goes on after a gap of a second
             lines, last_t = self.resumed.lines, self.resumed.last_t
             self.recorder = Recorder(wire, observers=[self.observer, self.facts], after=(lines, last_t))
