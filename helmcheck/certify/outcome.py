@@ -21,3 +21,6 @@ class Outcome:
     exit_code: int
     report_dir: Path
     results: dict = field(default_factory=dict)
+    #: ``--precision nominal`` stopped a vehicle run after its link check: the time scale at which
+    #: this line judges timing to nominal precision (a vehicle helmcheck starts is run again at it)
+    nominal_time_scale: float | None = None

@@ -222,7 +222,7 @@ class LineBudget:
         """One line for people: the line and what it costs in vehicle time."""
         lat = (f"reply p50 {self.latency_p50:.3f} s, p99 {self.latency_p99:.3f} s ({self.samples} probes)"
                if self.latency_p99 is not None else f"reply latency assumed {self.latency_s:.3f} s")
-        return (f"line: {self.baud} baud, {lat}, host jitter {self.jitter_s:.3f} s → observer uncertainty "
+        return (f"{self.baud} baud, {lat}, host jitter {self.jitter_s:.3f} s → observer uncertainty "
                 f"{self.observe_v:.1f} + {self.poll_v:.1f} vehicle s between reports at ×{self.k:g}")
 
     def note(self) -> str:

@@ -133,15 +133,15 @@ class Durations:
                     "and have both deadlines told apart", "opk": "$OPK park"}.get(arg, arg)
             hi = 1440 * 60 if arg == "opk" else self.hi
             return (f"no {what} the profile allows (up to {hi} s) can be timed on this line at time scale "
-                    f"{b.k:g} (RH-TIM-1: {b.describe()}); run at {self.advice(need)}")
+                    f"{b.k:g} (RH-TIM-1, the line: {b.describe()}); run at {self.advice(need)}")
         if kind == "ascent" and not self.ascent_ok:
             return (f"after the lockout the vehicle may reach the surface from {0.8 * self.dive_depth:g} "
                     f"{self.depth_unit} before a command can be answered on this line at time scale {b.k:g} "
-                    f"(RH-SAF-3: assuming an ascent of {ASCENT_MPS:g} m/s; {b.describe()}); run at "
+                    f"(RH-SAF-3: assuming an ascent of {ASCENT_MPS:g} m/s; the line: {b.describe()}); run at "
                     f"{self.advice(need)}")
         if kind == "lockout" and not self.lockout_ok:
             return (f"the {self.lockout_s:g} s lockout ends before the commands sent into it can be "
-                    f"answered on this line at time scale {b.k:g} (RH-SAF-1: {b.describe()}); run at "
+                    f"answered on this line at time scale {b.k:g} (RH-SAF-1, the line: {b.describe()}); run at "
                     f"{self.advice(need)}")
         return None
 

@@ -50,7 +50,7 @@ from .flow import LinkLost
 from .interpreter import OPERATOR_WAIT_S, run_case
 from .link import TesterLink
 from .restore import Custodian, written_settings
-from ...judge.linebudget import ASSUMED_LATENCY_S
+from ...judge.linebudget import ASSUMED_LATENCY_S, NOMINAL_WIDENING_S, from_settings
 from .session import Session, frame
 from .virtual import VirtualLine
 
@@ -341,6 +341,7 @@ def render_text(plan: Plan) -> str:
         out.append(f"Line: {plan.line['describe']}.")
         out.append(f"  Durations chosen on it: timeouts {d['to']} s (restarted: {d['to_restart']} s, long: "
                    f"{d['to_long']} s), $OPK {d['opk_min']} min, park on a queued waypoint {d['qpark']} s.")
+        out.append(f"  {precision_text(plan.line)}")
     for reason, ids in not_run.items():
         out.append(f"Not run (the profile or the line does not let them): {', '.join(ids)}: {reason}")
     for x in plan.lines:
@@ -349,6 +350,23 @@ def render_text(plan: Plan) -> str:
     out.append("Assumptions:")
     out += [f"  - {a}" for a in plan.assumptions]
     return "\n".join(out)
+
+
+def precision_text(line: dict) -> str:
+    """What the line budget (``LineBudget.as_dict``) lets the observer judge timing to, and the time
+    scale for nominal precision (RH-TIM-1's tolerance + :data:`NOMINAL_WIDENING_S`)."""
+    b = from_settings(line)
+    if b is None:
+        return ""
+    k = b.k
+    nominal = b.nominal_scale()
+    text = (f"Timing precision at ×{k:g}: RH-TIM-1's tolerance + {b.widening_v():.2f} s of vehicle time "
+            f"(the observer's uncertainty and the spacing of reports)")
+    if b.widening_v() <= NOMINAL_WIDENING_S:
+        return text + "; nominal (≤ +0.3 s)."
+    if nominal is not None:
+        return text + f"; nominal (≤ +{NOMINAL_WIDENING_S:g} s) at --time-scale {nominal:g} or less."
+    return text + f"; nominal (≤ +{NOMINAL_WIDENING_S:g} s) at no time scale on this line."
 
 
 def as_json(plan: Plan) -> dict:

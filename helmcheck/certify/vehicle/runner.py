@@ -45,6 +45,7 @@ from ...grammar import prepare
 from ...grammar.wirelog import run_header
 from ...judge import Ledger
 from ...judge.runfacts import RunFacts, partial_note, selection_note
+from ...judge.linebudget import NOMINAL_WIDENING_S
 from ...judge.vehicle import VehicleObserver
 from ...judge.wire import tester_note
 from ...line.recorder import Recorder
@@ -67,7 +68,7 @@ from .resume import Resumed, resume_into
 from .safety import BenchSafetyRefused
 from .session import Session, frame
 
-__all__ = ["Options", "certify", "Outcome", "Run"]
+__all__ = ["Options", "certify", "Outcome", "Run", "CoarseTiming"]
 
 
 @dataclass
@@ -105,6 +106,10 @@ class Options:
     resume: bool = False
     #: what the wire log's header names the run (``helmcheck diff`` drives a Run for its machinery)
     title: str = "certify vehicle"
+    #: ``"nominal"``: stop after the link check when this line at this time scale would judge
+    #: timing coarser than nominal (:data:`~helmcheck.judge.linebudget.NOMINAL_WIDENING_S`), naming
+    #: the time scale that would not (:class:`CoarseTiming`); ``"any"``: judge with what the line gives
+    precision: str = "any"
 
 
 def selected_ids(select: Optional[list]) -> list[str]:
@@ -112,6 +117,19 @@ def selected_ids(select: Optional[list]) -> list[str]:
     if not select:
         return ids
     return [cid for cid in ids if any(fnmatchcase(cid, p) for p in select)]
+
+
+class CoarseTiming(Exception):
+    """``--precision nominal``: this line at this time scale judges timing coarser than nominal."""
+
+    def __init__(self, budget):
+        self.budget = budget
+        self.scale = budget.nominal_scale()
+        where = (f"--time-scale {self.scale:g} would" if self.scale is not None
+                 else "no time scale on this line would (a faster baud, or a vehicle that answers sooner)")
+        super().__init__(f"--precision nominal: at ×{budget.k:g} on this line timing is judged to RH-TIM-1's "
+                         f"tolerance + {budget.widening_v():.2f} s of vehicle time (more than "
+                         f"+{NOMINAL_WIDENING_S:g} s; the line: {budget.describe()}); {where}")
 
 
 class Run(ExecChild):
@@ -132,6 +150,7 @@ class Run(ExecChild):
         self.progress = Progress(enabled=opts.progress)
         self.aborted: Optional[str] = None
         self.stopped: Optional[str] = None  #: a start-up check stopped the run: leads the verdict reason
+        self.coarse: Optional[CoarseTiming] = None  #: ``--precision nominal`` stopped it
         self.partial = False
         self.t_start = time.monotonic()
         self.results = resultsfile.new_results(opts)
@@ -329,6 +348,15 @@ class Run(ExecChild):
         self.observer.close()
 
 
+def _precision(run: "Run", precision: str) -> None:
+    """``--precision nominal`` (:class:`CoarseTiming`), after the link check measured the line."""
+    if precision != "nominal" or run.session is None:
+        return
+    budget = run.session.meter.budget()
+    if budget.widening_v() > NOMINAL_WIDENING_S:
+        raise CoarseTiming(budget)
+
+
 def certify(opts: Options) -> Outcome:
     """Run a whole certification (module docstring); never raises for vehicle or link faults."""
     run = Run(opts)
@@ -344,15 +372,18 @@ def certify(opts: Options) -> Outcome:
             run.open()
             run.probe()
             run.session.measure_line()  # what the line costs: the durations the cases choose
+            _precision(run, opts.precision)
             check_clock(run, opts.clock_check)
             run.run_cases(cases)
             if explore_now and run.aborted is None:
                 from .explore import explore
                 explore(run)
                 run.progress.step("exploration", "done")
-        except ClockMismatch as e:  # the declared time scale is clearly wrong: INCONCLUSIVE
-            run.aborted = run.stopped = str(e)
+        except (ClockMismatch, CoarseTiming) as e:  # the declared time scale is clearly wrong, or too
+            run.aborted = run.stopped = str(e)          # coarse for --precision nominal: INCONCLUSIVE
             run.progress.note(f"stopped: {e}")
+            if isinstance(e, CoarseTiming):
+                run.coarse = e
         except LinkLost as e:
             run.aborted = run.aborted or f"link fault: {e}"
             run.progress.note(f"link fault: {e}")
@@ -405,4 +436,5 @@ def certify(opts: Options) -> Outcome:
         reason = f"{reason.rstrip('.')}; {unverified_text(restore)}"
         if code != 1:  # the vehicle may have left with a setting changed: never a green run; a
             code = 2   # FAIL stays non-conformant (1), the restore named beside it
-    return Outcome(r["verdict"], reason, code, run.dir, r)
+    return Outcome(r["verdict"], reason, code, run.dir, r,
+                   nominal_time_scale=run.coarse.scale if run.coarse is not None else None)
