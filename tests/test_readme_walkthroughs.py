@@ -124,11 +124,7 @@ PARAMS = [pytest.param(name, [b for b in blocks if not b.slow], id=name,
           for name, blocks in JOURNEYS.items()]
 PARAMS.append(pytest.param(
     "vehicle-full", JOURNEYS.get("vehicle", []), id="vehicle-full",
-    marks=[pytest.mark.skipif(not SLOW, reason="about two minutes: HELMCHECK_WALKTHROUGH=all runs it"),
-           pytest.mark.xfail(strict=False, reason=(
-               "the emulator's full certification at x20 and 19200 baud is INCONCLUSIVE in some runs "
-               "(a few clauses could not be judged: RH-SRV-4, RH-TIM-1/2 in one run, RH-OUT-4, RH-INT-1/2 "
-               "in another) until the judge fix of the issue 'Judge any line' lands; remove this mark then"))]))
+    marks=[pytest.mark.skipif(not SLOW, reason="about two minutes: HELMCHECK_WALKTHROUGH=all runs it")]))
 
 
 @pytest.fixture
