@@ -14,8 +14,9 @@ the re-runs (``helmcheck/judge/wire.py``); the vehicle judge books the held viol
 note, live and offline alike (``helmcheck verify`` agrees).
 
 The fault is one only the exploration meets: an ``$OMS`` refused in ``S`` gets err 21 instead of
-20 when its timeout is not the 10 s that RH-ACK-4's own case (V-13) sends, so the case passes and
-only the exploration's random ``$OMS`` lines show it. RH-ACK-4 is the one clause selected, so
+20 when its timeout is not the one RH-ACK-4's own case (V-13) sends — the first ``$OMS`` of the
+run (the line budget's timeout) — so the case passes and only the exploration's ``$OMS`` lines,
+whose timeouts are drawn, show it. RH-ACK-4 is the one clause selected, so
 that its verdict is the exploration's.
 """
 
@@ -46,7 +47,8 @@ CLAUSE = "RH-ACK-4"
 
 class RefusesWith21(EmulatorCore):
     """RH-ACK-4: an ``$OMS`` refused in ``S`` is answered ``$ACK,9,1,21`` (not 20) when its
-    timeout is not 10 s. ``faults`` is how many more times it misbehaves (``None``: always)."""
+    timeout is not the first ``$OMS``'s (the case's). ``faults`` is how many more times it
+    misbehaves (``None``: always)."""
 
     faults: Optional[int] = None
 
@@ -54,9 +56,12 @@ class RefusesWith21(EmulatorCore):
         super().__init__(*a, **kw)
         self.wrong = False
         self.misbehaved = 0
+        self.first_timeout = None
 
     def _command(self, item, now, v):
-        self.wrong = isinstance(item, s.OMS) and item.timeout != 10 and self.faults != 0
+        if isinstance(item, s.OMS) and self.first_timeout is None:
+            self.first_timeout = item.timeout
+        self.wrong = isinstance(item, s.OMS) and item.timeout != self.first_timeout and self.faults != 0
         try:
             return super()._command(item, now, v)
         finally:

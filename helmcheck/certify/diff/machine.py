@@ -214,7 +214,7 @@ def machine(state: DiffState, nwp: int, speed: float, motor: int, oxflt: bool, t
             a2, b2 = pair.both(fn)
             for x, y in ((a, a2), (b, b2)):
                 x.failures = x.failures + y.failures
-                x.osi, x.v_osi, x.stop = y.osi, y.v_osi, y.stop
+                x.osi, x.v_osi, x.v_seq, x.stop = y.osi, y.v_osi, y.v_seq, y.stop
                 x.leeway = x.leeway or y.leeway
 
         # ------------------------------------------------------------------ rules

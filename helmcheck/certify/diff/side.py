@@ -65,6 +65,7 @@ class Side:
         self.t_step = 0.0  #: this side's link time at the present step's start
         #: (name, vehicle deadline) → duration: every model timer seen armed in this sequence
         self.timers: dict = {}
+        self.t_seq = 0.0  #: link time the sequence began
 
     # ------------------------------------------------------------------ life
     def open(self) -> None:
@@ -113,6 +114,7 @@ class Side:
         """A new sequence: its replay trace and its timers start empty."""
         self.session.trace = []
         self.timers = {}
+        self.t_seq = self.session.now()
 
     def trace(self) -> list:
         return list(self.session.trace or [])
@@ -192,6 +194,7 @@ class Side:
         t = ses.now()
         seen.osi = OsiView.of(osi)
         seen.v_osi = (t - t0) * self.k
+        seen.v_seq = (t - self.t_seq) * self.k
         seen.pending = self._near(t)
 
     def settle(self, until: float) -> Seen:

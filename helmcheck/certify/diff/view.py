@@ -9,7 +9,8 @@ fields and the pacing of replies are freedoms a conforming vehicle has (``docs/f
 
 :func:`differences` lists where two views differ. The park countdown is a timed value: two
 countdowns differ only by more than RH-TIM-1's tolerance of the larger one, widened by the
-vehicle time between the two reports and a second of rounding. Whether a difference is a
+vehicle time between the two reports (since the step began, or twice that since the sequence
+began, whichever is more: the countdowns began at each side's own time) and a second of rounding. Whether a difference is a
 *divergence* (or a timing race, or a choice the model leaves) is decided by :mod:`.machine`
 with each side's own judge; this module only compares.
 """
@@ -46,6 +47,7 @@ class Seen:
     ack: Optional[tuple] = None  #: (type, status, err) of the line's ``$ACK``; None: no ACK
     osi: Optional[OsiView] = None  #: the report that ended the step
     v_osi: float = 0.0  #: vehicle seconds from the step's start to that report
+    v_seq: float = 0.0  #: vehicle seconds from the sequence's start to that report
     stop: str = ""  #: why the side could not carry the step out (the report then is missing)
     failures: list = field(default_factory=list)  #: (clause, reason) its judge booked in the step
     race: str = ""  #: the line met a model timer within RH-TIM-1's tolerance (which one)
@@ -76,7 +78,9 @@ def _park_apart(a: Seen, b: Seen) -> bool:
     pa, pb = a.osi.park, b.osi.park
     if (pa == 0) != (pb == 0):
         return True
-    allowed = tolerance(max(pa, pb)) + abs(a.v_osi - b.v_osi) + 1.0
+    # each side's countdown began at its own vehicle time since the sequence began, and the report
+    # came at another: two vehicles at different time scales drift apart by the steps' line time
+    allowed = tolerance(max(pa, pb)) + max(abs(a.v_osi - b.v_osi), 2 * abs(a.v_seq - b.v_seq)) + 1.0
     return abs(pa - pb) > allowed
 
 

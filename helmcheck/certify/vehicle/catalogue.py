@@ -319,7 +319,8 @@ CASES: tuple[Case, ...] = (
        "brought under water by a servo dive first; the lockout's end is found with an $OMP (refused "
        "only by the lockout: the first one accepted after it holds the depth, RH-RD-12), then, still "
        "under water, $OMS is refused (26)", "N",
-       Send(OMS_DIVE), Until("under water", mode="A", submerged=True, depth_at_least="{dive_at}", budget_v=300.0),
+       Send(OMS_DIVE), Until("under water", mode="A", submerged=True, depth_at_least="{dive_at}", budget_v=300.0,
+                             refresh=OMS_DIVE),
        Fault("Sed"), Settle("lockout", probe=OMP_HOLD), Poll(mode="M", submerged=True),
        Send(OMS, expect="$ACK,9,1,26"), Poll(mode="M"), needs=("violation", "ascent")),
     _c("V-61", "RH-SAF-4", "At the surface the SafetyAction runs",

@@ -269,7 +269,12 @@ def _until(session: Session, st: Until, ctx: dict) -> None:
         return (deep and _condition(session, o, st.mode, None, park_below, st.submerged)
                 and (not st.surface or (o.depth is not None and float(o.depth) <= fix))
                 and (srp is None or flag == srp))
-    session.until(st.what, pred, st.budget_v, session.case_clauses[0])
+    refresh = None
+    if st.refresh:
+        body = fill(st.refresh, ctx)
+        timeout = float(body.rsplit(",", 1)[1])  # a control's timeout is its last field ($OMS, $OMP)
+        refresh = (frame(body), timeout / 2)
+    session.until(st.what, pred, st.budget_v, session.case_clauses[0], refresh=refresh)
 
 
 def _mission_end(session: Session, st: MissionEnd) -> None:

@@ -413,11 +413,17 @@ class Session:
         return osi
 
     def until(self, what: str, pred: Callable[[s.OSI], bool], budget_v: float,
-              clause: Optional[str] = None) -> s.OSI:
-        """Poll until ``pred(osi)``; past ``budget_v`` vehicle seconds, INCONCLUSIVE."""
+              clause: Optional[str] = None, refresh: Optional[tuple[bytes, float]] = None) -> s.OSI:
+        """Poll until ``pred(osi)``; past ``budget_v`` vehicle seconds, INCONCLUSIVE. ``refresh``:
+        ``(line, every_v)`` — the control that gets the vehicle there, sent again every ``every_v``
+        vehicle seconds (RH-RD-3: its timeout restarts), so a slow vehicle is not let go on the way."""
         t0 = self.now()
         wall = self._cap(budget_v / self.k)
+        again = t0
         while True:
+            if refresh is not None and self.now() - again >= refresh[1] / self.k:
+                self.exchange(refresh[0])
+                again = self.now()
             osi = self.poll()
             if pred(osi):
                 self.forced_wait += self.now() - t0

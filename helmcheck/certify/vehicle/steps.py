@@ -101,6 +101,7 @@ class Until:
     srp_active: Optional[bool] = None
     submerged: Optional[bool] = None  #: True: until the depth is below the GPS-fix depth
     depth_at_least: Optional[float | str] = None  #: until ``$OSI`` field 15 shows at least this depth
+    refresh: Optional[str] = None  #: a control sent again at half its timeout while waiting (a slow dive)
 
 
 @dataclass(frozen=True)
