@@ -50,14 +50,14 @@ def test_nominal_fixture_is_clean():
 def test_faulty_vehicle_flagged_with_line_numbers():
     out = check_log(LOGS / "vehicle_faults.log", profile=PROFILE)
     b = bad(out)
-    assert b["RH-ACK-1"] == [8]  # $OMS never acknowledged
-    assert b["RH-ACK-3"] == [13]  # err 21 instead of 20 for a heading out of range
-    assert b["RH-SRV-4"] == [23]  # still A after the 5 s servo timeout
-    assert b["RH-OUT-4"] == [23]
+    assert b["RH-ACK-1"] == [8, 9, 10, 11]  # $OMS never acknowledged, sent four times
+    assert b["RH-ACK-3"] == [16]  # err 21 instead of 20 for a heading out of range
+    assert b["RH-SRV-4"] == [26]  # still A after the 5 s servo timeout
+    assert b["RH-OUT-4"] == [26]
     assert "RH-INT-2" not in b  # control never ended: what it resumes is not in question
-    assert b["RH-BS-2"] == [12]  # the backseat's own range error, too
+    assert b["RH-BS-2"] == [15]  # the backseat's own range error, too
     ev = verdicts(out)["RH-ACK-3"]["evidence"]
-    assert ev[0]["line"].startswith("line 12: $OMS,400") and ev[1]["line"].startswith("line 13: $ACK,9,1,21")
+    assert ev[0]["line"].startswith("line 15: $OMS,400") and ev[1]["line"].startswith("line 16: $ACK,9,1,21")
 
 
 def test_faulty_backseat_flagged_with_line_numbers():
@@ -133,7 +133,7 @@ def test_cli_writes_reports_and_exit_codes(tmp_path, capsys):
     assert doc["log"]["format"] == "wirelog"
     assert cli_main(["check-log", str(LOGS / "vehicle_faults.log"), "--report-dir", str(tmp_path / "f"),
                      "--no-render"]) == 1
-    assert "RH-ACK-3 fail: lines 13" in capsys.readouterr().out
+    assert "RH-ACK-3 fail: lines 16" in capsys.readouterr().out
     assert cli_main(["check-log", str(LOGS / "backseat_only.log"), "--report-dir", str(tmp_path / "b"),
                      "--no-render"]) == 0
     coarse = tmp_path / "coarse.log"  # 2 × 1100 bytes stamped 1 s apart: within a second or not?

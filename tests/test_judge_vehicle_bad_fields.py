@@ -19,6 +19,7 @@ from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
 from helmcheck.grammar import checksum_hex, decode, format as format_sentence
+from helmcheck.judge.spoil import REPEAT
 from helmcheck.grammar import sentences as S
 from helmcheck.profile import DEFAULT
 from tests import strategies as gen
@@ -162,6 +163,10 @@ def test_a_report_whose_state_cannot_be_read_shows_none(tmp_path):
     rec = scenario()
     i = next(i for i, r in enumerate(rec) if r[1] == "<" and ",A," in r[2])
     rec[i] = (rec[i][0], "<", rec[i][2].replace(",A,", ",X,"))
+    t = rec[i][0]  # asked again at once, answered the same every time: the vehicle's, not the line's
+    for k in range(1, REPEAT):  # (X is one flip from P: two flips of one bit could make it)
+        at = t + 0.03 * k
+        rec[i + 3 * k - 1:i + 3 * k - 1] = [(at - 0.01, ">", "OSD,S"), (at, "<", rec[i][2]), (at + 0.01, "<", "ACK,8,0,0")]
     got = judge(tmp_path, rec)
     assert got["RH-OUT-1"]["verdict"] == "fail" and "mode" in got["RH-OUT-1"]["reason"]
     assert {c for c, e in got.items() if e["verdict"] == "fail"} == {"RH-OUT-1"}, got

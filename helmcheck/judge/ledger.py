@@ -11,6 +11,9 @@ observation of one clause:
 * ``inconclusive`` — the clause was exercised but could not be judged (timing the observer
   cannot bound, a mission file it does not have, a link fault);
 * ``not_tested`` — why the clause could not be exercised at all;
+* ``spoiled`` — an observation a faulty line may have spoilt, made again clean (the judge's
+  repetition rule, :mod:`helmcheck.judge.streaks`): not booked against the implementation,
+  counted, and named in the verdict's reason (an INCONCLUSIVE where nothing else was observed);
 * ``withdraw`` — the clause is outside what the run judged (a ``--select`` run that did not
   select it; a backseat whose exit cut short the scenarios exercising it): NOT-TESTED with that
   reason whatever was observed, except a violation, which stands (a run fact,
@@ -103,6 +106,9 @@ class _Entry:
     remarks: list = field(default_factory=list)
     withdrawn: Optional[tuple[str, str]] = None  #: (reason, prefix of an observed violation's reason)
     precision: Optional[tuple[float, float, float]] = None  #: the coarsest (nominal, widened, k) so far
+    spoiled: int = 0  #: observations a faulty line may have spoilt, made again (not judged)
+    spoiled_reason: str = ""
+    spoiled_evidence: list = field(default_factory=list)
 
 
 class Ledger:
@@ -206,6 +212,23 @@ class Ledger:
     def not_tested(self, cid: str, reason: str, case: str = "") -> None:
         """Why the clause could not be exercised (shown only if nothing else was found)."""
         self._add(cid, NOT_TESTED, reason, (), case)
+
+    def spoiled(self, cid: str, reason: str, evidence: Iterable[Evidence] = (), case: str = "") -> None:
+        """An observation of the clause a faulty line may have spoilt (``reason`` says how) was
+        made again clean: not judged, counted (module docstring)."""
+        e = self._e.get(cid)
+        if e is None:
+            return
+        e.spoiled += 1
+        if not e.spoiled_reason:
+            e.spoiled_reason = reason
+            e.spoiled_evidence = list(evidence)[:MAX_EVIDENCE]
+        if case:
+            e.cases[case] = None
+
+    def spoiled_count(self, cid: str) -> int:
+        e = self._e.get(cid)
+        return e.spoiled if e is not None else 0
 
     def withdraw(self, cid: str, reason: str, observed: str = "") -> None:
         """The clause is outside what the run judged: its verdict is NOT-TESTED with *reason*
@@ -324,6 +347,15 @@ class Ledger:
             n = lv[NOT_TESTED]
             reason = n.reason or "no occasion to exercise this clause"
             out = ClauseVerdict(cid, NOT_TESTED, reason, level, cases, (), (), 0, 0)
+        if e.spoiled:
+            said = (f" {e.spoiled} observation(s) a faulty line may have spoilt were not judged: each was made "
+                    f"again (first: {e.spoiled_reason}).")
+            if out.verdict == NOT_TESTED:
+                out = ClauseVerdict(cid, INCONCLUSIVE, f"nothing judged:{said}", level, cases,
+                                    tuple(e.spoiled_evidence), (), 0, 0)
+            else:
+                out = ClauseVerdict(out.id, out.verdict, out.reason + said, out.level, out.cases, out.evidence,
+                                    out.lines, out.offending_count, out.observations, out.precision)
         if e.precision is not None and out.verdict in (PASS, NON_STRICT, FAIL):
             nominal, widened, k = e.precision
             out = ClauseVerdict(out.id, out.verdict, out.reason + f" Timing judged within ±{widened:.2f} s of vehicle time "

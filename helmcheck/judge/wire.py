@@ -50,6 +50,15 @@ wire-log format (``docs/contracts.md``):
 ``run resumed: <what>``                     an interrupted run goes on (``--resume``): the
                                             vehicle's state is unknown again; commands left
                                             unanswered at the interruption are not judged
+``line fault <dir> <kind>: <detail>``       what a line-fault relay did to the line
+                                            (:mod:`helmcheck.grammar.faultnote`): the judges
+                                            give what it touched to the line
+                                            (:mod:`.linefaults`)
+``relay started: …``                        the record is a line-fault relay's: what no
+                                            ``line fault`` note touched, the line did not do
+``re-run …``                                the tester makes a spoilt observation again
+                                            (evidence only: the judge's repetition rule,
+                                            :mod:`.streaks`, reads the lines themselves)
 ==========================================  ===================================================
 """
 
@@ -61,6 +70,7 @@ from dataclasses import dataclass
 from typing import Any, Optional
 
 from ..grammar import Decoded, decode
+from ..grammar.faultnote import PREFIX as FAULT_PREFIX, read_fault_note
 from ..grammar.wirelog import FROM_VEHICLE, NOTE, TO_VEHICLE, WireEvent
 from ..profile import SAFETY_CODES
 from .linebudget import parse_budget
@@ -102,12 +112,12 @@ class Note:
 
     kind: str  #: case | case-end | not-tested | inconclusive | link | budget | plant | fault | lockout |
     #: lockout-end | scenario | silence | silence-end | reject | reject-end | operator | aborted |
-    #: resumed
+    #: resumed | line-fault | relay
     case: str = ""
     clauses: tuple[str, ...] = ()
     text: str = ""
     code: str = ""
-    value: Any = None  #: plant: (event class name, kwargs, v); link: baud
+    value: Any = None  #: plant: (event class name, kwargs, v); link: baud; line-fault: its FaultNote
 
 
 _CASE = re.compile(r"^case (\S+)(?: ((?:RH-[A-Z]+-\d+ ?)+))?: (.*)$")
@@ -134,6 +144,11 @@ def parse_plant(args: str) -> Optional[dict]:
 
 def parse_note(text: str) -> Optional[Note]:
     """The :class:`Note` a judge acts on, or ``None`` for a note that is evidence only."""
+    if text.startswith(FAULT_PREFIX):
+        fault = read_fault_note(text)
+        return Note("line-fault", value=fault, text=text) if fault is not None else None
+    if text.startswith("relay started: "):
+        return Note("relay", text=text)
     m = _CASE.match(text)
     if m:
         return Note("case", case=m.group(1), clauses=tuple((m.group(2) or "").split()), text=m.group(3))

@@ -129,6 +129,10 @@ def check_clock(run, enabled: bool = True) -> ClockCheck:
     if enabled:
         check = measure_clock(run.link, run.p, run.k)
         run.link.drain()  # an answer the check stopped waiting for is not left to the first case
+        ses = run.session
+        if ses is not None and any(not x.done or x.spoil for x in ses.obs.sent):
+            with ses.not_stopping():  # a request the line spoilt: settled, and made again (session.finish)
+                ses.finish()
     else:
         check = not_measured(run.k, "the check was turned off (--no-clock-check)")
     run.link.note(check.note())

@@ -8,13 +8,21 @@ into the ledger. The session only decides what to send next and how long to wait
 * :meth:`Session.exchange` — send one line and wait until the observer has settled it (its
   ``$ACK`` arrived, or the window of a line the vehicle must discard went by). A command left
   unanswered is followed by a liveness probe (``$OSD,S``), which is also what lets the observer
-  tell a missing ACK (RH-ACK-1) from a dead link. When the observer has booked a failure inside
+  tell a missing ACK (RH-ACK-1) from a dead link (a probe whose answer the line broke is asked
+  again). When a faulty line may have spoilt the observation (the observer holds it: a lost or
+  late ``$ACK``, a broken reply, :attr:`~helmcheck.judge.vehicle.Sent.spoil`), the line is sent
+  again, up to :data:`~helmcheck.judge.spoil.RERUNS` times, each re-run a ``re-run`` note naming
+  why: a clean answer makes the spoilt one the line's, the same error every time makes it the
+  vehicle's (the observer's repetition rule, :mod:`helmcheck.judge.streaks`). A command whose
+  second sending would change what the first did (``$OMW`` appends to the queue) is not sent
+  again: what the line spoilt of it stays INCONCLUSIVE. When the observer has booked a failure inside
   the present case, the case stops (:class:`~.flow.CaseStop`): the first fail is the root cause —
   except a bad field of a report the observer still read (RH-OUT-1/3 on one field of an ``$OSI``,
   :mod:`helmcheck.judge.vehicle.lines`), which causes nothing after it, unless the case is about
   that clause.
 * :meth:`Session.poll` — ``$OSD,S``; the ``$OSI`` the observer judged (read without its bad
-  fields, if it has any; one whose state fields cannot be read ends the case INCONCLUSIVE).
+  fields, if it has any; one whose state fields cannot be read, or that the line spoilt on every
+  re-run, ends the case INCONCLUSIVE).
 * :meth:`Session.wait`, :meth:`Session.settle`, :meth:`Session.until` — protocol time passing
   (vehicle seconds ÷ k, RH-TIM-2), polling all along. ``settle`` polls across a model timer's
   deadline until the vehicle is seen to have left the state before it, so the observer can
@@ -35,6 +43,7 @@ from typing import Callable, Optional
 
 from ...grammar import checksum_hex
 from ...grammar import sentences as s
+from ...judge.spoil import RERUNS
 from ...judge.timing import ack_allowance, ack_give_up_after, tolerance
 from ...judge.vehicle import Sent, VehicleObserver
 from ...judge.wire import case_end_note, case_note, tester_note
@@ -92,6 +101,7 @@ class Session:
         #: what the line costs (:mod:`.linemeter`), and the durations chosen from it (:mod:`.durations`)
         self.meter = LineMeter(self.k, profile.baud, profile.ack_window_s)
         self._durations: Optional[Durations] = None
+        self.reruns = 0  #: re-runs the last :meth:`exchange` took (a faulty line spoilt what came before)
 
     # ================================================================ the line budget
     def measure_line(self, host: bool = True) -> None:
@@ -183,7 +193,19 @@ class Session:
         return None
 
     def exchange(self, raw: bytes) -> Optional[Sent]:
-        """Send ``raw`` and wait until the observer has settled it (module docstring)."""
+        """Send ``raw`` and wait until the observer has settled it; made again while a faulty line
+        may have spoilt it (module docstring). The last sending is returned; :attr:`reruns` says
+        how many re-runs it took."""
+        sent = self._exchange_once(raw)
+        self.reruns = 0
+        while (sent is not None and sent.spoil and self.reruns < RERUNS and _rerunnable(sent)
+               and self.obs.streaks.awaits(sent.raw)):
+            self.reruns += 1
+            self.note(f"re-run {self.reruns} of {RERUNS}: {_line_text(raw)}: {sent.spoil}")
+            sent = self._exchange_once(raw)
+        return sent
+
+    def _exchange_once(self, raw: bytes) -> Optional[Sent]:
         self.link.drain()
         sent = self.send(raw)
         if sent is None:
@@ -194,17 +216,19 @@ class Session:
             self.link.sleep(max(0.0, sent.t + wait - self.now()))
             self.check()
             return sent
-        hard = sent.t + ack_give_up_after(allowance) + 0.05  # long enough to see a late ACK (RH-ACK-2)
+        # long enough to see a late ACK (RH-ACK-2), and until the observer has given up on it: a
+        # probe sent sooner would have its answer taken for this line's
         while not sent.done:
+            hard = self.obs.give_up_at(sent) + 0.05
             rx = self.link.next(hard)
-            if rx is None:
+            if rx is None and self.now() >= self.obs.give_up_at(sent) + 0.05:
                 break
         if sent.done:
             self._sample(sent)
             self._trace({"expect": _brief(sent.expected)})
             self.check()
             return sent
-        self._probe(hard)
+        self._probe(self.now())
         self.check()
         return sent
 
@@ -265,30 +289,50 @@ class Session:
         failure (:meth:`check`)."""
         pending = [x for x in self.obs.sent if not x.done]
         if pending:
-            size = max(len(x.raw) for x in pending)
-            allowance = ack_allowance(self.profile.ack_window_s, size, 0, self.profile.baud)
-            hard = max(x.t for x in pending) + ack_give_up_after(allowance) + 0.05
-            while any(not x.done for x in pending) and self.now() < hard:
+            while any(not x.done for x in pending):
+                hard = max(self.obs.give_up_at(x) for x in pending if not x.done) + 0.05
+                if self.now() >= hard:
+                    break
                 self.link.next(hard)
             self.poll()
+        self.rerun_spoilt()
         self.check()
         if linger_v > 0:
             self.wait(linger_v)
             self.check()
 
+    def rerun_spoilt(self) -> None:
+        """Make again what a faulty line may have spoilt among the lines sent so far that were not
+        exchanged one by one (a ``lazy_silence`` step, the clock check): each such line once more,
+        through :meth:`exchange` (its own re-runs as ever)."""
+        done: set = set()
+        for x in list(self.obs.sent):
+            if x.spoil and x.raw not in done and _rerunnable(x) and self.obs.streaks.awaits(x.raw):
+                done.add(x.raw)
+                self.note(f"re-run of {_line_text(x.raw)}: {x.spoil}")
+                self.exchange(x.raw)
+
     def _probe(self, after: float) -> None:
         """A command got no ACK in time: does the vehicle still answer anything? (an ``$OSD,S``
-        the observer judges like any other — its answer decides RH-ACK-1 against a link fault)."""
+        the observer judges like any other — its answer decides RH-ACK-1 against a link fault).
+        A probe left unanswered is asked again (a faulty line may have lost it or broken its
+        answer), up to :data:`~helmcheck.judge.spoil.RERUNS` times."""
         self.link.sleep(max(0.0, after - self.now()))
         self.note("liveness probe")
-        probe = self.send(frame("OSD,S"))
-        end = self.now() + 2 * self.profile.ack_window_s + 0.5
-        while probe is not None and not probe.done and self.now() < end:
-            self.link.next(end)
-        if probe is None or probe.ack is None:
-            if self.obs.alive_t is None or self.obs.alive_t < (probe.t if probe else self.now()):
-                raise LinkSilent(f"the vehicle answered nothing at all for {end - after:.1f} s "
-                                 f"(device off, wrong port or baud?)")
+        for _ in range(RERUNS + 1):
+            probe = self.send(frame("OSD,S"))
+            while probe is not None and not probe.done:  # until the observer gives up on it (exchange)
+                end = self.obs.give_up_at(probe) + 0.05
+                if self.now() >= end:
+                    break
+                self.link.next(end)
+            if probe is not None and probe.ack is not None:
+                return
+            if self.obs.alive_t is not None and self.obs.alive_t >= (probe.t if probe else self.now()):
+                return
+            # nothing, or nothing that reads: the line may have lost the probe or its answer
+        raise LinkSilent(f"the vehicle answered nothing at all for {self.now() - after:.1f} s "
+                         f"(device off, wrong port or baud?)")
 
     def burst(self, raws: list[bytes]) -> list[Sent]:
         """Write several commands at once, then wait for all their answers (RH-ACK-6)."""
@@ -311,6 +355,12 @@ class Session:
         if any(not x.done for x in sents):
             self._probe(hard)
         self.check()
+        for i, x in enumerate(sents):  # what the line spoilt is made again, one by one
+            if x.spoil and _rerunnable(x) and self.obs.streaks.awaits(x.raw):
+                self.note(f"re-run of {_line_text(x.raw)} from a burst: {x.spoil}")
+                again = self.exchange(x.raw)
+                if again is not None:
+                    sents[i] = again
         return sents
 
     def poll(self) -> s.OSI:
@@ -322,6 +372,9 @@ class Session:
                 self.tester("not-tested", self.case_clauses, "the profile's osd_letters lack S: the "
                                                              "vehicle's state cannot be observed")
                 raise CaseStop("not-tested", "the profile's osd_letters lack S")
+            if sent is not None and sent.spoil:
+                raise CaseStop("inconclusive", f"$OSD,S was answered without a readable $OSI {self.reruns + 1} "
+                                               f"time(s) in a row: {sent.spoil} (a faulty line?)")
             if sent is not None and any(cls == "OSI" for _, cls, _ in sent.data):
                 # an $OSI came, but its state fields could not be read (booked on their clause)
                 raise CaseStop("inconclusive", "the $OSI answering $OSD,S shows no readable state (mode, "
@@ -468,6 +521,12 @@ class Session:
     def start_mission(self, name: str, srp: str = "", ignore_gps: int = 0, clause: str = "RH-MSN-2") -> s.OSI:
         """``$OMSTART`` by name (rh5 form, RH-MSN-2); INCONCLUSIVE when the vehicle lacks it."""
         sent = self.exchange(frame(f"OMSTART,{ignore_gps},0,0,0,{name},{srp}"))
+        if sent is not None and not sent.accepted and self.reruns:
+            # sent again after the line spoilt its answer: the first sending may have started it
+            osi = self.poll()
+            if osi.mode in ("N", "P"):
+                self.mission_started_at = self.now()
+                return osi
         if sent is None or not sent.accepted:
             what = f"mission {name!r}" + (f" with SRP {srp!r}" if srp else "")
             why = (f"the profile's {what} did not start: {_brief([sent.ack]) if sent and sent.ack else 'no answer'}"
@@ -498,6 +557,18 @@ class Session:
             raise CaseStop("inconclusive", "the vehicle's last $OSI does not show its position readably "
                                            "(fields 4 and 5)")
         return f"{float(o.lat):.6f}", f"{float(o.lon):.6f}"
+
+
+def _rerunnable(sent: Sent) -> bool:
+    """A line whose second sending does what its first did (module docstring): not an ``$OMW``
+    that queues a waypoint (the keyword forms are)."""
+    if sent.kind.kind not in ("command", "error"):
+        return False
+    return not isinstance(sent.kind.item, s.OMW)
+
+
+def _line_text(raw: bytes) -> str:
+    return _esc(raw.rstrip(b"\r\n"))
 
 
 def _esc(raw: bytes) -> str:

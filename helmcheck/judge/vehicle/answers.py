@@ -12,6 +12,12 @@ judges replies, split out to keep one concern per module; it works on the observ
 * **The ACK window** (RH-ACK-2, :func:`~helmcheck.judge.timing.ack_allowance`; an ACK later
   than the window, transmit time and the observer's own uncertainty is a FAIL), the answer
   against the mirror (:mod:`.belief`), and ``$OSD``'s data before its ACK (RH-ACK-5, RH-OSD-1).
+* **A faulty line** (module :mod:`.observer`, "a faulty line"): an answer whose replies the line
+  may have spoilt (a broken run came while it waited), or that came later than its window (a
+  stall of the line can hold it), is *held*: what it would book goes to the repetition rule
+  (:mod:`helmcheck.judge.streaks`) under the command, which decides when it is sent again; an
+  answer in full and on time with nothing spoilt makes what was held for that command (and the
+  replies held for its earlier sendings) the line's.
 * **Every** ``$OSI`` against the mirror (RH-OUT-4 and the clauses of what led there, attributed by
   :mod:`.blame`), the timers it brackets (RH-TIM-1/2), and the checks beyond the mirror
   (:mod:`.osichecks`).
@@ -19,10 +25,14 @@ judges replies, split out to keep one concern per module; it works on the observ
 
 from __future__ import annotations
 
+from typing import Optional
+
 from ...grammar import sentences as s
 from ...grammar.wirelog import escape
 from ...model.timers import tolerance
 from ..ledger import Evidence
+from ..spoil import REPEAT
+from ..streaks import OTHER_REPEAT
 from ..timing import ack_allowance, ack_uncertainty, ack_verdict, transmit_time
 from .blame import command_clauses, looked_up, passable, stated_by
 from .sent import Sent, brief, names, text_of
@@ -153,6 +163,82 @@ class Answers:
 
     def _answered(self, p: Sent, a: s.ACK, t: float, evd: Evidence, late: bool) -> None:
         p.state, p.ack, p.t_ack = "answered", a, t
+        if late and p.held_item is not None:  # it did answer, late: no longer a lost answer (RH-ACK-1)
+            p.held = [f for f in self.streaks.release(p.held_item) if f[0] != "RH-ACK-1"]
+            p.held_item = None
+            why = self._late_text(p, t - p.t)
+            if why is None:  # a relay's record: the line did not hold it up
+                for cid, reason, evidence, case in p.held:
+                    self.ledger.failed(cid, reason, evidence, case)
+                p.held = []
+            p.late_text = why or ""
+        p.holding = bool(p.spoils)  # a broken run came while it waited: what it leaves wrong is held
+        try:
+            on_time = self._answered_held(p, a, t, evd, late)
+        finally:
+            p.holding = False
+        self._settle_held(p, on_time)
+
+    def _settle_held(self, p: Sent, on_time: bool = True) -> None:
+        """What an answered command's findings were held for goes to the repetition rule; an answer
+        with nothing spoilt and nothing wrong makes the command's earlier sendings' held
+        observations the line's (module docstring)."""
+        if p.held and p.spoils:
+            spoils = p.spoils
+            known = next((text for text, _need, k, _sig in spoils if k), None)
+            text = known or spoils[0][0]
+            need = max(n for _t, n, _k, _sig in spoils)
+            # the same error: the same clauses, and the same damage to the replies
+            sig = ("cmd",) + tuple(sorted({f[0] for f in p.held})) + tuple(x[3] for x in spoils)
+            self.hold_command(p, sig, text, need, known is not None)
+        elif p.held:
+            # late, nothing spoilt: a stall holds up what is sent during it, so an $ACK late is the
+            # vehicle's when the one before it was late too and it was sent after that one came
+            # back (the line seen flowing again), with no $ACK on time in between; the same
+            # command answered on time later makes it the line's
+            sig = ("late",) if p.t >= self.late_until else ("late", "held up with the one before", p.seq)
+            self.late_until = max(self.late_until, p.t_ack or p.t)
+            self.hold_command(p, sig, p.late_text, OTHER_REPEAT, False, key=("late",))
+        elif on_time and not p.spoils:
+            self.answered_clean(p)
+
+    def answered_clean(self, p: Sent) -> None:
+        """``p`` was answered in full and on time, nothing spoilt: its earlier sendings' held
+        observations (and the replies held for them) were the line's."""
+        self.clean_sendings[p.raw] = p.seq
+        if len(self.clean_sendings) > 512:
+            self.clean_sendings.pop(next(iter(self.clean_sendings)))
+        if self.streaks:
+            self.streaks.clean(("cmd", p.raw))
+            self.streaks.interrupt(("late",))  # an answer on time: late ones before it are not a run
+            self.streaks.clean_owned(p.raw, p.mark)
+
+    def hold_command(self, p: Sent, sig: tuple, text: str, need: int, known: bool,
+                     key: Optional[tuple] = None) -> None:
+        """What ``p``'s answer would book, held under the command (module docstring) — or
+        dismissed at once when a later sending of it was already answered in full."""
+        if key is None and self.clean_sendings.get(p.raw, 0) > p.seq:
+            self.streaks.made_again(text, p.held)
+            p.held = []
+            return
+        p.held_item = self.streaks.hold(key or ("cmd", p.raw), sig, text, p.held, need=need, known=known,
+                                        owners=(p.raw,))
+        p.held = []
+        if p.held_item is not None:
+            p.spoil = p.spoil or text
+
+    def _late_text(self, p: Sent, dt: float) -> Optional[str]:
+        """Why an ``$ACK`` ``dt`` s late may be the line's (a stall held it), or None when a
+        relay's record shows the line did not hold it (then it is booked at once)."""
+        note = self.faults.held_between(p.t, p.t + dt)
+        if note is not None:
+            return f"the line held it (the relay's note: {note})"
+        if self.faults.instrumented:
+            return None
+        return f"an $ACK {dt:.2f} s after its command: a stall of the line (or of the host) may have held it"
+
+    def _answered_held(self, p: Sent, a: s.ACK, t: float, evd: Evidence, late: bool) -> bool:
+        """Judge the answer (module docstring); True when the ``$ACK`` came within its window."""
         ev = [p.ev, evd]
         replies = self.vbytes - p.vbytes0
         window = self.profile.ack_window_s
@@ -162,6 +248,11 @@ class Answers:
         if late and p.late_booked:
             pass  # RH-ACK-2 was booked when the give-up deadline passed
         elif verdict == "fail":
+            why = self._late_text(p, dt)
+            if why is not None and not p.holding:
+                p.holding, p.late_text = True, why
+                if why.startswith("the line held"):
+                    p.spoils.append((why, REPEAT, True, ("late",)))
             self.book("fail", ("RH-ACK-2",), f"$ACK,{a.type} came {dt:.2f} s after {text_of(p)}; allowed "
                                              f"{allowance:.2f} s: the {window:g} s window, "
                                              f"{transmit_time(len(p.raw) + replies, self.baud):.3f} s of transmit "
@@ -180,7 +271,7 @@ class Answers:
         observed = [cls for _, cls, _ in p.data] + [a]
         if p.branched:  # already in the mirror, unanswered: judge the late answer's content only
             self._late_answer(p, a, observed, ev)
-            return
+            return verdict == "pass" and not late
         # RH-RD-15: the command took effect the instant its ACK went out, which its arrival bounds
         # (less the replies' transmit time), however long the vehicle took to answer
         took = min(dt, transmit_time(replies, self.baud))
@@ -227,6 +318,7 @@ class Answers:
             self.last_osd = p
             self._osd_data(p, a, ev)
         self.checks.answered(p, a, res, ev)
+        return verdict == "pass" and not late
 
     def _late_answer(self, p: Sent, a: s.ACK, observed: list, ev: list) -> None:
         want = next((r for r in p.expected if isinstance(r, s.ACK)), None)

@@ -3,13 +3,19 @@
 :class:`Deadlines` is the part of :class:`~helmcheck.judge.vehicle.observer.VehicleObserver` that
 acts when time passes without an answer, split out to keep one concern per module; it works on the
 observer's own state (``pending``, ``silent``, ``gave_up``, ``dead``, ``quiet``, the ledger) and is
-never used alone. A command unanswered past its give-up deadline fails RH-ACK-2 (once the vehicle
-is seen to still answer) and, :data:`GIVE_UP_S` after it was sent, RH-ACK-1; a line the vehicle
-must discard passes its clause (RH-FRM-2/4/5/6/7) when its window passes unanswered.
+never used alone. A command unanswered past its give-up deadline, once the vehicle is seen to
+still answer, would fail RH-ACK-2 and RH-ACK-1 — but a faulty line may have lost the command on its
+way (which the tester's record cannot show) or its ``$ACK`` on the way back, so both are held
+until the command is sent again (the repetition rule, :mod:`helmcheck.judge.streaks`): answered
+then, they were the line's; unanswered :data:`~helmcheck.judge.spoil.REPEAT` times in a row, they
+are the vehicle's. In a line-fault relay's record the line is known: a lost answer no note
+explains is booked at once. A line the vehicle must discard passes its clause (RH-FRM-2/4/5/6/7)
+when its window passes unanswered.
 """
 
 from __future__ import annotations
 
+from ..spoil import REPEAT
 from ..timing import ack_allowance, ack_give_up_after
 from .sent import Sent, text_of
 
@@ -48,6 +54,14 @@ class Deadlines:
         if self.gave_up:
             self._give_up(t)
 
+    def give_up_at(self, p: Sent) -> float:
+        """When the observer will take ``p``'s ``$ACK`` as missing (RH-ACK-1), as things stand (the
+        replies seen since it was sent count in its allowance): a driver that sends anything of
+        the same type before then has its answer taken for ``p``'s."""
+        allowance = ack_allowance(self.profile.ack_window_s, len(p.raw), self.vbytes - p.vbytes0, self.baud,
+                                  self.res, self.jitter)
+        return p.t + ack_give_up_after(allowance)
+
     def _silent_over(self, q: Sent, t: float) -> bool:
         allowance = ack_allowance(self.profile.ack_window_s, len(q.raw), 0, self.baud, self.res, self.jitter)
         return t - q.t > allowance
@@ -71,10 +85,36 @@ class Deadlines:
         p.state = "missing"
         p.waited = ack_give_up_after(allowance)
         self.gave_up.append(p)
+        if not p.branched:
+            # it may have been acted on, its answer lost: both stay candidates (as for a command a
+            # later answer overtook, RH-ACK-6)
+            p.branched = True
+            p.expected = self.beliefs.unanswered(p.kind.item, self.v(p.t))
         if self.alive_t is not None and self.alive_t > p.t:
-            self._book_late(p)
+            self._hold_missing(p)
         else:
             self.dead.append(p)
+
+    def _hold_missing(self, p: Sent) -> None:
+        """No ``$ACK`` though the vehicle still answers: RH-ACK-2 and RH-ACK-1, held until the command
+        is sent again (module docstring), or booked at once where a relay's record shows the line
+        did nothing to it."""
+        from .observer import LOST
+        known = next((text for text, _need, k, _sig in p.spoils if k), None) or self.faults.held_between(p.t, self.t)
+        if self.faults.instrumented and known is None:
+            self._book_late(p)
+            p.missing_booked = True
+            self._book_missing(p)
+            return
+        p.holding = True
+        try:
+            self._book_late(p)
+            p.missing_booked = True
+            self._book_missing(p)
+        finally:
+            p.holding = False
+        text = known or (p.spoils[0][0] if p.spoils else LOST)
+        self.hold_command(p, ("cmd", "no $ACK"), text, REPEAT, known is not None)
 
     def _book_late(self, p: Sent) -> None:
         cands = ((p.kind.variant,) if p.kind.variant else ()) + ("RH-ACK-2",)
@@ -99,7 +139,7 @@ class Deadlines:
 
     def _revive(self, t: float) -> None:
         for p in self.dead:
-            self._book_late(p)
+            self._hold_missing(p)
         self.dead.clear()
         for q in self.quiet:
             self._silence_kept(q)

@@ -10,10 +10,13 @@ extension (RH-SAF-5). A command the profile does not claim is an unknown ID (RH-
 
 :class:`OutputJudge` judges every line the vehicle sends on its own (RH-FRM-1/2/3/6/8,
 RH-OUT-1/2/3) into the ledger; a ``$C`` that does not follow its form fails RH-FRM-8, and a line
-that is a sentence with a parity bit in bit 7 of every byte fails RH-FRM-9 (not 8N1). Bytes from
-the vehicle that frame into no sentence cannot be attributed (line noise looks the same) and are
-INCONCLUSIVE for RH-FRM-1 — except the same bytes before reply after reply (a modem or vehicle
-prefix), which is an RH-FRM-1 FAIL quoting them.
+that is a sentence with a parity bit in bit 7 of every byte fails RH-FRM-9 (not 8N1). A broken
+line's failures go to its :attr:`~OutputJudge.holder` first: a faulty line may have broken it,
+so the vehicle observer holds them until the line is read again (the repetition rule,
+:mod:`helmcheck.judge.streaks`; the form of the damage, :mod:`helmcheck.judge.spoil`). Bytes
+from the vehicle that frame into no sentence are RH-FRM-1's the same way: line noise unless the
+same bytes come before reply after reply (:data:`PREFIX_REPEAT` in a row: a modem or vehicle
+prefix).
 
 A sentence with bad fields (:attr:`~helmcheck.grammar.Decoded.partial`: framed, checksummed, split
 into its fields, but with a field the grammar cannot read or a value out of its range) fails each
@@ -133,15 +136,31 @@ class OutputJudge:
         self.ledger = ledger
         self.profile = profile
         self.noise_before: Optional[bytes] = None  #: a discarded run just before the next line
-        self.prefix: Optional[bytes] = None
-        self.prefix_count = 0
-        self.prefix_reported = False
+        #: the run discarded just before the line last judged (None: the line came clean after a line)
+        self.before_line: Optional[bytes] = None
         self.discards = 0
         #: a line's bytes → (its sentence, its passes), for lines judged without any fault
         self._clean: dict = {}
         #: (clause, reason) of the failures booked for bad fields of sentences still read (module
         #: docstring; the latest :data:`~helmcheck.judge.wire.LINE_CACHE` of them)
         self.read_anyway: set = set()
+        #: takes a broken line's failures for the repetition rule (a faulty line may have broken
+        #: it: :mod:`helmcheck.judge.streaks`): ``holder(raw, decoded, fails, evidence, case,
+        #: discard_clause)`` returns True when it took them; None: book them at once
+        self.holder = None
+
+    def _book(self, raw: bytes, d: Optional[Decoded], fails: list, ev: Evidence, case: str,
+              discard: str = "") -> None:
+        """The failures of one broken run: to the holder, or into the ledger."""
+        if not fails:
+            return
+        if self.holder is not None and self.holder(raw, d, fails, ev, case, discard):
+            return
+        for clause, reason in fails:
+            if clause == "RH-FRM-1" and d is None:  # no holder: bytes that frame into nothing
+                self.ledger.inconclusive(clause, reason, [ev], case)
+            else:
+                self.ledger.failed(clause, reason, [ev], case)
 
     def discard(self, raw: bytes, length: int, clause: str, ev: Evidence, case: str) -> None:
         """Bytes from the vehicle that frame into no sentence."""
@@ -150,36 +169,41 @@ class OutputJudge:
             self.ledger.failed("RH-FRM-6", f"the vehicle sent a line of {length} bytes, over the "
                                            f"{self.profile.max_line_bytes}-byte limit", [ev], case)
             return
-        self.noise_before = raw
-        self.ledger.inconclusive("RH-FRM-1", "bytes from the vehicle that frame into no sentence "
-                                             "(line noise or a vehicle fault: cannot attribute)", [ev], case)
+        if raw[:1] != b"$":
+            self.noise_before = raw
+        self._book(raw, None, [("RH-FRM-1", f"bytes from the vehicle that frame into no sentence: "
+                                            f"{escape(raw[:40])!r}")], ev, case, clause)
 
     def line(self, d: Decoded, ev: Evidence, case: str) -> Optional[s.Sentence]:
         """Judge one vehicle line; returns the sentence when it is valid."""
         led = self.ledger
-        if self.noise_before is not None or self.prefix is not None:  # (else _prefix changes nothing)
-            self._prefix(ev, case)
+        self.before_line, self.noise_before = self.noise_before, None
         known = self._clean.get(d.raw)
         if known is not None:  # a line seen before without fault: the same passes again
             led.passed_all(known[1], [ev], case)
             return known[0]
         if self._parity(d, ev, case):
             return None
+        fails: list = []
         if d.terminator != "\r\n":
-            led.failed("RH-FRM-1", "the vehicle ended a sentence without CR LF", [ev], case)
+            fails.append(("RH-FRM-1", "the vehicle ended a sentence without CR LF"))
         for f in d.findings:
             if f.clause == "RH-FRM-3":
-                led.failed("RH-FRM-3", f"the vehicle emitted lower-case checksum hex: {f.message}", [ev], case)
+                fails.append(("RH-FRM-3", f"the vehicle emitted lower-case checksum hex: {f.message}"))
         sent = d.sentence
         if sent is None:
             if d.partial is not None and not isinstance(d.partial, s.Command):
-                return self._partial(d, ev, case)
+                got = self._partial(d, ev, case, fails)
+                self._book(d.raw, d, fails, ev, case)
+                return got
             err = d.error
             clause, why = self._clause(d, err)
-            led.failed(clause, f"the vehicle sent an invalid {d.sentence_id or 'line'}: {why}", [ev], case)
+            fails.append((clause, f"the vehicle sent an invalid {d.sentence_id or 'line'}: {why}"))
+            self._book(d.raw, d, fails, ev, case)
             return None
         if isinstance(sent, s.Command):
-            led.failed("RH-FRM-1", f"the vehicle sent a command sentence ${sent.ID}", [ev], case)
+            fails.append(("RH-FRM-1", f"the vehicle sent a command sentence ${sent.ID}"))
+            self._book(d.raw, d, fails, ev, case)
             return None
         cls = type(sent)
         key = (cls, not d.findings, sent.field_count if cls is s.OSI else 0)
@@ -187,7 +211,9 @@ class OutputJudge:
         if passes is None:
             passes = _PASSES[key] = _passes(sent, d)
         led.passed_all(passes, [ev], case)
-        if d.terminator == "\r\n" and not d.findings and d.raw.isascii():  # judged by its bytes alone
+        if fails:
+            self._book(d.raw, d, fails, ev, case)
+        elif d.terminator == "\r\n" and not d.findings and d.raw.isascii():  # judged by its bytes alone
             if len(self._clean) >= LINE_CACHE:
                 self._clean.clear()
             self._clean[d.raw] = (sent, passes)
@@ -203,9 +229,9 @@ class OutputJudge:
             why = f"{err.message} (the form is $C<hdg>P<pitch>R<roll>T<temp>D<depth>, no commas)"
         return clause, why
 
-    def _partial(self, d: Decoded, ev: Evidence, case: str) -> Optional[s.Reply]:
-        """A reply with bad fields (module docstring): each fails its own clause; an ``$OSI`` whose
-        state fields were read is returned, the bad fields ``None`` in it."""
+    def _partial(self, d: Decoded, ev: Evidence, case: str, fails: list) -> Optional[s.Reply]:
+        """A reply with bad fields (module docstring): each fails its own clause (into ``fails``);
+        an ``$OSI`` whose state fields were read is returned, the bad fields ``None`` in it."""
         sent = d.partial
         read = isinstance(sent, s.OSI) and not d.unread & STATE_FIELDS
         failed = set()
@@ -217,7 +243,7 @@ class OutputJudge:
                     self.read_anyway.clear()
                 self.read_anyway.add((clause, reason))
             failed.add(clause)
-            self.ledger.failed(clause, reason, [ev], case)
+            fails.append((clause, reason))
         # what the line does show: its frame, and the rules no field of it breaks
         self.ledger.passed_all(tuple((c, "the other fields in their form and range" if c.startswith("RH-OUT") else r)
                                      for c, r in _passes(sent, d) if c not in failed), [ev], case)
@@ -239,19 +265,3 @@ class OutputJudge:
                                        f"vehicle sends 7{kind[0].upper()}1, not 8N1 (bit 7 cleared, the line "
                                        f"reads {escape(low.rstrip(bytes((13, 10))))[:80]})", [ev], case)
         return True
-
-    def _prefix(self, ev: Evidence, case: str) -> None:
-        """RH-FRM-1: the same bytes before reply after reply are the vehicle's (or a modem's)."""
-        before, self.noise_before = self.noise_before, None
-        if before is None:
-            self.prefix, self.prefix_count = None, 0
-            return
-        if before == self.prefix:
-            self.prefix_count += 1
-        else:
-            self.prefix, self.prefix_count = before, 1
-        if self.prefix_count >= PREFIX_REPEAT and not self.prefix_reported:
-            self.prefix_reported = True
-            self.ledger.failed("RH-FRM-1", f"{self.prefix_count} replies in a row are preceded by the same "
-                                           f"bytes {escape(before)!r} (a vehicle or modem prefix, not line "
-                                           f"noise)", [ev], case)

@@ -19,9 +19,21 @@
 * the one ledger it writes to, with clause attribution by :mod:`.blame` (findings inside a case
   are booked on the clauses the case is about).
 
-Notes it acts on (:mod:`helmcheck.judge.wire`): ``case``/``case … end`` (attribution),
-``not tested``/``inconclusive`` (tester facts), ``link:`` (RH-FRM-9), ``plant:`` and
-``fault injected`` (exact plant events from an emulator's own log).
+* **a faulty line** (``docs/contracts.md``, "A faulty line"): an error the line could have caused
+  — a broken vehicle line (its form: :mod:`helmcheck.judge.spoil`), bytes that frame into
+  nothing, a lost or late ``$ACK``, a reply left incomplete by a broken line — is held
+  (:mod:`helmcheck.judge.streaks`) until the observation is made again: the same command re-sent,
+  the same sentence read again. Made again clean, it was the line's (counted, not judged); the
+  same error again, as often as its form needs, it is the vehicle's; never made again (the case
+  or the record ends), INCONCLUSIVE naming what the line may have done. :attr:`Sent.spoil` tells
+  a live driver which observation to make again. A record that carries a line-fault relay's
+  notes (:mod:`helmcheck.judge.linefaults`) is judged exactly: what a note touched is the line's,
+  what none touched is the vehicle's.
+
+Notes it acts on (:mod:`helmcheck.judge.wire`): ``case``/``case … end`` (attribution; a case's
+end concludes what it held), ``not tested``/``inconclusive`` (tester facts), ``link:``
+(RH-FRM-9), ``plant:`` and ``fault injected`` (exact plant events from an emulator's own log),
+``line fault …`` and ``relay started:`` (a line-fault relay's record).
 
 A driver reads, besides the ledger: :attr:`sent` (every classified backseat line, with its
 outcome — the handle a live driver waits on), :attr:`last_osi`, :meth:`deadline` and
@@ -30,6 +42,7 @@ outcome — the handle a live driver waits on), :attr:`last_osi`, :meth:`deadlin
 
 from __future__ import annotations
 
+import re
 from collections import deque
 from typing import Optional
 
@@ -39,6 +52,9 @@ from ...grammar.wirelog import escape
 from ...model import plant as P
 from ...profile import Profile
 from ..ledger import Evidence, Ledger, Reason
+from ..linefaults import LineFaults
+from ..spoil import REPEAT, explain, explain_discard, signature
+from ..streaks import OTHER_REPEAT, Streaks
 from ..timing import JITTER_S
 from ..wire import FROM_VEHICLE, LINE_CACHE, NOTE, TO_VEHICLE, Decodings, WireEvent, parse_note
 from . import osichecks
@@ -47,7 +63,7 @@ from .answers import Answers
 from .blame import targets
 from .catalog import GivenMissions, KnownMissions
 from .deadlines import Deadlines
-from .lines import Kind, OutputJudge, classify
+from .lines import PREFIX_REPEAT, Kind, OutputJudge, classify
 from .sent import Sent, class_of_id, text_of
 
 __all__ = ["VehicleObserver", "Sent"]
@@ -58,6 +74,21 @@ _PLANT = {"WaypointReached": P.WaypointReached, "OnStation": P.OnStation,
 _new_tuple = tuple.__new__
 _DATA_OF = {"G": "GPRMC", "C": "Compass", "S": "OSI", "P": "OPI", "D": "DVL", "Y": "OYSI", "T": "OCTD",
             "I": "OINS"}
+_OUT_ID = re.compile(rb"\$?([A-Z]+)(?:,([0-9]{1,3}))?")
+#: What a lost answer may be, when nothing else says (the line's bytes to the vehicle are not seen)
+LOST = "no $ACK: the line may have lost the command or its $ACK"
+
+
+def out_key(raw: bytes) -> tuple:
+    """The observation a vehicle line is, to know it again: its ID as read (and an ``$ACK``'s
+    type), or ``?`` when none can be read."""
+    m = _OUT_ID.match(raw)
+    if m is None:
+        return ("out", "?")
+    sid = m.group(1).decode()
+    if sid == "ACK":
+        return ("out", "ACK", (m.group(2) or b"?").decode())
+    return ("out", sid)
 
 
 class VehicleObserver(Answers, Deadlines):
@@ -75,6 +106,14 @@ class VehicleObserver(Answers, Deadlines):
         self.missions = GivenMissions(catalog) if catalog is not None else KnownMissions(profile)
         self.beliefs = Beliefs(profile, self.missions, self.k)
         self.out = OutputJudge(ledger, profile)
+        self.out.holder = self._hold_out
+        #: observations a faulty line may have spoilt, held until made again (module docstring)
+        self.streaks = Streaks(ledger)
+        self.faults = LineFaults()  #: what a line-fault relay's notes say the line did
+        #: a command's bytes -> the latest sending of it answered in full, on time, nothing spoilt
+        self.clean_sendings: dict = {}
+        self.late_until = 0.0  #: when the latest late $ACK came (what was sent before may share its stall)
+        self._unit_fault: Optional[str] = None  #: the relay's note on the vehicle run being judged
         self.framers = {TO_VEHICLE: Framer(profile.max_line_bytes),
                         FROM_VEHICLE: Framer(max(4096, 4 * profile.max_line_bytes))}
         self.pending: deque[Sent] = deque()
@@ -132,6 +171,9 @@ class VehicleObserver(Answers, Deadlines):
             reason = f"{case}: {reason}"
         for cid in targets(candidates, clauses, stated):
             if verdict == "fail":
+                if at is not None and at.holding:  # the line may have spoilt it: held (module docstring)
+                    at.held.append((cid, reason, list(evidence), case))
+                    continue
                 self.ledger.failed(cid, reason, evidence, case)
             elif verdict == "inconclusive":
                 self.ledger.inconclusive(cid, reason, evidence, case)
@@ -209,9 +251,15 @@ class VehicleObserver(Answers, Deadlines):
         n = parse_note(ev.note)
         if n is None:
             return
-        if n.kind == "case":
+        if n.kind == "line-fault":
+            self.faults.note(ev.t, n.value)
+        elif n.kind == "relay":
+            self.faults.relay_started()
+        elif n.kind == "case":
             self.case, self.case_clauses = n.case, n.clauses
         elif n.kind == "case-end":
+            if self.streaks:
+                self.streaks.conclude("the case ended before it was made again")
             self.case, self.case_clauses = "", ()
         elif n.kind in ("not-tested", "inconclusive"):
             for cid in n.clauses:
@@ -267,9 +315,12 @@ class VehicleObserver(Answers, Deadlines):
             if self.after_discard and k.kind in ("command", "error") and not k.variant:
                 k = Kind(k.kind, k.item, k.ack_type, variant="RH-FRM-7")
             self.after_discard = False
+        if self.faults.instrumented:
+            self.faults.take(TO_VEHICLE)  # what the vehicle got, as recorded: judged as it is
         self.seq += 1
         sent = Sent(self.seq, ev.t, raw, self._evidence(ev, raw, ">"), k, self.case, self.case_clauses,
                     self.vbytes)
+        sent.mark = self.streaks.mark()
         self.sent.append(sent)
         if k.kind in ("command", "error"):
             if self.first_command_t is None:
@@ -290,6 +341,8 @@ class VehicleObserver(Answers, Deadlines):
 
     # ------------------------------------------------------------------ vehicle lines
     def _vehicle(self, fe, ev: WireEvent) -> None:
+        if self.faults.instrumented:
+            self._unit_fault = self.faults.take(FROM_VEHICLE)
         if isinstance(fe, Discard):
             self.out.discard(fe.raw, fe.length, fe.clause, self._evidence(ev, fe.raw, "<"), self.case)
             return
@@ -299,9 +352,14 @@ class VehicleObserver(Answers, Deadlines):
                 and not d.error.clause.startswith("RH-FRM") and self._invalid_ack(fe.raw, evd)):
             # a malformed $ACK answering a line the vehicle must discard: booked on that line's
             # clause (whatever else is wrong with the answer); the bytes before it are still read
-            self.out._prefix(evd, self.case)
+            self.out.before_line, self.out.noise_before = self.out.noise_before, None
             return
         sent = self.out.line(d, evd, self.case)
+        if self.streaks and d.sentence is not None and not d.findings and d.terminator == "\r\n":
+            # the sentence read whole: what was held for it (and for the bytes before it) was the line's
+            self.streaks.clean(out_key(fe.raw))
+            if self.out.before_line is None:
+                self.streaks.clean(("junk",))
         if sent is not None:
             self.alive_t = ev.t
             if self.dead or self.quiet:
@@ -320,6 +378,37 @@ class VehicleObserver(Answers, Deadlines):
                                                                       "OYSI", "OCTD", "OINS"):
             self._data(None, class_of_id(d.sentence_id), ev.t, evd)
 
+    def _hold_out(self, raw: bytes, d, fails: list, ev: Evidence, case: str, discard: str) -> bool:
+        """The failures of a broken vehicle run, held until it is read again (module docstring):
+        False when they are booked at once (a line-fault relay's record in which no note touched it)."""
+        fault, self._unit_fault = self._unit_fault, None
+        if self.faults.instrumented and fault is None:
+            return False  # the relay says the line did nothing to it: what it is, the vehicle sent
+        junk = d is None and raw[:1] != b"$"
+        key = ("junk",) if junk else out_key(raw)
+        if fault is not None:
+            text, sig, need = f"the line touched it (the relay's note: {fault})", ("note",), REPEAT
+        else:
+            sig = ("junk", raw[:32]) if junk else (signature(raw, d) if d is not None else ("discard", discard))
+            spoil = None
+            if not self.streaks.proven(key, sig):
+                spoil = explain_discard(raw, discard, "", self.profile) if d is None else explain(raw, self.profile, d)
+            if junk:
+                text, need = spoil.text if spoil is not None else "bytes between lines", PREFIX_REPEAT
+            elif spoil is not None:
+                text, need = spoil.text, REPEAT
+            else:
+                text, need = "a broken line (of a form no one fault of a line gives)", OTHER_REPEAT
+        findings = [(cid, reason, [ev], case) for cid, reason in fails]
+        owners = tuple(q.raw for q in self.pending)
+        held = self.streaks.hold(key, sig, text, findings, need=need, owners=owners, known=fault is not None)
+        if held is not None:
+            for q in self.pending:
+                q.spoils.append((text, need, fault is not None, sig))
+                if not q.spoil:
+                    q.spoil = text
+        return True
+
     def _processed(self, upto: "Sent", t: float) -> None:
         """Commands sent before ``upto`` that the vehicle is answering: it has processed them
         (RH-ACK-6), answered or not; the unanswered ones go into the mirror unanswered."""
@@ -332,11 +421,16 @@ class VehicleObserver(Answers, Deadlines):
 
     def _data(self, sentence, cls: str, t: float, evd: Evidence) -> None:
         """A data sentence: it belongs to the oldest ``$OSD`` still waiting (RH-ACK-5)."""
-        p = None
-        for q in self.pending:
+        p = first = None  # the oldest $OSD waiting that no later command's ACK overtook (RH-ACK-6:
+        for q in self.pending:  # an $OSD overtaken was processed before it, its data before its ACK)
             if q.kind.ack_type == 8:
-                p = q
-                break
+                if not q.overtaken:
+                    p = q
+                    break
+                if first is None:
+                    first = q
+        if p is None:
+            p = first
         if p is not None:
             self._processed(p, t)
         if p is None:
@@ -377,6 +471,7 @@ class VehicleObserver(Answers, Deadlines):
                                                  f"be read ({what})", [p.ev], p.case)
         for q in self.silent:
             q.state = "silent"
+        self.streaks.conclude("the run was interrupted before it was made again")
         self.pending.clear()
         self.silent.clear()
         self.dead.clear()
@@ -419,6 +514,7 @@ class VehicleObserver(Answers, Deadlines):
             if p.ack is None and p.late_booked and not p.missing_booked:
                 p.missing_booked = True
                 self._book_missing(p)
+        self.streaks.conclude("the record ended before it was made again")
         self._mission_unshown("the record ended")
         self.checks.close()
         if self.ledger.holding:

@@ -43,6 +43,15 @@ class Sent:
     branched: bool = False  #: a later command was answered first: taken into the mirror unanswered
     late_booked: bool = False  #: RH-ACK-2 booked: no ACK by the give-up deadline
     missing_booked: bool = False  #: RH-ACK-1 booked: no ACK at all
+    #: a faulty line may have spoilt what answered it (:mod:`helmcheck.judge.streaks`): what it may
+    #: have done, for the tester to make the observation again ("" when nothing was spoilt)
+    spoil: str = ""
+    spoils: list = field(default_factory=list)  #: (what the line may have done, a relay's note) per run
+    holding: bool = False  #: its violations are held, not booked (they go to :attr:`held`)
+    held: list = field(default_factory=list)  #: (clause, reason, evidence, case) held
+    held_item: object = None  #: the :class:`~helmcheck.judge.streaks.Held` its findings went to
+    mark: int = 0  #: the streaks' order when it was sent
+    late_text: str = ""  #: why its late ``$ACK`` may be the line's (a stall)
 
     @property
     def done(self) -> bool:
