@@ -74,7 +74,7 @@ class Streaks:
     def is_open(self, key: Hashable) -> bool:
         return key in self._held
 
-    def awaits(self, owner: bytes) -> bool:
+    def awaits(self, owner: Hashable) -> bool:
         """Something is held that a re-run of the command ``owner`` would make again: the command's
         own observation, or a reply held for it."""
         if ("cmd", owner) in self._held:
@@ -153,7 +153,7 @@ class Streaks:
         self._dismiss(items)
         return len(items)
 
-    def clean_owned(self, owner: bytes, before: int) -> int:
+    def clean_owned(self, owner: Hashable, before: int) -> int:
         """The command ``owner`` was answered again in full: the replies held for its earlier
         sendings (held before ``before``) were made again."""
         n = 0

@@ -168,8 +168,10 @@ class Session:
         if self.ignore:
             got = [f for f in got if f[0] not in self.ignore]
         read = self.obs.out.read_anyway
-        if read:  # a bad field of a report still read is no cause of what follows (judge.vehicle.lines)
-            got = [f for f in got if f[0] in self.case_clauses or f not in read]
+        if read:  # a bad field of a report still read is no cause of what follows (judge.vehicle.lines;
+            # booked after the repetition rule held it, its reason says so after it)
+            got = [f for f in got if f[0] in self.case_clauses
+                   or not any(f[0] == c and f[1].startswith(r) for c, r in read)]
         if got and self.stop_on_fail:
             cid, reason = got[0]
             raise CaseStop("fail", f"{cid}: {reason}", cid)
@@ -199,7 +201,7 @@ class Session:
         sent = self._exchange_once(raw)
         self.reruns = 0
         while (sent is not None and sent.spoil and self.reruns < RERUNS and _rerunnable(sent)
-               and self.obs.streaks.awaits(sent.raw)):
+               and self.obs.awaits(sent)):
             self.reruns += 1
             self.note(f"re-run {self.reruns} of {RERUNS}: {_line_text(raw)}: {sent.spoil}")
             sent = self._exchange_once(raw)
@@ -307,8 +309,8 @@ class Session:
         through :meth:`exchange` (its own re-runs as ever)."""
         done: set = set()
         for x in list(self.obs.sent):
-            if x.spoil and x.raw not in done and _rerunnable(x) and self.obs.streaks.awaits(x.raw):
-                done.add(x.raw)
+            if x.spoil and x.ident not in done and _rerunnable(x) and self.obs.awaits(x):
+                done.add(x.ident)
                 self.note(f"re-run of {_line_text(x.raw)}: {x.spoil}")
                 self.exchange(x.raw)
 
@@ -356,7 +358,7 @@ class Session:
             self._probe(hard)
         self.check()
         for i, x in enumerate(sents):  # what the line spoilt is made again, one by one
-            if x.spoil and _rerunnable(x) and self.obs.streaks.awaits(x.raw):
+            if x.spoil and _rerunnable(x) and self.obs.awaits(x):
                 self.note(f"re-run of {_line_text(x.raw)} from a burst: {x.spoil}")
                 again = self.exchange(x.raw)
                 if again is not None:

@@ -74,6 +74,9 @@ class Answers:
             del self.pending[idx]
             for i in range(idx):  # still waiting: an ACK that comes is out of order, none is missing
                 self.pending[i].overtaken = True
+            for q in self.gave_up:  # given up on, sent before it: an ACK that still comes came after
+                if q.ack is None and q.seq < p.seq:
+                    q.overtaken = True
             if p.overtaken:
                 self.book("fail", ("RH-ACK-6",), f"$ACK,{a.type} for {text_of(p)} came after the ACK of a "
                                                  f"later command (ACKs out of order)", [p.ev, evd], at=p)
@@ -205,31 +208,35 @@ class Answers:
     def answered_clean(self, p: Sent) -> None:
         """``p`` was answered in full and on time, nothing spoilt: its earlier sendings' held
         observations (and the replies held for them) were the line's."""
-        self.clean_sendings[p.raw] = p.seq
+        self.clean_sendings[p.ident] = p.seq
         if len(self.clean_sendings) > 512:
             self.clean_sendings.pop(next(iter(self.clean_sendings)))
         if self.streaks:
-            self.streaks.clean(("cmd", p.raw))
-            self.streaks.interrupt(("late",))  # an answer on time: late ones before it are not a run
-            self.streaks.clean_owned(p.raw, p.mark)
+            self.streaks.clean(("cmd", p.ident))
+            if p.t >= self.late_until:  # sent after the last late one came back, answered on time:
+                self.streaks.interrupt(("late",))  # late ones before it are not a run
+            self.streaks.clean_owned(p.ident, p.mark)
 
     def hold_command(self, p: Sent, sig: tuple, text: str, need: int, known: bool,
                      key: Optional[tuple] = None) -> None:
         """What ``p``'s answer would book, held under the command (module docstring) — or
         dismissed at once when a later sending of it was already answered in full."""
-        if key is None and self.clean_sendings.get(p.raw, 0) > p.seq:
+        if key is None and self.clean_sendings.get(p.ident, 0) > p.seq:
             self.streaks.made_again(text, p.held)
             p.held = []
             return
-        p.held_item = self.streaks.hold(key or ("cmd", p.raw), sig, text, p.held, need=need, known=known,
-                                        owners=(p.raw,))
+        p.held_item = self.streaks.hold(key or ("cmd", p.ident), sig, text, p.held, need=need, known=known,
+                                        owners=(p.ident,))
         p.held = []
         if p.held_item is not None:
             p.spoil = p.spoil or text
 
     def _late_text(self, p: Sent, dt: float) -> Optional[str]:
-        """Why an ``$ACK`` ``dt`` s late may be the line's (a stall held it), or None when a
-        relay's record shows the line did not hold it (then it is booked at once)."""
+        """Why an ``$ACK`` ``dt`` s late may be the line's (a stall held it), or None when it cannot
+        be (a later command's ``$ACK`` came first: a stall delays everything, in order; or a relay's
+        record shows the line did not hold it): then it is booked at once."""
+        if p.overtaken:  # a later command was answered first: a stall holds the line up in order
+            return None
         note = self.faults.held_between(p.t, p.t + dt)
         if note is not None:
             return f"the line held it (the relay's note: {note})"

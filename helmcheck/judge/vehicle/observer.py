@@ -400,7 +400,7 @@ class VehicleObserver(Answers, Deadlines):
             else:
                 text, need = "a broken line (of a form no one fault of a line gives)", OTHER_REPEAT
         findings = [(cid, reason, [ev], case) for cid, reason in fails]
-        owners = tuple(q.raw for q in self.pending)
+        owners = tuple(q.ident for q in self.pending)
         held = self.streaks.hold(key, sig, text, findings, need=need, owners=owners, known=fault is not None)
         if held is not None:
             for q in self.pending:
@@ -408,6 +408,10 @@ class VehicleObserver(Answers, Deadlines):
                 if not q.spoil:
                     q.spoil = text
         return True
+
+    def awaits(self, p: Sent) -> bool:
+        """Something is held that sending ``p`` again would make again (module docstring)."""
+        return bool(self.streaks) and self.streaks.awaits(p.ident)
 
     def _processed(self, upto: "Sent", t: float) -> None:
         """Commands sent before ``upto`` that the vehicle is answering: it has processed them

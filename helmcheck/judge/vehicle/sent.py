@@ -54,6 +54,12 @@ class Sent:
     late_text: str = ""  #: why its late ``$ACK`` may be the line's (a stall)
 
     @property
+    def ident(self) -> tuple:
+        """What makes a sending the same observation as another: its bytes, and the form a vehicle
+        must still read it in (after a torn line, RH-FRM-7, is not the same as on its own)."""
+        return (self.raw, self.kind.variant)
+
+    @property
     def done(self) -> bool:
         return self.state != "pending"
 
