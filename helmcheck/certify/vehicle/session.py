@@ -321,18 +321,24 @@ class Session:
         answer), up to :data:`~helmcheck.judge.spoil.RERUNS` times."""
         self.link.sleep(max(0.0, after - self.now()))
         self.note("liveness probe")
+        alive = False
         for _ in range(RERUNS + 1):
+            self.link.drain()
             probe = self.send(frame("OSD,S"))
             while probe is not None and not probe.done:  # until the observer gives up on it (exchange)
                 end = self.obs.give_up_at(probe) + 0.05
                 if self.now() >= end:
                     break
                 self.link.next(end)
-            if probe is not None and probe.ack is not None:
+            alive = ((probe is not None and probe.ack is not None)
+                     or (self.obs.alive_t is not None and self.obs.alive_t >= (probe.t if probe else self.now())))
+            if alive and not (probe is not None and probe.spoil and self.obs.awaits(probe)):
                 return
-            if self.obs.alive_t is not None and self.obs.alive_t >= (probe.t if probe else self.now()):
-                return
-            # nothing, or nothing that reads: the line may have lost the probe or its answer
+            # nothing, nothing that reads, or an answer the line spoilt: asked again
+            if alive:
+                self.note(f"re-run of the liveness probe: {probe.spoil}")
+        if alive:
+            return  # alive, its answers spoilt every time: held by the observer, INCONCLUSIVE at worst
         raise LinkSilent(f"the vehicle answered nothing at all for {self.now() - after:.1f} s "
                          f"(device off, wrong port or baud?)")
 
