@@ -7,6 +7,7 @@ produce (backseat bytes ``>``, vehicle bytes ``<``, notes ``!``) and reads the v
 
 from __future__ import annotations
 
+import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
@@ -14,6 +15,7 @@ from helmcheck.certify.backseat.scenarios import SCENARIOS, make_plan
 from helmcheck.grammar import checksum_hex
 from helmcheck.judge import Ledger, WireEvent
 from helmcheck.judge.backseat import BS_CLAUSES, POLL_INTERVAL_S, BackseatObserver, line_budget
+from helmcheck.judge.spoil import REPEAT
 from helmcheck.judge.timing import JITTER_S, transmit_time
 from helmcheck.profile import DEFAULT
 
@@ -136,26 +138,46 @@ def test_rh_bs_4_coarse_timestamps_are_inconclusive_only_when_they_cannot_bound_
 
 # ------------------------------------------------------------------ RH-BS-1, -2, -7 per line
 
-def test_rh_bs_1_2_7_framing_fields_and_style_are_judged_per_line():
-    r = Run()
-    r.bs(0.0, POLL)
-    r.bs(0.5, b"$OSD,G,C,S,P,,,,*5E\r\n")  # wrong checksum: RH-BS-1
-    r.bs(0.6, b"$OSD,,,S,,,,,*B\r\n")  # unpadded: RH-BS-1
-    r.bs(0.7, frame("OMP,808088080,00,5"))  # nine hex digits: RH-BS-2
-    r.bs(0.8, frame("OSD,G,C,S,P,,,,", lower=True))  # lower-case hex: RH-BS-7
-    r.bs(0.9, frame("OSD,G,C,S,P,,,,", term=b"\n"))  # bare LF: RH-BS-7
-    r.bs(1.0, b"noise")
-    r.bs(1.1, POLL)  # the noise is discarded when '$' comes: RH-BS-1
-    r.bs(1.2, frame("OMS,400,3,20,2,10"))  # heading out of range: RH-BS-2
-    r.bs(1.3, b"$OMS,10.0,2.0")  # cut short by the end of the run: not judged
+#: (a line, the clause it breaks, the verdict): each judged on its own line
+BAD_LINES = [
+    (b"$OSD,G,C,S,P,,,,*5E\r\n", "RH-BS-1", "fail"),  # wrong checksum
+    (b"$OSD,,,S,,,,,*B\r\n", "RH-BS-1", "fail"),  # unpadded
+    (frame("OMP,808088080,00,5"), "RH-BS-2", "fail"),  # nine hex digits
+    (frame("OSD,G,C,S,P,,,,", lower=True), "RH-BS-7", "non-strict"),  # lower-case hex
+    (frame("OSD,G,C,S,P,,,,", term=b"\n"), "RH-BS-7", "non-strict"),  # bare LF
+    (frame("OMS,400,3,20,2,10"), "RH-BS-2", "fail"),  # heading out of range
+]
+
+
+@pytest.mark.parametrize("bad,clause,verdict", BAD_LINES)
+def test_rh_bs_1_2_7_framing_fields_and_style_are_judged_per_line(bad, clause, verdict):
+    """Sent the same way again and again (spoil.REPEAT times: a faulty line does not repeat its
+    damage), a broken line is the backseat's; once, then sent whole, it was the line's (counted,
+    not judged); once and never again, INCONCLUSIVE naming what the line may have done."""
+    r = Run().bs(0.0, POLL)
+    for i in range(REPEAT):
+        r.bs(0.5 + 0.1 * i, bad)
+    r.bs(1.5, b"$OMS,10.0,2.0")  # cut short by the end of the run: not judged
     r.close(2.0)
-    assert r.fails("RH-BS-1") == 3
-    assert r.fails("RH-BS-2") == 2
-    assert r.fails("RH-BS-7") == 2
-    v = r.verdicts()
-    assert v["RH-BS-1"] == v["RH-BS-2"] == "fail" and v["RH-BS-7"] == "non-strict"
-    ev = r.ledger.verdict("RH-BS-1").evidence[0]
-    assert (ev.t, ev.dir, ev.text, ev.lineno) == (0.5, ">", "$OSD,G,C,S,P,,,,*5E", 2)
+    assert r.fails(clause) == REPEAT and r.verdict(clause) == verdict
+    assert {c for c in ("RH-BS-1", "RH-BS-2", "RH-BS-7") if r.fails(c)} == {clause}
+    ev = r.ledger.verdict(clause).evidence[0]
+    assert (ev.t, ev.lineno) == (0.5, 2)
+    again = Run().bs(0.0, POLL).bs(0.5, bad).bs(0.6, frame("OMS,10.0,2.0,20.0,1.0,10")).bs(0.7, POLL)
+    again.bs(0.8, frame("OMP,8080808080,00,5")).close(2.0)
+    assert not again.fails(clause) and again.ledger.spoiled_count(clause) == 1
+    assert again.verdict(clause) == "pass", again.ledger.verdict(clause).reason
+    once = Run().bs(0.0, POLL).bs(0.5, bad).close(2.0)
+    assert once.verdict(clause) == "inconclusive" and "the line" in once.ledger.verdict(clause).reason
+
+
+def test_rh_bs_1_noise_is_the_backseats_when_it_comes_before_line_after_line():
+    r = Run().bs(0.0, POLL)
+    for i in range(REPEAT):
+        r.bs(0.5 + 0.1 * i, b"noise" + POLL)  # the noise is discarded when '$' comes: RH-BS-1
+    assert r.close(2.0).fails("RH-BS-1") == REPEAT
+    r = Run().bs(0.0, POLL).bs(0.5, b"noise" + POLL).bs(0.6, POLL).close(2.0)
+    assert r.verdict("RH-BS-1") == "pass"
 
 
 def test_rh_bs_1_a_line_keeps_the_time_and_log_line_of_its_first_byte():
@@ -166,7 +188,8 @@ def test_rh_bs_1_a_line_keeps_the_time_and_log_line_of_its_first_byte():
 
 
 def test_rh_bs_1_noise_left_at_the_end_of_the_run_is_judged():
-    assert Run().bs(0.0, POLL).bs(0.5, b"xx\x00").close(1.0).fails("RH-BS-1") == 1
+    r = Run().bs(0.0, POLL).bs(0.5, b"xx\x00").close(1.0)
+    assert r.verdict("RH-BS-1") == "inconclusive" and "between lines" in r.ledger.verdict("RH-BS-1").reason
 
 
 @given(st.lists(st.sampled_from([POLL, b"$OSD,,,S,,,,,*B\r\n", frame("OMP,808088080,00,5"),
@@ -445,7 +468,10 @@ def test_results_document_strict_and_partial():
     from helmcheck.judge.runfacts import RunFacts
     from helmcheck.reports.results import exit_code, validate
 
-    r = Run().bs(0.0, frame("OSD,G,C,S,P,,,,", lower=True)).close(1.0)
+    r = Run()
+    for i in range(REPEAT):  # the backseat's own (a faulty line does not repeat itself)
+        r.bs(0.1 * i, frame("OSD,G,C,S,P,,,,", lower=True))
+    r.close(1.0)
     for strict, verdict, code in ((False, "non-strict", 0), (True, "fail", 1)):
         doc = build_results(RunRecord("complete", "the run completed", r.o, 0.0, 1.0, 1.0), profile=DEFAULT,
                             settings={"strict": strict, "time_scale": 1.0}, command="x", port="pty",
@@ -453,7 +479,7 @@ def test_results_document_strict_and_partial():
         assert not validate(doc) and doc["role"] == "backseat"
         assert doc["verdict"] == verdict and exit_code(verdict, strict) == code
         bs7 = next(c for c in doc["clauses"] if c["id"] == "RH-BS-7")
-        assert bs7["offending_count"] == 1 and bs7["evidence"][0]["line"] == "line 1: $OSD,G,C,S,P,,,,*5f"
+        assert bs7["offending_count"] == REPEAT and bs7["evidence"][0]["line"] == "line 1: $OSD,G,C,S,P,,,,*5f"
     # a cut-short run records why in its wire log (``run partial:``), and the results follow the record
     why = "the backseat closed the port or crashed after 0.5 s"
     cut = build_results(RunRecord("disconnected", why, r.o, 0.0, 1.0, 10.0, facts=RunFacts(partial=why)),

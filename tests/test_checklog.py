@@ -55,7 +55,9 @@ def test_faulty_vehicle_flagged_with_line_numbers():
     assert b["RH-SRV-4"] == [26]  # still A after the 5 s servo timeout
     assert b["RH-OUT-4"] == [26]
     assert "RH-INT-2" not in b  # control never ended: what it resumes is not in question
-    assert b["RH-BS-2"] == [15]  # the backseat's own range error, too
+    # the backseat's range error, once, then $OMS sent whole: a faulty line could have made it (two
+    # flips of one bit, which the checksum cannot see) — not judged, and counted (judge.streaks)
+    assert "RH-BS-2" not in b and "1 observation(s) a faulty line may have spoilt" in verdicts(out)["RH-BS-2"]["reason"]
     ev = verdicts(out)["RH-ACK-3"]["evidence"]
     assert ev[0]["line"].startswith("line 15: $OMS,400") and ev[1]["line"].startswith("line 16: $ACK,9,1,21")
 
@@ -63,10 +65,10 @@ def test_faulty_vehicle_flagged_with_line_numbers():
 def test_faulty_backseat_flagged_with_line_numbers():
     out = check_log(LOGS / "backseat_faults.log", profile=PROFILE)
     b = bad(out)
-    assert b["RH-BS-1"] == [6]  # unpadded checksum *7
-    assert b["RH-BS-3"] == [7, 9]  # $OMS before a mission runs
-    assert 9 in b["RH-BS-5"] and 20 in b["RH-BS-5"]  # quick resend; $OMP during the lockout
-    assert len(b["RH-BS-4"]) >= 1 and b["RH-BS-4"][0] > 25  # the $OPOS flood
+    assert b["RH-BS-1"] == [6, 7, 8, 9]  # unpadded checksum *7, every time
+    assert b["RH-BS-3"] == [10, 12]  # $OMS before a mission runs
+    assert 12 in b["RH-BS-5"] and 23 in b["RH-BS-5"]  # quick resend; $OMP during the lockout
+    assert len(b["RH-BS-4"]) >= 1 and b["RH-BS-4"][0] > 28  # the $OPOS flood
     v = verdicts(out)
     assert v["RH-BS-5"]["verdict"] == "non-strict"  # a SHOULD
     assert v["RH-SAF-1"]["verdict"] == "pass"  # the vehicle answered 26 during the lockout
@@ -77,7 +79,8 @@ def test_unreadable_lines_are_findings():
     assert out.findings[0]["line"] == 6
     v = verdicts(out)
     assert v["RH-FRM-1"]["verdict"] == "inconclusive" and 6 in v["RH-FRM-1"]["lines"]
-    assert v["RH-BS-1"]["verdict"] == "fail" and v["RH-BS-1"]["lines"] == [10]  # noise bytes
+    # noise bytes, once: a faulty line's, perhaps (judge.streaks): not judged, and said so
+    assert v["RH-BS-1"]["verdict"] == "inconclusive" and 10 in v["RH-BS-1"]["lines"]
 
 
 def test_one_direction_log_says_so():

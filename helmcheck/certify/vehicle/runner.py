@@ -2,7 +2,8 @@
 
 :func:`certify` opens the port, records a ``link:`` note (the line's settings, RH-FRM-9), checks
 that something answers (a link that carries nothing, or only garbage, is INCONCLUSIVE with the
-reason), checks that the vehicle's clock runs at the declared time scale (:mod:`.clockprobe`: a
+reason; garbage that reads as sentences at another common baud rate names it, with the option
+to run with), checks that the vehicle's clock runs at the declared time scale (:mod:`.clockprobe`: a
 clear mismatch stops the run INCONCLUSIVE, naming both rates), runs the selected clause cases
 in order (:mod:`.interpreter`), then the hypothesis exploration (:mod:`.explore`), and writes
 ``DIR/results.json`` after every case (:mod:`.resultsfile`) — atomically, so a crash or Ctrl-C
@@ -110,6 +111,25 @@ class Options:
     #: timing coarser than nominal (:data:`~helmcheck.judge.linebudget.NOMINAL_WIDENING_S`), naming
     #: the time scale that would not (:class:`CoarseTiming`); ``"any"``: judge with what the line gives
     precision: str = "any"
+
+
+#: ``$OSD,S`` requests the link check sends more when the first two get only garbage, and the
+#: bytes it would like to read a baud rate from (:func:`garbage_reason`)
+PROBE_MORE = 6
+PROBE_BYTES = 120
+
+
+def garbage_reason(captured: bytes, count: int, port: str, baud: int) -> str:
+    """Why a link that carries only garbage is a link fault: the baud rate that would make the
+    bytes sentences when one stands out (:func:`~helmcheck.line.baudguess.guess_baud`), with the
+    option to run with; else what was seen."""
+    from ...line.baudguess import guess_baud
+    g = guess_baud(captured, baud)
+    if g.baud is not None and g.baud != baud:
+        return (f"the vehicle's bytes read as sentences at {g.baud} baud, not {baud}: run with --baud {g.baud} "
+                f"({count} bytes from {port}, none a valid sentence at {baud})")
+    return (f"{count} bytes from {port}, none of them a valid sentence at {baud} baud (garbage: {g.reason}; "
+            f"not a remote-helm vehicle, or a line too noisy to read?)")
 
 
 def selected_ids(select: Optional[list]) -> list[str]:
@@ -231,18 +251,25 @@ class Run(ExecChild):
         self.progress.alert(text)
 
     def probe(self) -> None:
-        """Does anything answer? Nothing at all, or only garbage, is a link fault."""
+        """Does anything answer? Nothing at all, or only garbage, is a link fault. Garbage is
+        asked a few more times and read for the baud rate that would make it sentences
+        (:func:`helmcheck.line.baudguess.guess_baud`): a wrong ``--baud`` is named, with the one to
+        run with."""
         link = self.link
         assert link is not None
         link.sleep(0.05)
         link.drain()
-        for _ in range(2):
+        captured = bytearray()
+        for attempt in range(2 + PROBE_MORE):
+            if attempt >= 2 and (link.bytes_in == 0 or len(captured) >= PROBE_BYTES):
+                break  # silent, or enough garbage to read the rate from
             link.send(frame("OSD,S"))
             end = link.now() + self.p.ack_window_s + 0.5
             while True:
                 rx = link.next(end)
                 if rx is None:
                     break
+                captured += rx.raw
                 if self.observer.alive_t is not None:
                     link.sleep(0.1)
                     link.drain()
@@ -251,8 +278,9 @@ class Run(ExecChild):
         if link.bytes_in == 0:
             raise LinkSilent(f"no bytes at all from {self.o.port} in {link.now():.1f} s: is a vehicle on "
                              f"this port, powered, at {self.p.baud} baud?")
-        raise LinkLost(f"{link.bytes_in} bytes from {self.o.port}, none of them a valid sentence "
-                       f"(garbage: wrong baud or not a remote-helm vehicle?)")
+        why = garbage_reason(bytes(captured), link.bytes_in, self.o.port, self.p.baud)
+        self.stopped = why  # the verdict's first words: what to change
+        raise LinkLost(why)
 
     def _found(self) -> None:
         """What the vehicle was found in (:mod:`.restore`): its mode, and in ``S`` its settings."""

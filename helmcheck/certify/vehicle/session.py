@@ -15,7 +15,8 @@ into the ledger. The session only decides what to send next and how long to wait
   why: a clean answer makes the spoilt one the line's, the same error every time makes it the
   vehicle's (the observer's repetition rule, :mod:`helmcheck.judge.streaks`). A command whose
   second sending would change what the first did (``$OMW`` appends to the queue) is not sent
-  again: what the line spoilt of it stays INCONCLUSIVE. When the observer has booked a failure inside
+  again, and neither is a :meth:`Session.burst` (its point is when its commands arrive): what the
+  line spoilt of them stays INCONCLUSIVE. When the observer has booked a failure inside
   the present case, the case stops (:class:`~.flow.CaseStop`): the first fail is the root cause —
   except a bad field of a report the observer still read (RH-OUT-1/3 on one field of an ``$OSI``,
   :mod:`helmcheck.judge.vehicle.lines`), which causes nothing after it, unless the case is about
@@ -44,7 +45,7 @@ from typing import Callable, Optional
 from ...grammar import checksum_hex
 from ...grammar import sentences as s
 from ...judge.spoil import RERUNS
-from ...judge.timing import ack_allowance, ack_give_up_after, tolerance
+from ...judge.timing import ack_allowance, tolerance
 from ...judge.vehicle import Sent, VehicleObserver
 from ...judge.wire import case_end_note, case_note, tester_note
 from ...profile import Profile
@@ -352,24 +353,17 @@ class Session:
         t = self.link.send(b"".join(raws))
         self._trace({"send": _esc(b"".join(raws)), "t": round(t, 6)})
         sents = [x for x in self.obs.sent if x.seq > seq]
-        allowance = ack_allowance(self.profile.ack_window_s, sum(map(len, raws)), 0, self.profile.baud)
-        hard = t + ack_give_up_after(allowance) * len(raws) + 0.05
-        while any(not x.done for x in sents):
-            if self.link.next(hard) is None:
+        while any(not x.done for x in sents):  # until each is answered or the observer gave up on it
+            hard = max(self.obs.give_up_at(x) for x in sents if not x.done) + 0.05
+            if self.link.next(hard) is None and self.now() >= hard:
                 break
         for x in sents:
             if x.done:
                 self._sample(x)
         if any(not x.done for x in sents):
             self._probe(hard)
-        self.check()
-        for i, x in enumerate(sents):  # what the line spoilt is made again, one by one
-            if x.spoil and _rerunnable(x) and self.obs.awaits(x):
-                self.note(f"re-run of {_line_text(x.raw)} from a burst: {x.spoil}")
-                again = self.exchange(x.raw)
-                if again is not None:
-                    sents[i] = again
-        return sents
+        self.check()  # a burst is about its timing (a lockout's commands): what the line spoilt of
+        return sents  # it is not made again later (it stays INCONCLUSIVE unless sent again)
 
     def poll(self) -> s.OSI:
         """``$OSD,S`` and the ``$OSI`` the observer judged."""

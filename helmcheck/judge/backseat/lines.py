@@ -13,6 +13,16 @@
   model would refuse (:func:`helmcheck.model.validate.field_error`) fails.
 * **RH-BS-7** (SHOULD) — upper-case checksum hex and CR LF: a grammar finding on the line
   (lower-case hex, bare LF) is a violation; every other line meets it.
+
+A faulty line between the backseat and the vehicle breaks lines the backseat wrote whole, so a
+broken line's violations are held, not booked (``docs/contracts.md``, "A faulty line"; the
+repetition rule, :mod:`helmcheck.judge.streaks`, and the damage's form,
+:mod:`helmcheck.judge.spoil`): the next line of the same sentence read whole makes them the
+line's; the same error on the backseat's next lines of that sentence, as often as its form
+needs, makes them the backseat's; a line never sent again leaves them INCONCLUSIVE, naming what
+the line may have done. Bytes that frame into nothing are held the same way (the same bytes
+before line after line are the backseat's). In a line-fault relay's record (its notes,
+:mod:`helmcheck.judge.linefaults`) the line is known: what no note touched is booked at once.
 """
 
 from __future__ import annotations
@@ -21,6 +31,8 @@ from ...grammar import sentences as s
 from ...grammar.errors import FRAMING
 from ...model.validate import field_error
 from ..ledger import Ledger
+from ..spoil import REPEAT, explain, explain_discard, signature
+from ..streaks import OTHER_REPEAT, Streaks
 from .common import SentLine, Settings
 
 __all__ = ["LineRules"]
@@ -35,6 +47,11 @@ class LineRules:
         self.lines = 0
         self.commands = 0
         self._first = set()
+        self.streaks = Streaks(ledger)  #: broken lines held until the backseat sends the sentence again
+        #: the record carries a line-fault relay's notes, and the note on the line being judged
+        self.instrumented = False
+        self.fault: str | None = None
+        self._junk_before = False
 
     def _pass(self, cid: str, reason: str, line: SentLine) -> None:
         if cid in self._first:
@@ -43,37 +60,77 @@ class LineRules:
             self._first.add(cid)
             self.ledger.passed(cid, reason, [line.evidence()], self.s.case)
 
+    def _hold(self, line: SentLine, fails: list) -> None:
+        """A broken line's violations: held (module docstring), or booked at once."""
+        fault, self.fault = self.fault, None
+        case = self.s.case
+        if not fails:
+            return
+        if self.instrumented and fault is None:
+            for cid, reason in fails:
+                self.ledger.failed(cid, reason, [line.evidence()], case)
+            return
+        raw, d = line.raw, line.decoded
+        junk = d is None and raw[:1] != b"$"
+        key = ("bs-junk",) if junk else ("bs", line.sid or "?")
+        if fault is not None:
+            text, sig, need = f"the line touched it (the relay's note: {fault})", ("note",), REPEAT
+        else:
+            sig = ("junk", raw[:32]) if junk else (signature(raw, d) if d is not None
+                                                   else ("discard", line.discard.clause))
+            spoil = None if self.streaks.proven(key, sig) else (
+                explain_discard(raw, line.discard.clause, "", self.s.profile) if d is None
+                else explain(raw, self.s.profile, d))
+            if spoil is not None:
+                text, need = spoil.text, REPEAT
+            else:
+                text, need = "a broken line (of a form no one fault of a line gives)", OTHER_REPEAT
+        self.streaks.hold(key, sig, text, [(cid, reason, [line.evidence()], case) for cid, reason in fails],
+                          need=need, known=fault is not None)
+
     def discarded(self, line: SentLine) -> None:
         """RH-BS-1: bytes the framer threw away."""
         d = line.discard
-        self.ledger.failed("RH-BS-1", f"{d.length} byte(s) that are no sentence ({d.clause}: {d.reason})",
-                           [line.evidence()], self.s.case)
+        if line.raw[:1] != b"$":
+            self._junk_before = True
+        self._hold(line, [("RH-BS-1", f"{d.length} byte(s) that are no sentence ({d.clause}: {d.reason})")])
 
     def line(self, line: SentLine) -> None:
         d = line.decoded
-        led = self.ledger
-        case = self.s.case
+        fails: list = []
         self.lines += 1
+        junk, self._junk_before = self._junk_before, False
         if d.findings:
-            led.failed("RH-BS-7", str(d.findings[0]), [line.evidence()], case)
+            fails.append(("RH-BS-7", str(d.findings[0])))
         else:
             self._pass("RH-BS-7", "upper-case checksum hex and CR LF", line)
         err = d.error
         if err is not None:
             if err.kind == FRAMING:
-                led.failed("RH-BS-1", str(err), [line.evidence()], case)
+                fails.append(("RH-BS-1", str(err)))
             else:
                 self._pass("RH-BS-1", "well framed, correct checksum", line)
-                led.failed("RH-BS-2", str(err), [line.evidence()], case)
+                fails.append(("RH-BS-2", str(err)))
+            self._hold(line, fails)
             return
         self._pass("RH-BS-1", "well framed, correct checksum", line)
         cmd = d.sentence
-        if not isinstance(cmd, s.Command):
+        if isinstance(cmd, s.Command):
+            self.commands += 1
+            code = field_error(cmd, self.s.profile)
+            if code is not None:
+                fails.append(("RH-BS-2", f"${cmd.ID}: a field is out of range (a vehicle answers err {code})"))
+            else:
+                self._pass("RH-BS-2", f"${cmd.ID} fields within range", line)
+        if fails:
+            self._hold(line, fails)
             return
-        self.commands += 1
-        code = field_error(cmd, self.s.profile)
-        if code is not None:
-            led.failed("RH-BS-2", f"${cmd.ID}: a field is out of range (a vehicle answers err {code})",
-                       [line.evidence()], case)
-        else:
-            self._pass("RH-BS-2", f"${cmd.ID} fields within range", line)
+        self.fault = None
+        if self.streaks:  # the sentence read whole: what was held for it (and junk before it) was the line's
+            self.streaks.clean(("bs", line.sid))
+            if not junk:
+                self.streaks.clean(("bs-junk",))
+
+    def close(self) -> None:
+        """The record ended: what is still held is INCONCLUSIVE."""
+        self.streaks.conclude("the record ended before the backseat sent it again")

@@ -17,6 +17,10 @@ Dispatch:
   (:mod:`.reaction`); a line a vehicle answers waits for its ``$ACK`` (:class:`~.knowledge.Pending`);
 * vehicle bytes (``<``) — re-framed; each ``$OSI`` and ``$ACK`` is knowledge
   (:mod:`.knowledge`) from the time it had fully arrived; an ``$ACK`` answers a waiting command;
+* a faulty line: the backseat's broken lines are held until it sends the sentence again
+  (:mod:`.lines`); in a line-fault relay's record (``line fault …`` notes,
+  :mod:`helmcheck.judge.linefaults`) a report or answer the line broke on its way to the
+  backseat is not something the backseat could know;
 * notes (``!``, :func:`~helmcheck.judge.wire.parse_note`) — ``scenario X starts`` (findings
   then carry ``X`` as their case), ``lockout starts (<code>)`` / ``lockout ends``, ``silence
   starts`` / ``silence ends`` (no answer is expected meanwhile, and servo control is not
@@ -37,6 +41,7 @@ from ...grammar.wirelog import TO_VEHICLE_RUN, escape, is_line
 from ...profile import Profile
 from ..facts import LOCKOUT_REFUSED, NEEDS_MISSION, NEEDS_RUNNING, NEEDS_STOPPED
 from ..ledger import Evidence, Ledger
+from ..linefaults import LineFaults
 from ..timing import ack_allowance, ack_give_up_after
 from ..wire import FROM_VEHICLE, NOTE, TO_VEHICLE, Decodings, WireEvent, parse_note
 from .budget import LineBudget
@@ -102,6 +107,7 @@ class BackseatObserver:
         self.max_wait = ack_give_up_after(ack_allowance(profile.ack_window_s, profile.max_line_bytes, 1024,
                                                         st.baud, st.resolution))
         self.silent = False
+        self.faults = LineFaults()  #: what a line-fault relay's notes say the line did
         self.started: Optional[float] = None  #: time of the backseat's first byte
         self.ended: Optional[float] = None
 
@@ -147,6 +153,7 @@ class BackseatObserver:
                 ep.end = t
             self.reaction.episode_over(ep)
         self.reaction.close()
+        self.lines.close()
         self.pending.clear()
         for cid, why in _NOT_TESTED.items():
             self.ledger.not_tested(cid, why)
@@ -180,12 +187,14 @@ class BackseatObserver:
         self.budget.record(ev.t, len(data), rec)
         if self._whole_line(self._framer, data):
             self._records.clear()
+            self._touched()
             self._line(SentLine(data, ev.t, ev.lineno, self._decode(data)))
             return
         self._records.append((self._offset, ev.t, ev.lineno))
         self._offset += len(data)
         for e in self._framer.feed(data):
             t, lineno = self._first_byte(e.offset)
+            self._touched()
             if isinstance(e, Discard):
                 self.lines.discarded(SentLine(e.raw, t, lineno, None, e))
                 self._consumed = e.offset + e.length
@@ -199,6 +208,12 @@ class BackseatObserver:
             recs.popleft()
         while len(recs) > 1:
             recs.pop()
+
+    def _touched(self) -> None:
+        """The relay's note on the backseat's run about to be judged (:mod:`.lines`)."""
+        if self.faults.instrumented:
+            self.lines.instrumented = True
+            self.lines.fault = self.faults.take(TO_VEHICLE)
 
     def _line(self, line: SentLine) -> None:
         self.pending.expire(line.t, self.max_wait)
@@ -225,13 +240,19 @@ class BackseatObserver:
         self.pending.expire(ev.t, self.max_wait)
         self.arrivals.record(ev.t, len(data))
         if self._whole_line(self._vframer, data):
-            self._report(data, ev.t, self.arrivals.arrival(len(data)))
+            if not self._spoilt():
+                self._report(data, ev.t, self.arrivals.arrival(len(data)))
             return
         base = self._voffset
         self._voffset += len(data)
         for e in self._vframer.feed(data):
-            if isinstance(e, Line):
+            if not self._spoilt() and isinstance(e, Line):
                 self._report(e.raw, ev.t, self.arrivals.arrival(e.offset + len(e.raw) - base))
+
+    def _spoilt(self) -> bool:
+        """A relay's note says the line broke the vehicle's run now framed, on its way to the
+        backseat: what the backseat got was not that report (it could not know from it)."""
+        return self.faults.instrumented and self.faults.take(FROM_VEHICLE) is not None
 
     def _report(self, raw: bytes, t: float, arrived: float) -> None:
         if raw[:5] not in _READ:  # nothing else tells the backseat what it could know
@@ -302,6 +323,10 @@ class BackseatObserver:
             self.servo.end(ev.t)
         elif n.kind == "silence-end":
             self.silent = False
+        elif n.kind == "line-fault":
+            self.faults.note(ev.t, n.value)
+        elif n.kind == "relay":
+            self.faults.relay_started()
         elif n.kind == "link" and n.value:
             st.baud = int(n.value)
             self.arrivals.baud = st.baud

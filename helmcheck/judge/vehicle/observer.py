@@ -114,6 +114,7 @@ class VehicleObserver(Answers, Deadlines):
         self.clean_sendings: dict = {}
         self.late_until = 0.0  #: when the latest late $ACK came (what was sent before may share its stall)
         self._unit_fault: Optional[str] = None  #: the relay's note on the vehicle run being judged
+        self._junk_wait: Optional[tuple] = None  #: bytes between lines, waiting for what follows them
         self.framers = {TO_VEHICLE: Framer(profile.max_line_bytes),
                         FROM_VEHICLE: Framer(max(4096, 4 * profile.max_line_bytes))}
         self.pending: deque[Sent] = deque()
@@ -258,6 +259,7 @@ class VehicleObserver(Answers, Deadlines):
         elif n.kind == "case":
             self.case, self.case_clauses = n.case, n.clauses
         elif n.kind == "case-end":
+            self._junk_settle(False)
             if self.streaks:
                 self.streaks.conclude("the case ended before it was made again")
             self.case, self.case_clauses = "", ()
@@ -355,6 +357,8 @@ class VehicleObserver(Answers, Deadlines):
             self.out.before_line, self.out.noise_before = self.out.noise_before, None
             return
         sent = self.out.line(d, evd, self.case)
+        if self._junk_wait is not None:
+            self._junk_settle(d.sentence is not None)
         if self.streaks and d.sentence is not None and not d.findings and d.terminator == "\r\n":
             # the sentence read whole: what was held for it (and for the bytes before it) was the line's
             self.streaks.clean(out_key(fe.raw))
@@ -385,6 +389,10 @@ class VehicleObserver(Answers, Deadlines):
         if self.faults.instrumented and fault is None:
             return False  # the relay says the line did nothing to it: what it is, the vehicle sent
         junk = d is None and raw[:1] != b"$"
+        if junk and fault is None:  # bytes between lines: judged with what follows them (_junk_settle)
+            self._junk_settle(False)
+            self._junk_wait = (raw, fails, ev, case, discard)
+            return True
         key = ("junk",) if junk else out_key(raw)
         if fault is not None:
             text, sig, need = f"the line touched it (the relay's note: {fault})", ("note",), REPEAT
@@ -399,6 +407,8 @@ class VehicleObserver(Answers, Deadlines):
                 text, need = spoil.text, REPEAT
             else:
                 text, need = "a broken line (of a form no one fault of a line gives)", OTHER_REPEAT
+        if self.alive_t is None:  # nothing read whole from it yet: garbage at another baud rate, or a
+            sig = ("before any sentence", ev.lineno)  # line too noisy, repeats; not a vehicle fault
         findings = [(cid, reason, [ev], case) for cid, reason in fails]
         owners = tuple(q.ident for q in self.pending)
         held = self.streaks.hold(key, sig, text, findings, need=need, owners=owners, known=fault is not None)
@@ -408,6 +418,21 @@ class VehicleObserver(Answers, Deadlines):
                 if not q.spoil:
                     q.spoil = text
         return True
+
+    def _junk_settle(self, reply: bool) -> None:
+        """Bytes between lines, now that what follows them is known: before a reply, they are held
+        with the bytes before the replies next to it (the same bytes before reply after reply are a
+        vehicle or modem prefix, RH-FRM-1, :data:`~.lines.PREFIX_REPEAT` in a row); before
+        anything else (more garbage: a wrong baud rate, a line too noisy), they are held alone."""
+        if self._junk_wait is None:
+            return
+        raw, fails, ev, case, discard = self._junk_wait
+        self._junk_wait = None
+        spoil = explain_discard(raw, discard, "", self.profile)
+        text = spoil.text if spoil is not None else "bytes between lines"
+        findings = [(cid, reason, [ev], case) for cid, reason in fails]
+        key, sig = (("junk",), ("junk", raw[:32])) if reply else (("junk", "alone"), ("junk", "alone", ev.lineno))
+        self.streaks.hold(key, sig, text, findings, need=PREFIX_REPEAT)
 
     def awaits(self, p: Sent) -> bool:
         """Something is held that sending ``p`` again would make again (module docstring)."""
@@ -475,6 +500,7 @@ class VehicleObserver(Answers, Deadlines):
                                                  f"be read ({what})", [p.ev], p.case)
         for q in self.silent:
             q.state = "silent"
+        self._junk_settle(False)
         self.streaks.conclude("the run was interrupted before it was made again")
         self.pending.clear()
         self.silent.clear()
@@ -518,6 +544,7 @@ class VehicleObserver(Answers, Deadlines):
             if p.ack is None and p.late_booked and not p.missing_booked:
                 p.missing_booked = True
                 self._book_missing(p)
+        self._junk_settle(False)
         self.streaks.conclude("the record ended before it was made again")
         self._mission_unshown("the record ended")
         self.checks.close()
