@@ -16,6 +16,12 @@ again), with the findings it would book. What happens next decides:
   :data:`.spoil.RERUNS` re-runs) or of any other form (:data:`OTHER_REPEAT`: the line would have
   to do two faults in one line, twice). The error is then *proven* for that key: met again, it is
   booked at once;
+* **the same broken bytes again** — a faulty line does not break a line the same way twice
+  (the same bit of the same byte flipped, the same byte lost): the same broken line, byte for
+  byte, seen :data:`SAME_REPEAT` times for a key (:data:`SAME_REPEAT_SHORT` for a line shorter
+  than :data:`SHORT_LINE`, which a structural fault — its CR lost — can hit more often), made
+  again clean in between or not, is the implementation's: an error that comes only now and then
+  is found by it;
 * **never made again** (:meth:`Streaks.conclude`: the case ends, the record ends, the key is
   pushed out) — INCONCLUSIVE, naming what the line may have done.
 
@@ -33,10 +39,16 @@ from typing import Hashable, Optional
 from .ledger import Ledger
 from .spoil import REPEAT
 
-__all__ = ["Held", "Streaks", "OTHER_REPEAT", "MAX_KEYS", "MAX_HELD"]
+__all__ = ["Held", "Streaks", "OTHER_REPEAT", "SAME_REPEAT", "SAME_REPEAT_SHORT", "SHORT_LINE", "MAX_KEYS",
+           "MAX_HELD"]
 
 #: In a row, the same error of a form no single line fault gives is the implementation's.
 OTHER_REPEAT = 2
+#: The same broken bytes, this many times for a key (not necessarily in a row), are the
+#: implementation's; for a line shorter than :data:`SHORT_LINE` bytes, :data:`SAME_REPEAT_SHORT`.
+SAME_REPEAT = 2
+SAME_REPEAT_SHORT = 3
+SHORT_LINE = 20
 MAX_KEYS = 64
 MAX_HELD = 16
 _BREAK = object()  # the sig of a break in a run (:meth:`Streaks.interrupt`): holds nothing
@@ -54,6 +66,7 @@ class Held:
     owners: tuple = ()  #: the commands (their bytes) it answered, whose re-run makes it again
     seq: int = 0  #: the order it was held in
     known: bool = False  #: a relay's note says the line touched it
+    raw: Optional[bytes] = None  #: the broken bytes, when it is a broken line
 
 
 class Streaks:
@@ -63,6 +76,7 @@ class Streaks:
         self.ledger = ledger
         self._held: OrderedDict[Hashable, list[Held]] = OrderedDict()
         self._proven: dict[Hashable, set] = {}
+        self._same: OrderedDict[Hashable, OrderedDict] = OrderedDict()  #: key -> broken bytes -> times seen
         self._seq = 0
         self.dismissed = 0  #: observations made again clean
         self.failed = 0  #: observations booked as violations by repetition
@@ -70,6 +84,20 @@ class Streaks:
 
     def __bool__(self) -> bool:
         return bool(self._held)
+
+    def _seen_again(self, key: Hashable, raw: bytes) -> bool:
+        """Count ``raw`` for ``key``; True when it has now been seen as often as makes it the
+        implementation's (module docstring)."""
+        seen = self._same.get(key)
+        if seen is None:
+            seen = self._same[key] = OrderedDict()
+            if len(self._same) > MAX_KEYS:
+                self._same.popitem(last=False)
+        n = seen[raw] = seen.get(raw, 0) + 1
+        seen.move_to_end(raw)
+        if len(seen) > 32:
+            seen.popitem(last=False)
+        return n >= (SAME_REPEAT_SHORT if len(raw) < SHORT_LINE else SAME_REPEAT)
 
     def is_open(self, key: Hashable) -> bool:
         return key in self._held
@@ -86,14 +114,28 @@ class Streaks:
         return sig in self._proven.get(key, ())
 
     def hold(self, key: Hashable, sig: Hashable, text: str, findings: list, *, need: int = REPEAT,
-             owners: tuple = (), known: bool = False) -> Optional[Held]:
-        """Hold an observation; returns it, or None when it was booked (repeated, or proven)."""
+             owners: tuple = (), known: bool = False, raw: Optional[bytes] = None) -> Optional[Held]:
+        """Hold an observation (``raw``: the broken bytes, when it is a broken line); returns it,
+        or None when it was booked (repeated, or proven)."""
         if not findings:
             return None
         self._seq += 1
-        h = Held(key, sig, need, text, list(findings), owners, self._seq, known)
+        h = Held(key, sig, need, text, list(findings), owners, self._seq, known, raw)
         if not known and self.proven(key, sig):
             self._book_fail([h], f"the same error as before on this {_what(key)}")
+            return None
+        if not known and raw is not None and self._seen_again(key, raw):
+            self._proven.setdefault(key, set()).add(sig)
+            items = self._held.get(key, [])
+            same = [x for x in items if x.raw == raw and not x.known]
+            if same:
+                rest = [x for x in items if x not in same]
+                if any(x.findings for x in rest):
+                    self._held[key] = rest
+                else:
+                    self._held.pop(key, None)
+            self._book_fail(same + [h], "the same broken line, byte for byte, as before: a faulty line does not "
+                                        "break a line the same way twice")
             return None
         items = self._held.get(key)
         if items is None:

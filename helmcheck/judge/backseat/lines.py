@@ -86,7 +86,7 @@ class LineRules:
             else:
                 text, need = "a broken line (of a form no one fault of a line gives)", OTHER_REPEAT
         self.streaks.hold(key, sig, text, [(cid, reason, [line.evidence()], case) for cid, reason in fails],
-                          need=need, known=fault is not None)
+                          need=need, known=fault is not None, raw=None if junk else raw)
 
     def discarded(self, line: SentLine) -> None:
         """RH-BS-1: bytes the framer threw away."""

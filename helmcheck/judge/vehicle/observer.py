@@ -411,7 +411,8 @@ class VehicleObserver(Answers, Deadlines):
             sig = ("before any sentence", ev.lineno)  # line too noisy, repeats; not a vehicle fault
         findings = [(cid, reason, [ev], case) for cid, reason in fails]
         owners = tuple(q.ident for q in self.pending)
-        held = self.streaks.hold(key, sig, text, findings, need=need, owners=owners, known=fault is not None)
+        held = self.streaks.hold(key, sig, text, findings, need=need, owners=owners, known=fault is not None,
+                                 raw=raw if self.alive_t is not None else None)
         if held is not None:
             for q in self.pending:
                 q.spoils.append((text, need, fault is not None, sig))
@@ -432,7 +433,7 @@ class VehicleObserver(Answers, Deadlines):
         text = spoil.text if spoil is not None else "bytes between lines"
         findings = [(cid, reason, [ev], case) for cid, reason in fails]
         key, sig = (("junk",), ("junk", raw[:32])) if reply else (("junk", "alone"), ("junk", "alone", ev.lineno))
-        self.streaks.hold(key, sig, text, findings, need=PREFIX_REPEAT)
+        self.streaks.hold(key, sig, text, findings, need=PREFIX_REPEAT)  # (the same bytes: the prefix rule)
 
     def awaits(self, p: Sent) -> bool:
         """Something is held that sending ``p`` again would make again (module docstring)."""
