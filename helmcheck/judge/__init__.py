@@ -13,6 +13,9 @@ reads them. Modules:
 * :mod:`~helmcheck.judge.wire` — wire events and the recorder notes a judge understands;
 * :mod:`~helmcheck.judge.runfacts` — the run facts (selection, the implementation's end, a
   run cut short) the wire log's notes record, booked into a ledger;
+* a faulty line: :mod:`~helmcheck.judge.spoil` — the form of a broken line a line fault gives;
+  :mod:`~helmcheck.judge.streaks` — observations it may have spoilt, held until made again
+  (the repetition rule); :mod:`~helmcheck.judge.linefaults` — a line-fault relay's notes;
 * :mod:`~helmcheck.judge.vehicle` — the vehicle observer (§1–8);
 * :mod:`~helmcheck.judge.backseat` — the backseat observer (§9).
 

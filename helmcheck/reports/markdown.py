@@ -2,7 +2,8 @@
 
 A headline that leads with the scope ("PASS — partial: 4 of 60 claimed clauses judged; not a
 certificate", :func:`helmcheck.reports.scope.headline`) and why clauses were not judged, a
-PARTIAL warning if the run was interrupted, what was tested (identity), a counts table, the
+PARTIAL warning if the run was interrupted, what was tested (identity), the port's line error
+counters (:mod:`helmcheck.reports.linecounters`), a counts table, the
 exploration's model coverage with what it means for the verdict, the clauses that did not pass
 with their reasons (worst first), every passing clause with its first evidence line, real ACK
 errors counted apart from the tester's negative tests, and the digest and signature. Strings
@@ -16,6 +17,7 @@ from __future__ import annotations
 import re
 
 from .identity import identity_rows
+from .linecounters import counters_summary
 from .rundir import Run
 from .scope import headline, model_coverage_note, scope_of
 from .text import printable
@@ -109,6 +111,10 @@ def render_markdown(run: Run, comparison_md: str | None = None) -> str:
         else:
             out += ["**Vehicle NOT verified as restored**: " + md_escape("; ".join(rec.get("problems") or []))
                     + ". Set by hand: " + md_escape("; ".join(rec.get("by_hand") or [])) + ".", ""]
+
+    counters = counters_summary(r)
+    if counters is not None:
+        out += [f"Line error counters: {md_escape(counters)}.", ""]
 
     c = counts(r)
     out.append("| " + " | ".join(VERDICT_LABEL[v] for v in c) + " | total |")

@@ -16,6 +16,8 @@ entry point is :func:`.runner.certify`. Modules, one concern each:
   jitter, the report's size); :mod:`.durations` — the timeouts, parks and waits chosen from it
   so that the observer can time every one (or a case NOT-TESTED before it runs).
 * :mod:`.flow` — how a case stops early (flow control, never a verdict).
+* :mod:`.casecounters` — the port's error counters read around each case (a rise: the case's
+  clauses INCONCLUSIVE).
 * :mod:`.explore` — hypothesis sequences aimed at the model (:mod:`.machine`: the rules and
   episodes), shrunk on failure, within a budget
   in wall and vehicle seconds; :mod:`.generate` — what they draw (every claimed command at its

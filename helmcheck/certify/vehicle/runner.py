@@ -5,8 +5,8 @@ that something answers (a link that carries nothing, or only garbage, is INCONCL
 reason; garbage that reads as sentences at another common baud rate names it, with the option
 to run with), checks that the vehicle's clock runs at the declared time scale (:mod:`.clockprobe`: a
 clear mismatch stops the run INCONCLUSIVE, naming both rates), runs the selected clause cases
-in order (:mod:`.interpreter`), then the hypothesis exploration (:mod:`.explore`), and writes
-``DIR/results.json`` after every case (:mod:`.resultsfile`) — atomically, so a crash or Ctrl-C
+in order (:mod:`.interpreter`; the port's error counters read around each, :mod:`.casecounters`),
+then the hypothesis exploration (:mod:`.explore`), and writes ``DIR/results.json`` after every case (:mod:`.resultsfile`) — atomically, so a crash or Ctrl-C
 leaves a valid partial report marked ``partial`` — plus ``DIR/wire.log`` and, at the end, every
 report format.
 
@@ -56,6 +56,7 @@ from ...reports import results as R
 from ...reports.certificate import RunDeclaration, finish_run
 from ..outcome import Outcome
 from . import resultsfile
+from .casecounters import CaseCounters
 from .catalogue import select_cases
 from .clockprobe import ClockMismatch, check_clock
 from .exec_child import ExecChild
@@ -325,18 +326,24 @@ class Run(ExecChild):
     def run_cases(self, cases: list) -> None:
         ses = self.session
         assert ses is not None
+        counters = CaseCounters(self.link)  # the port's error counters around each case (casecounters.py)
         for case in cases:
             self.check_child()
             entry = {"id": case.id, "clauses": list(case.clauses), "title": case.title,
                      "expectation": case.expectation, "start": case.start, "steps": case.describe()["steps"]}
             if all(self.ledger.has_failed(cid) for cid in case.clauses):
-                entry.update(verdict="not-run", reason="its clauses had already failed", wall_s=0.0)
+                entry.update(verdict="not-run", reason="its clauses had already failed", wall_s=0.0,
+                             line_counters={"available": False, "reason": "the case did not run"})
                 self.results["cases"].append(entry)
                 self.progress.step(f"{case.id} {case.subject}", "skipped (already failed)")
                 continue
             t0 = time.monotonic()
+            counters.start()
             try:
-                outcome, reason = run_case(ses, case)
+                try:
+                    outcome, reason = run_case(ses, case)
+                finally:
+                    entry["line_counters"] = counters.end(case.id, case.clauses)
             except LinkLost as e:
                 gone = self.child_gone(settle_s=1.0)
                 if gone:  # the vehicle under test died: not a link fault
