@@ -11,8 +11,8 @@ owns the *form* half of the rule the judges use (``docs/contracts.md``, "A fault
   lines run together, or the one body byte the checksum says is missing) makes it clean
   sentences;
 * **noise** — a run of at most :data:`NOISE_RUN_MAX` bytes taken out makes it a clean sentence;
-* **torn** — a line shorter than any sentence (:data:`SHORTEST`), or a sentence cut short by a
-  ``$`` (noise, or its LF lost);
+* **torn** — a line shorter than any sentence (:data:`SHORTEST`, :data:`SHORTEST_COMMAND`), or
+  a sentence cut short by a ``$`` (noise, or its LF lost);
 
 and what is not one of these (commas in ``$C``, a wrong checksum many bits off, a field out of
 range under a right checksum, a parity bit in every byte) is the implementation's. The other
@@ -33,8 +33,8 @@ from ..grammar import decode
 from ..grammar.checksum import checksum
 from ..grammar.wirelog import escape
 
-__all__ = ["Spoil", "explain", "explain_discard", "signature", "RERUNS", "REPEAT", "NOISE_RUN_MAX", "MAX_FLIPS",
-           "SHORTEST"]
+__all__ = ["Spoil", "explain", "explain_discard", "signature", "flips_to_frame", "RERUNS", "REPEAT", "NOISE_RUN_MAX",
+           "MAX_FLIPS", "SHORTEST", "SHORTEST_COMMAND"]
 
 #: Re-runs of a spoilt observation the tester makes (and a judge waits for). An error of line form
 #: is the implementation's when the original and this many re-runs show it alike (:data:`REPEAT`
@@ -50,6 +50,8 @@ NOISE_RUN_MAX = 8
 MAX_FLIPS = 2
 #: ``$ACK,1,0,0*hh`` CR LF: no sentence a vehicle sends is shorter.
 SHORTEST = 15
+#: ``$OSD*hh`` CR LF: no command a backseat sends is shorter.
+SHORTEST_COMMAND = 9
 
 _FRAME = re.compile(rb"\$([\x20-\x23\x25-\x29\x2b-\x7e]*)\*([0-9A-F]{2})\r\n\Z")
 _HEX = b"0123456789ABCDEF"
@@ -262,24 +264,31 @@ def _same_bit_twice(raw: bytes, d, profile) -> bool:
     return False
 
 
-def explain(raw: bytes, profile, d=None) -> Optional[Spoil]:
+def explain(raw: bytes, profile, d=None, shortest: int = SHORTEST) -> Optional[Spoil]:
     """The line fault that could have made ``raw`` (a line from ``$`` to LF that is not a clean
-    sentence: invalid, or with a finding) out of clean sentences, or None (module docstring)."""
-    key = (raw, id(profile))
+    sentence: invalid, or with a finding) out of clean sentences, or None (module docstring).
+    ``shortest``: no sentence of the sender is shorter (a vehicle's :data:`SHORTEST`; a backseat's
+    ``$OSD*hh`` CR LF, :data:`SHORTEST_COMMAND`)."""
+    key = (raw, id(profile), shortest)
     if key in _EXPLAINED:
         return _EXPLAINED[key]
     if len(_EXPLAINED) >= 256:
         _EXPLAINED.clear()
-    got = _EXPLAINED[key] = _explain(raw, profile, d)
+    got = _EXPLAINED[key] = _explain(raw, profile, d, shortest)
     return got
 
 
 _EXPLAINED: dict = {}
 
 
-def _explain(raw: bytes, profile, d=None) -> Optional[Spoil]:
-    if raw[:1] == b"$" and raw.endswith(b"\n") and len(raw) < SHORTEST:
+def _explain(raw: bytes, profile, d, shortest: int) -> Optional[Spoil]:
+    got = _repaired(raw, profile, d)
+    if got is None and raw[:1] == b"$" and raw.endswith(b"\n") and len(raw) < shortest:
         return Spoil("torn", f"a torn line ({len(raw)} bytes: shorter than any sentence)", ("torn",))
+    return got
+
+
+def _repaired(raw: bytes, profile, d) -> Optional[Spoil]:
     if d is None:
         d = decode(raw, profile)
     sig = signature(raw, d)

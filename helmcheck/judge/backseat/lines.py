@@ -31,7 +31,7 @@ from ...grammar import sentences as s
 from ...grammar.errors import FRAMING
 from ...model.validate import field_error
 from ..ledger import Ledger
-from ..spoil import REPEAT, explain, explain_discard, signature
+from ..spoil import REPEAT, SHORTEST_COMMAND, explain, explain_discard, signature
 from ..streaks import OTHER_REPEAT, Streaks
 from .common import SentLine, Settings
 
@@ -80,7 +80,7 @@ class LineRules:
                                                    else ("discard", line.discard.clause))
             spoil = None if self.streaks.proven(key, sig) else (
                 explain_discard(raw, line.discard.clause, "", self.s.profile) if d is None
-                else explain(raw, self.s.profile, d))
+                else explain(raw, self.s.profile, d, SHORTEST_COMMAND))
             if spoil is not None:
                 text, need = spoil.text, REPEAT
             else:
