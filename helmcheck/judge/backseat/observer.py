@@ -18,9 +18,9 @@ Dispatch:
 * vehicle bytes (``<``) — re-framed; each ``$OSI`` and ``$ACK`` is knowledge
   (:mod:`.knowledge`) from the time it had fully arrived; an ``$ACK`` answers a waiting command;
 * a faulty line: the backseat's broken lines are held until it sends the sentence again
-  (:mod:`.lines`); in a line-fault relay's record (``line fault …`` notes,
-  :mod:`helmcheck.judge.linefaults`) a report or answer the line broke on its way to the
-  backseat is not something the backseat could know;
+  (:mod:`.lines`; a line-fault relay's notes, :mod:`helmcheck.judge.linefaults`, say exactly which
+  the line broke). A report the line broke on its way to the backseat is still taken as known
+  (decision: a backseat may read a damaged line; the live certification cannot tell either);
 * notes (``!``, :func:`~helmcheck.judge.wire.parse_note`) — ``scenario X starts`` (findings
   then carry ``X`` as their case), ``lockout starts (<code>)`` / ``lockout ends``, ``silence
   starts`` / ``silence ends`` (no answer is expected meanwhile, and servo control is not
@@ -240,19 +240,22 @@ class BackseatObserver:
         self.pending.expire(ev.t, self.max_wait)
         self.arrivals.record(ev.t, len(data))
         if self._whole_line(self._vframer, data):
-            if not self._spoilt():
-                self._report(data, ev.t, self.arrivals.arrival(len(data)))
+            self._taken()
+            self._report(data, ev.t, self.arrivals.arrival(len(data)))
             return
         base = self._voffset
         self._voffset += len(data)
         for e in self._vframer.feed(data):
-            if not self._spoilt() and isinstance(e, Line):
+            self._taken()
+            if isinstance(e, Line):
                 self._report(e.raw, ev.t, self.arrivals.arrival(e.offset + len(e.raw) - base))
 
-    def _spoilt(self) -> bool:
-        """A relay's note says the line broke the vehicle's run now framed, on its way to the
-        backseat: what the backseat got was not that report (it could not know from it)."""
-        return self.faults.instrumented and self.faults.take(FROM_VEHICLE) is not None
+    def _taken(self) -> None:
+        """A relay's note on a vehicle run is used up by it (it touched that run and no other). A
+        report the line broke on its way is still taken as known: a backseat may read it anyway,
+        and the live certification, which sees what it sent, takes it so too."""
+        if self.faults.instrumented:
+            self.faults.take(FROM_VEHICLE)
 
     def _report(self, raw: bytes, t: float, arrived: float) -> None:
         if raw[:5] not in _READ:  # nothing else tells the backseat what it could know
