@@ -65,7 +65,7 @@ certificate: --implementation names the backseat in every report; --sign-key sig
 examples:
   helmcheck certify backseat                          # pty: prints 'port: /dev/pts/N', waits for a backseat
   helmcheck certify backseat --duration 10 --time-scale 10 \\
-      --exec 'python3 tests/backseats/good_backseat.py {port} --time-scale {time_scale}'
+      --exec 'python3 examples/backseat.py --port {port} --time-scale {time_scale}'
   helmcheck certify backseat --port socket://127.0.0.1:0 --scenario lockout   # a TCP server; prints its port
   helmcheck certify backseat --port /dev/ttyUSB0 --profile iver3.toml --strict
   helmcheck keygen --out lab                          # a signing key pair, once

@@ -12,6 +12,10 @@ judges replies, split out to keep one concern per module; it works on the observ
 * **The ACK window** (RH-ACK-2, :func:`~helmcheck.judge.timing.ack_allowance`; an ACK later
   than the window, transmit time and the observer's own uncertainty is a FAIL), the answer
   against the mirror (:mod:`.belief`), and ``$OSD``'s data before its ACK (RH-ACK-5, RH-OSD-1).
+  Decision (the profile is silent): a line a tester sent after opening the link (its ``link:``
+  note) and before the vehicle had answered anything — the link check's probe of a vehicle still
+  starting up — is not timed, nor missed (:attr:`~.sent.Sent.first_contact`): the link check waits
+  for the vehicle to answer at all. A capture's first lines are judged like any other.
 * **Every** ``$OSI`` against the mirror (RH-OUT-4 and the clauses of what led there, attributed by
   :mod:`.blame`), the timers it brackets (RH-TIM-1/2), and the checks beyond the mirror
   (:mod:`.osichecks`).
@@ -159,7 +163,9 @@ class Answers:
         allowance = ack_allowance(window, len(p.raw), replies, self.baud, self.res, self.jitter)
         dt = t - p.t
         verdict = "fail" if late else ack_verdict(dt, allowance, window, self.res, self.jitter)
-        if late and p.late_booked:
+        if p.first_contact and not late:
+            pass  # the first answer of a vehicle not heard from yet (still starting): not timed
+        elif late and p.late_booked:
             pass  # RH-ACK-2 was booked when the give-up deadline passed
         elif verdict == "fail":
             self.book("fail", ("RH-ACK-2",), f"$ACK,{a.type} came {dt:.2f} s after {text_of(p)}; allowed "

@@ -70,6 +70,8 @@ class Deadlines:
         never to a later command."""
         p.state = "missing"
         p.waited = ack_give_up_after(allowance)
+        if p.first_contact:
+            return  # a vehicle not heard from yet (still starting up): not judged (answers.py)
         self.gave_up.append(p)
         if self.alive_t is not None and self.alive_t > p.t:
             self._book_late(p)

@@ -270,6 +270,9 @@ class VehicleObserver(Answers, Deadlines):
         self.seq += 1
         sent = Sent(self.seq, ev.t, raw, self._evidence(ev, raw, ">"), k, self.case, self.case_clauses,
                     self.vbytes)
+        # a tester that opened the link (its ``link:`` note) probes a vehicle that may still be
+        # starting: its lines before the first answer are not timed (answers.py); a capture's are
+        sent.first_contact = self.alive_t is None and self.link_baud is not None
         self.sent.append(sent)
         if k.kind in ("command", "error"):
             if self.first_command_t is None:
