@@ -163,7 +163,7 @@ class Candidate:
         steps, self.model.trace = list(trace), []
         fired = []
         if any(st.row.event == "violation" for st in steps):
-            self._depth_unknown()
+            self._depth_unknown(self._mode)
         for st in steps:
             row = st.row
             before_mode, before_phase = self._mode, self._phase
@@ -185,15 +185,25 @@ class Candidate:
             self._book(row, before_mode, before_phase)
         return fired
 
-    def _depth_unknown(self) -> None:
-        """A violation came: the depth the mirror has is the last report's, from before it, and the
-        vehicle may have gone down since (a mission's dive). During the lockout it holds that unseen
-        depth (RH-RD-11), so whether it is at the surface when the lockout ends (RH-SAF-4 at once, or
-        the ascent first) is for a report to show: the surface is then adopted (:mod:`.closure`),
-        never assumed from a depth read before the violation."""
+    def _depth_unknown(self, before: str) -> None:
+        """A violation came: the depth the mirror has is the last report's, from before it, and a
+        vehicle that was heading down (a remote control, or a mission whose next waypoint is under
+        water) may have gone down since. During the lockout it holds that unseen depth (RH-RD-11), so
+        whether it is at the surface when the lockout ends (RH-SAF-4 at once, or the ascent first) is
+        then for a report to show: the surface is adopted (:mod:`.closure`), never assumed from a
+        depth read before the violation. A vehicle stopped, or on a surface leg, stays where it was."""
         m = self.model
         fix = m.profile.gps_fix_depth_m
-        if m.phase == "lockout" and m.snapshot.depth_m <= fix:
+        if m.phase != "lockout" or m.snapshot.depth_m > fix:
+            return
+        diving = before in ("A", "M", "W", "mP")
+        if before in ("N", "P") and m.mission is not None:
+            # without the vehicle's mission files (a catalogue that learns, :mod:`.catalog`) the
+            # waypoint's depth is not known: it may be diving too
+            diving = (getattr(m.missions, "learns", True) or m.mission.is_open
+                      or not 0 <= m.mission_wp < len(m.mission.waypoints)
+                      or m.mission.waypoints[m.mission_wp].depth > fix)
+        if diving:
             m.update_plant(m.snapshot.with_(depth_m=fix + 1e-3))
 
     def _book(self, row: Row, before_mode: str, before_phase: str) -> None:
