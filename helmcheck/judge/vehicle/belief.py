@@ -52,6 +52,9 @@ from .sent import brief
 __all__ = ["Beliefs", "CommandResult", "OsiResult", "CAP"]
 
 CAP = 6
+#: Commands that may set a timer going when accepted (their ACK instant's uncertainty is the
+#: timer's, :attr:`Beliefs.arm_v`); a refused one, or any other, sets none going.
+_ARMING = frozenset({s.OMS, s.OMP, s.OPK, s.OMW, s.ODVL, s.OJW, s.OMSTART, s.OMSTARTPaper, s.OXFLT})
 #: Command events the lockout refuses (err 26) and the ascent does not: their answer tells them apart.
 _LOCK_ONLY = LOCKOUT_REFUSED - ASCENT_REFUSED
 
@@ -93,10 +96,10 @@ class Beliefs:
         self.cands: list[Candidate] = [Candidate(VehicleModel(profile, catalog))]
         #: why the vehicle's state is not known (findings are INCONCLUSIVE until it is again)
         self.desync = "the record begins with the vehicle's state unknown"
-        #: vehicle seconds: the widest window in which a command that may arm a timer went into
-        #: effect since the state was last known (RH-RD-15: its ACK going out, which the ACK's
-        #: arrival less the replies' transmit time bounds). An ``$OSD`` arms nothing, so its data's
-        #: transmit time does not widen the timing of anything.
+        #: vehicle seconds: the widest window in which an accepted command that may arm a timer
+        #: (:data:`_ARMING`) went into effect since the state was last known (RH-RD-15: its ACK
+        #: going out, which the ACK's arrival less the replies' transmit time bounds). A refused
+        #: command, an ``$OSD`` or any other arms nothing: their answers' timing widens nothing.
         self.arm_v = 0.0
         #: the last ``$OSI`` and the vehicle second it arrived (its depth is read only when needed)
         self.last_osi: Optional[tuple[s.OSI, float]] = None
@@ -109,8 +112,9 @@ class Beliefs:
     def command(self, item, v: float, slack_v: float, observed: list) -> CommandResult:
         """Feed an answered command (module docstring); ``observed`` is the vehicle's replies."""
         desync = self.desync
-        if type(item) is not s.OSD:
-            self.arm_v = max(self.arm_v, slack_v)
+        ack = observed[-1] if observed and isinstance(observed[-1], s.ACK) else None
+        if type(item) in _ARMING and (ack is None or ack.status == 0):
+            self.arm_v = max(self.arm_v, slack_v)  # it may have set a timer going (RH-RD-15)
         if type(item) is s.OSD:
             result = self._poll(item, v, slack_v, observed, desync)
             if result is not None:
