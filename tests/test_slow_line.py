@@ -55,6 +55,8 @@ def _judged_pass(out, select) -> None:
     assert not bad, bad
     judged = {c["id"] for c in out.results["clauses"] if c["verdict"] == "pass"}
     assert set(select) <= judged, {c["id"]: c["reason"] for c in out.results["clauses"] if c["id"] in select}
+    timing = next(c for c in out.results["clauses"] if c["id"] == "RH-TIM-1")
+    assert timing["precision"]["widened_s"] > timing["precision"]["nominal_s"] > 0, timing  # said how coarse
     budget = out.results["settings"]["line_budget"]
     assert budget["measured"] and budget["latency_p50_s"] >= 0.45, budget  # it saw the line it ran on
 
