@@ -32,7 +32,11 @@ measured, a stated assumption) and turns it into:
   :meth:`LineBudget.advice`: the time scale, or the baud, at which it would be);
 * :meth:`LineBudget.precision_v` — the widened RH-TIM-1 tolerance a duration is judged with on
   this line: the nominal ``max(0.5 s, 5 %)``, the observer's uncertainty and the spacing of the
-  reports that sample the deadline (a transition later than that is certain to be seen as late).
+  reports that sample the deadline (a transition later than that is certain to be seen as late);
+  :meth:`LineBudget.widening_v` what is added to the nominal, :meth:`LineBudget.nominal_scale` the
+  time scale at which that is at most :data:`NOMINAL_WIDENING_S` (``--precision nominal``);
+* :attr:`LineBudget.spread_s` — how much later one line may be answered than another written with
+  it (the latencies' spread): what a lockout's burst of commands after ``$OXFLT`` must fit in.
 
 The planning latency is the largest reply latency measured so far with a margin
 (:func:`planning_latency`), never more than the ACK window (a slower answer is itself a finding,
