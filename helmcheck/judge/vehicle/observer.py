@@ -240,9 +240,25 @@ class VehicleObserver(Answers, Deadlines):
                 except TypeError:
                     return
             for c in self.beliefs.cands:
+                if isinstance(event, P.WaypointReached) and self._unknown_waypoint(c.model, event.index):
+                    continue  # what the waypoint holds is learnt from the reports (closure)
                 c.model.plant(event, max(v, c.model.now or 0.0))
                 c.drain()
             self.event(ev.t, "lockout" if isinstance(event, P.SafetyViolation) else "note", ev.note[:80])
+
+    def _unknown_waypoint(self, m, index: Optional[int]) -> bool:
+        """Whether reaching mission waypoint ``index`` (the next one when None) does what the
+        observer does not know yet: a mission learnt from the reports (no mission files given)
+        whose park at that waypoint, or whose length, has not been seen. A plant note of such a
+        waypoint reached is left to the reports, which the closure learns it from (as in a log
+        without notes); applied, it would take the waypoint as holding nothing."""
+        run = m.mission
+        if run is None or m.mode != "N":
+            return False
+        entry = self.missions.entry(run.name)
+        if entry is None:
+            return False  # the mission files were given (or the name is unknown: nothing to learn)
+        return run.is_open or not entry.park_known(m.mission_wp if index is None else index)
 
     # ------------------------------------------------------------------ backseat lines
     def _backseat(self, fe, ev: WireEvent) -> None:
