@@ -25,7 +25,10 @@ through. The slow one is at some ``s_j``, the fast one at ``s_k`` (``j ≤ k``);
 countdowns *display* its own clock's count (start + duration − now, unskewed), so the park time
 of each acceptable state is the interval between what the two shadows show (the fast shadow in
 it now or as it left it; the slow shadow in it now or the fast one as it entered it), widened by
-``slack`` and rounded outwards to whole seconds (field 10 is rounded up, RH-RD-5).
+``slack`` and rounded outwards to whole seconds (field 10 is rounded up, RH-RD-5). A count is
+widened also where it has reached 0: the slow shadow, still counting past its own count's end,
+shows how far past (a report made up to ``slack`` earlier may still show ``P1``); a state that
+shows no park shows ``P0`` exactly.
 
 So that the slow shadow can still be "before" a timer the model itself already ran, the model
 keeps a checkpoint: a copy of itself taken just before the first timer fires after a
@@ -196,8 +199,8 @@ def expectation(model, now: float, slack: float = 0.0) -> Expectation:
     states: list[Acceptable] = []
     if aligned:
         for i in range(j, k + 1):
-            values = [fast.park_remaining(now) if i == k else fv[i].exit_park,
-                      slow.park_remaining(now) if i == j else fv[i].entry_park]
+            values = [fast.park_remaining(now, clip=False) if i == k else fv[i].exit_park,
+                      slow.park_remaining(now, clip=False) if i == j else fv[i].entry_park]
             states.append(_acceptable(fv[i].sig, values, slack))
     else:  # pragma: no cover - only if two state-changing timers ever race
         for v in fv + sv:
@@ -206,12 +209,16 @@ def expectation(model, now: float, slack: float = 0.0) -> Expectation:
 
 
 def _acceptable(sig: tuple, values: list[Optional[float]], slack: float) -> Acceptable:
-    vals = [0.0 if v is None else v for v in values]
-    lo, hi = min(vals), max(vals)
-    if hi > 0:
-        lo, hi = max(0.0, lo - slack), hi + slack
+    """The state ``sig`` with the park times ``values`` may show (module docstring): ``None`` is no
+    park (``P0`` exactly); a count, also one at or past its end, is widened by ``slack``."""
+    lo = hi = 0.0
+    first = True
+    for v in values:
+        a, b = (0.0, 0.0) if v is None else (v - slack, v + slack)
+        lo, hi = (a, b) if first else (min(lo, a), max(hi, b))
+        first = False
     mode, wp, err, srp = sig
-    return Acceptable(mode, wp, err, srp, max(0, math.floor(lo)), math.ceil(hi))
+    return Acceptable(mode, wp, err, srp, max(0, math.floor(lo)), max(0, math.ceil(hi)))
 
 
 def _timer_near(model, now: float, slack: float) -> bool:
