@@ -340,7 +340,7 @@ class SkewedTimers(Timers):
         start, dur = t
         return start + self._length(dur)
 
-    def remaining(self, name: str, now: float) -> Optional[float]:
+    def remaining(self, name: str, now: float, clip: bool = True) -> Optional[float]:
         t = self._t.get(name)
         if t is None:
             return None
@@ -348,7 +348,8 @@ class SkewedTimers(Timers):
         length = self._length(dur)
         if length <= 0:
             return 0.0
-        return max(0.0, dur * (start + length - now) / length)
+        left = dur * (start + length - now) / length
+        return left if not clip or left > 0.0 else 0.0
 
 
 def _quantize(value: Decimal, places: int, heading: bool = False) -> Decimal:
