@@ -25,10 +25,12 @@ through. The slow one is at some ``s_j``, the fast one at ``s_k`` (``j ≤ k``);
 countdowns *display* its own clock's count (start + duration − now, unskewed), so the park time
 of each acceptable state is the interval between what the two shadows show (the fast shadow in
 it now or as it left it; the slow shadow in it now or the fast one as it entered it), widened by
-``slack`` and rounded outwards to whole seconds (field 10 is rounded up, RH-RD-5). A count is
-widened also where it has reached 0: the slow shadow, still counting past its own count's end,
-shows how far past (a report made up to ``slack`` earlier may still show ``P1``); a state that
-shows no park shows ``P0`` exactly.
+``slack`` and rounded outwards to whole seconds (field 10 is rounded up, RH-RD-5). Only a
+running count is widened (``slack`` is when the report was made; a count that does not run —
+an ``$OPK`` park not yet on station, a mission park frozen in a lockout — shows the same at any
+moment), and a running count also where it has reached 0: the slow shadow, still counting past
+its own count's end, shows how far past (a report made up to ``slack`` earlier may still show
+``P1``). A state that shows no park shows ``P0`` exactly.
 
 So that the slow shadow can still be "before" a timer the model itself already ran, the model
 keeps a checkpoint: a copy of itself taken just before the first timer fires after a
@@ -152,11 +154,27 @@ class Expectation:
         return out
 
 
+#: A park time a state shows: ``None`` (no park, ``P0``) or ``(seconds, running)``.
+Shown = Optional[tuple[float, bool]]
+
+#: The timer whose count field 10 shows, by mode (``W`` only while parked on a queued waypoint).
+_COUNT = {"P": "park", "mP": "opk", "W": "qpark"}
+
+
+def _shown(m, at: float, clip: bool = True) -> Shown:
+    """What field 10 of ``m`` shows at ``at`` (before rounding), and whether that count runs."""
+    left = m.park_remaining(at, clip)
+    if left is None:
+        return None
+    name = _COUNT.get(m.mode)
+    return left, name is not None and m.timers.armed(name)
+
+
 @dataclass
 class _Visit:
     sig: tuple
-    entry_park: Optional[float]
-    exit_park: Optional[float] = None
+    entry_park: Shown
+    exit_park: Shown = None
 
 
 def _sig(m) -> tuple:
@@ -166,16 +184,16 @@ def _sig(m) -> tuple:
 def _run(shadow, now: float) -> list[_Visit]:
     """Advance ``shadow`` to ``now`` one expiry at a time, recording distinct states."""
     t0 = shadow.now if shadow.now is not None else now
-    visits = [_Visit(_sig(shadow), shadow.park_remaining(t0))]
+    visits = [_Visit(_sig(shadow), _shown(shadow, t0))]
     timers = shadow.timers
     while timers.due is not None and timers.due <= now:
         d = timers.due
-        before = shadow.park_remaining(d)
+        before = _shown(shadow, d)
         shadow._run_due(d)
         sig = _sig(shadow)
         if sig != visits[-1].sig:
             visits[-1].exit_park = before
-            visits.append(_Visit(sig, shadow.park_remaining(d)))
+            visits.append(_Visit(sig, _shown(shadow, d)))
     shadow._run_due(now)
     return visits
 
@@ -199,8 +217,8 @@ def expectation(model, now: float, slack: float = 0.0) -> Expectation:
     states: list[Acceptable] = []
     if aligned:
         for i in range(j, k + 1):
-            values = [fast.park_remaining(now, clip=False) if i == k else fv[i].exit_park,
-                      slow.park_remaining(now, clip=False) if i == j else fv[i].entry_park]
+            values = [_shown(fast, now, clip=False) if i == k else fv[i].exit_park,
+                      _shown(slow, now, clip=False) if i == j else fv[i].entry_park]
             states.append(_acceptable(fv[i].sig, values, slack))
     else:  # pragma: no cover - only if two state-changing timers ever race
         for v in fv + sv:
@@ -208,13 +226,17 @@ def expectation(model, now: float, slack: float = 0.0) -> Expectation:
     return Expectation(now, slack, tuple(dict.fromkeys(states)))
 
 
-def _acceptable(sig: tuple, values: list[Optional[float]], slack: float) -> Acceptable:
+def _acceptable(sig: tuple, values: list[Shown], slack: float) -> Acceptable:
     """The state ``sig`` with the park times ``values`` may show (module docstring): ``None`` is no
-    park (``P0`` exactly); a count, also one at or past its end, is widened by ``slack``."""
+    park (``P0`` exactly); a running count, also one at or past its end, is widened by ``slack``."""
     lo = hi = 0.0
     first = True
     for v in values:
-        a, b = (0.0, 0.0) if v is None else (v - slack, v + slack)
+        if v is None:
+            a = b = 0.0
+        else:
+            w = slack if v[1] else 0.0
+            a, b = v[0] - w, v[0] + w
         lo, hi = (a, b) if first else (min(lo, a), max(hi, b))
         first = False
     mode, wp, err, srp = sig
@@ -245,11 +267,12 @@ def _steady(model, now: float, slack: float) -> Optional[tuple]:
         return None
     base = model.now if model.now is not None and model.now > now else now
     mode, wp, err, park, srp = model.state(base)
-    p = model.park_remaining(base)
-    if p is None or p <= 0:
+    shown = _shown(model, base)
+    if shown is None or shown[0] <= 0:
         lo = hi = 0
     else:
-        lo, hi = max(0, math.floor(max(0.0, p - slack))), math.ceil(p + slack)
+        p, w = shown[0], (slack if shown[1] else 0.0)
+        lo, hi = max(0, math.floor(max(0.0, p - w))), math.ceil(p + w)
         lo = min(lo, park)
         hi = max(hi, park)
     return mode, wp, err, srp, lo, hi

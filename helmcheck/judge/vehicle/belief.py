@@ -363,6 +363,9 @@ class Beliefs:
                 causes.insert(0, "RH-SAF-2")
             if osi.mode == p.model.mode:  # the mode is right: a countdown is what differs
                 causes += {"mP": ["RH-PK-2"], "W": ["RH-OMW-4"]}.get(osi.mode, [])
+            if (p.resumed and osi.mode == p.model.mode == "P"
+                    and all(f.field == "park_time" for f in result.findings)):
+                causes.insert(0, "RH-INT-2")  # a park resumed after remote control: its time left
             if p.timed or any(tt for tt in (p.model.timer(),) if tt is not None and abs(tt[0] - v) <= 2 * tt[1]):
                 causes += ["RH-TIM-1", "RH-TIM-2"]  # a duration was being timed around this report
             result.causes = tuple(dict.fromkeys(c for c in causes if c != "RH-OUT-4"))
