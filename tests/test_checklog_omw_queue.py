@@ -1,0 +1,104 @@
+"""RH-OMW-2: the ``$OMW`` queue in arrival order, judged from field 7 — only on evidence that
+excludes every conforming explanation.
+
+No report says which queued waypoint the vehicle has reached (the mode stays ``W``); the judge
+follows the waypoints it may be heading for from field 7 (:mod:`helmcheck.judge.vehicle.queuetarget`).
+It used to follow one guess, and to start over, as if the vehicle had set out for the first
+queued waypoint again, whenever the queue changed — also when an ``$OMW`` in ``W`` only appended
+a waypoint (RH-RD-3). A vehicle that had passed its first waypoint unseen and was heading for the
+second was then "seen" heading for the second before it could have reached the first: RH-OMW-2
+FAILed on a conforming vehicle (a distance taken as proof of which waypoint it heads for).
+
+The sessions are the reference emulator's core driven in virtual time: two waypoints queued
+(the second 80 m beyond the first), reports every 0.5 s, a third waypoint appended when the
+vehicle is well on its way to the second, reports on; recorded without the emulator's notes and
+checked as ``check-log`` checks a recording. The faulty counterpart takes an appended waypoint
+first: still RH-OMW-2's FAIL.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from helmcheck.checklog.checker import check_log
+from helmcheck.grammar import sentences as s
+from helmcheck.profile import DEFAULT
+from tests.faulty_vehicles.base import Model
+from tests.virtual_vehicle import VirtualVehicle, osi_fields
+
+M_PER_DEG = 111_320.0
+
+
+def session(path: Path, on_the_way_m: float, model_factory=None) -> list:
+    """The session above: the third waypoint appended ``on_the_way_m`` metres after the vehicle
+    passed the first (as the vehicle's own model has it). Returns the reports' (v, mode, field 7)."""
+    vv = VirtualVehicle(DEFAULT, model_factory)
+    m = vv.core.model
+    seen = []
+
+    def poll() -> list:
+        f = osi_fields(vv.send("OSD,G,C,S"))
+        seen.append((round(vv.now, 2), f[2], float(f[7])))
+        return f
+
+    vv.send("OMSTART,0,0,0,0,conformance.mis,")
+    vv.now += 5.0
+    f = poll()
+    lat, lon = float(f[4]), float(f[5])
+    w1 = (lat + 20 / M_PER_DEG, lon)
+    w2 = (w1[0], lon + 80 / (M_PER_DEG * 0.75))
+    w3 = (w2[0] + 40 / M_PER_DEG, w2[1])
+    for w in (w1, w2):
+        vv.send(f"OMW,{w[0]:.6f},{w[1]:.6f},2.0,,20,2.0,0,")
+    while len(m.queue) == 2 and vv.now < 200:
+        vv.now += 0.5
+        poll()
+    until = vv.now + on_the_way_m / 1.03  # 2 kn
+    while vv.now < until:
+        vv.now += 0.5
+        poll()
+    vv.now += 0.1
+    vv.send(f"OMW,{w3[0]:.6f},{w3[1]:.6f},2.0,,20,2.0,0,")
+    while m.mode == "W" and vv.now < until + 200:
+        vv.now += 0.5
+        poll()
+    vv.write(path)  # without the emulator's own notes: no waypoint reached is seen
+    return seen
+
+
+def judged(path: Path) -> dict:
+    out = check_log(path, profile=DEFAULT, role="vehicle")
+    return {c["id"]: (c["verdict"], c["reason"]) for c in out.clauses}
+
+
+@pytest.mark.parametrize("on_the_way_m", [5.0, 20.0, 50.0])
+def test_a_waypoint_appended_after_an_unseen_arrival_is_no_disorder(tmp_path, on_the_way_m):
+    path = tmp_path / "wire.log"
+    seen = session(path, on_the_way_m)
+    assert seen[-1][1] == "N", seen[-3:]  # the whole queue was followed, and the mission resumed
+    v = judged(path)
+    bad = {c: r for c, (verdict, r) in v.items() if verdict == "fail"}
+    assert not bad, bad
+    assert v["RH-OMW-2"][0] == "pass", v["RH-OMW-2"]
+
+
+class AppendedFirst(Model):
+    """RH-OMW-2: an ``$OMW`` accepted in ``W`` goes to the head of the queue (newest first)."""
+
+    def receive(self, item, now):
+        was = self.mode == "W" and len(self.queue)
+        out = super().receive(item, now)
+        if was and isinstance(item, s.OMW) and len(self.queue) > was:
+            self.queue.insert(0, self.queue.pop())
+            self._control_changed()
+        return out
+
+
+def test_a_vehicle_that_takes_the_appended_waypoint_first_fails_RH_OMW_2(tmp_path):
+    path = tmp_path / "wire.log"
+    session(path, 20.0, model_factory=AppendedFirst)
+    v = judged(path)
+    assert v["RH-OMW-2"][0] == "fail", v["RH-OMW-2"]
+    assert "not kept in arrival order" in v["RH-OMW-2"][1]
