@@ -44,7 +44,7 @@ from ..wire import FROM_VEHICLE, LINE_CACHE, NOTE, TO_VEHICLE, Decodings, WireEv
 from . import osichecks
 from .belief import Beliefs
 from .answers import Answers
-from .blame import targets
+from .blame import command_clauses, targets
 from .catalog import GivenMissions, KnownMissions
 from .deadlines import Deadlines
 from .lines import Kind, OutputJudge, classify
@@ -108,6 +108,8 @@ class VehicleObserver(Answers, Deadlines):
         self.aborted = ""
         #: (mode before, command ID) of every accepted control command in a remote mode (coverage)
         self.interrupt_pairs: set = set()
+        #: an answer that names two faults, held until a report tells them apart (:meth:`_hold`)
+        self.held: Optional[tuple] = None
 
     # ------------------------------------------------------------------ helpers
     def v(self, t: float) -> float:
@@ -157,6 +159,37 @@ class VehicleObserver(Answers, Deadlines):
             return None
         due, dur, nm = got
         return due / self.k, dur, nm
+
+    # ------------------------------------------------------------------ an answer naming two faults
+    def _hold(self, p: Sent, cands: tuple, ignored: tuple, what: str, ev: list) -> None:
+        """An answer no conforming state gives, which the state before the accepted command just
+        before it gives (:attr:`~.belief.CommandResult.ignored`): either the answer is wrong, or
+        that command was not carried out. Held until the next report tells them apart
+        (:meth:`_settle`)."""
+        cmd, row, ack = ignored
+        q = next((q for q in reversed(self.sent) if q.kind.item is cmd and q is not p), None)
+        self.held = (p, cands, command_clauses(cmd, ack, row), what, ev,
+                     text_of(q) if q is not None else f"${cmd.ID}", [q.ev] if q is not None else [])
+
+    def _settle(self, ignored: Optional[bool], explained: bool, report: list) -> None:
+        """Book the held answer: on its own clauses when the next report shows the command before
+        it carried out (the mirror explains the report, a vehicle that did not carry it out does
+        not); on that command's clauses when the report shows it not carried out; on both when
+        the report tells nothing apart, or none comes before another command or the record's end."""
+        p, cands, other, what, ev, text, before_ev = self.held  # type: ignore[misc]
+        self.held = None
+        if ignored and not explained:
+            self.book("fail", other, f"{text} was accepted but not carried out: the next report shows the state "
+                                     f"before it, and {what} — as that state answers", before_ev + ev + report, at=p)
+        elif explained and ignored is False:
+            self.book("fail", cands, what, ev, at=p)
+        else:
+            self.book("fail", cands, f"{what}; or else {text} before it, accepted with no report between, was not "
+                                     f"carried out (the state before it answers so): no report tells which",
+                      before_ev + ev, at=p)
+            self.book("fail", other, f"{text}, accepted, may not have been carried out: {what}, as the state before "
+                                     f"it answers; or else that answer is wrong: no report tells which",
+                      before_ev + ev, at=p)
 
     # ------------------------------------------------------------------ input
     def feed(self, ev: WireEvent) -> None:
@@ -376,6 +409,8 @@ class VehicleObserver(Answers, Deadlines):
         state is unknown again (taken from the next report that shows it whole, as at the start of
         a record), and the run is no longer ended early."""
         t = ev.t
+        if self.held is not None:
+            self._settle(None, False, [])
         self.framers = {TO_VEHICLE: Framer(self.profile.max_line_bytes),  # a line cut by the
                         FROM_VEHICLE: Framer(max(4096, 4 * self.profile.max_line_bytes))}  # stop is nobody's
         for p in list(self.pending) + self.dead:
@@ -426,6 +461,8 @@ class VehicleObserver(Answers, Deadlines):
                 p.missing_booked = True
                 self._book_missing(p)
         self._mission_unshown("the record ended")
+        if self.held is not None:
+            self._settle(None, False, [])
         self.checks.close()
         if self.ledger.holding:
             self.ledger.release(False, "not confirmed: the record ended before the re-runs")
