@@ -38,6 +38,10 @@ never their values) and keeps, besides the model, what judging needs and the mod
   report of the after-state a little before the model's own deadline, within the tolerance,
   leaves the last report of the before-state as the bracket's start), and the last err 26 to a
   command only the lockout refuses;
+* ``noted`` — the moment a plant note (the emulator's own log) says the next mission waypoint was
+  reached, where the observer left that event to the reports because it does not know yet what
+  the waypoint holds: the closure adopts it at that moment, not in a window (until the next
+  confirmed report);
 * ``nav_seen`` / ``fix_seen`` — the latest report of the running mission's distance to its next
   waypoint (``$OSI`` field 7 in ``N`` or ``P`` at that waypoint: mission name, waypoint, metres,
   vehicle time, position, speed) and the latest reported position (earliest and latest vehicle
@@ -96,7 +100,7 @@ class Candidate:
 
     __slots__ = ("model", "events", "story", "extra_v", "window", "pending", "timed", "abandoned",
                  "s_cause", "refused_locked", "seen_v", "seen_mode", "seen_at", "locked_v", "code_unknown",
-                 "refresh", "nav_seen", "fix_seen", "left_v", "release", "resumed", "_mode", "_phase")
+                 "refresh", "nav_seen", "fix_seen", "left_v", "release", "resumed", "noted", "_mode", "_phase")
 
     def __init__(self, model: VehicleModel):
         if model.trace is None:
@@ -125,6 +129,9 @@ class Candidate:
         #: it) of a timed release
         self.release: Optional[tuple] = None
         self.resumed = False  #: the mission park counting is one resumed after remote control
+        #: vehicle time of a plant note of the next mission waypoint reached that the observer left
+        #: to the reports (what the waypoint holds is not known yet): the closure places it then
+        self.noted: Optional[float] = None
         self._mode = model.mode
         self._phase = model.phase
 
@@ -144,7 +151,7 @@ class Candidate:
         c.seen_at = dict(self.seen_at)
         c.code_unknown = self.code_unknown
         c.nav_seen, c.fix_seen = self.nav_seen, self.fix_seen
-        c.left_v, c.release, c.resumed = self.left_v, self.release, self.resumed
+        c.left_v, c.release, c.resumed, c.noted = self.left_v, self.release, self.resumed, self.noted
         c._mode, c._phase = self._mode, self._phase
         return c
 
@@ -271,7 +278,7 @@ class Candidate:
 
     def saw(self, v: float, mode: str) -> None:
         """A confirmed ``$OSI`` showed ``mode``, sent at vehicle time ``v``."""
-        self.seen_v, self.seen_mode = v, mode
+        self.seen_v, self.seen_mode, self.noted = v, mode, None
         self.seen_at[mode] = v
 
     def lapse_uncertainty(self) -> None:

@@ -5,8 +5,9 @@ an ``$OPK`` position or a queued ``$OMW`` waypoint, the surface after a lockout,
 tripping by itself (RH-SAF-5), the end of a mission of unknown length. The observer adopts such
 an event for a candidate state only when a report cannot be explained without it, and places it
 in an explicit **time window**: it happened after ``tp`` (the last observation that showed it had
-not, or the model's last input) and before the report that reveals it. The event is applied at
-the window's start and the window's width is carried as extra slack on every timer it started
+not, or the model's last input) and before the report that reveals it — or at ``tp`` exactly,
+where the emulator's own log has a plant note of that waypoint reached
+(:attr:`~.candidate.Candidate.noted`). The event is applied at the window's start and the window's width is carried as extra slack on every timer it started
 (:class:`~.candidate.Candidate`), so any moment in the window is accepted.
 
 :func:`explain_osi` tries, in order of plausibility (fewest events first), the events that fit
@@ -54,6 +55,9 @@ __all__ = ["explain_osi", "explain_reply", "same_replies", "reply_keys", "MAX_WA
 
 #: The most mission (or queue) waypoints the observer assumes passed between two reports.
 MAX_WAYPOINTS = 8
+#: The trials of one mission waypoint reached, what it holds learnt: the event a plant note gives
+#: the moment of when the observer left it to the reports (:attr:`~.candidate.Candidate.noted`).
+_NOTED = ("mission waypoint reached", "a mission park", "the mission's end")
 _FT = 0.3048
 _SAFETY = frozenset(SAFETY_CODES)
 
@@ -127,6 +131,9 @@ def explain_osi(c: Candidate, osi: s.OSI, v: float, slack_v: float, tp: float, c
         if ok(trial, early):
             if learn is not None:
                 learn()
+            if n == 1 and c.noted == tp and name.startswith(_NOTED):
+                # the emulator's own note says when: the waypoint was reached then, at the window's start
+                return trial.adopted(f"{name} at v={tp:.1f} (the plant's note)", tp, tp, n)  # type: ignore[union-attr]
             return trial.adopted(f"{name} between v={tp - early:.1f} and v={v:.1f}", tp - early, v, n)  # type: ignore[union-attr]
         return None
 

@@ -274,8 +274,12 @@ class VehicleObserver(Answers, Deadlines):
                     return
             for c in self.beliefs.cands:
                 if isinstance(event, P.WaypointReached) and self._unknown_waypoint(c.model, event.index):
-                    continue  # what the waypoint holds is learnt from the reports (closure)
-                c.model.plant(event, max(v, c.model.now or 0.0))
+                    # what the waypoint holds is learnt from the reports (the closure), in a window
+                    # that begins when the note says it was reached: the model is brought to then
+                    c.model.advance(max(v, c.model.now or 0.0))
+                    c.noted = c.model.now
+                else:
+                    c.model.plant(event, max(v, c.model.now or 0.0))
                 c.drain()
             self.event(ev.t, "lockout" if isinstance(event, P.SafetyViolation) else "note", ev.note[:80])
 
