@@ -9,6 +9,11 @@ the waypoint held nothing (the judge then expected ``N`` toward the next waypoin
 vehicle rightly reports its mission park): such a note is left to the reports, as if the log had
 no notes. The session is the reference emulator's core driven in virtual time to and through the
 park of ``conformance.mis`` (waypoint 1, 300 s), its log kept whole.
+
+A note also comes between an ``$OSD`` and its ``$OSI`` when the event happened while the report
+was on its way: the report shows the state the vehicle was in when it processed the ``$OSD``,
+before the event, and is judged before the note is applied (it was judged against the state
+after it: a queued waypoint reached, the park on it expected, ``P0`` FAILed).
 """
 
 from __future__ import annotations
@@ -21,6 +26,8 @@ from helmcheck.checklog.checker import check_log
 from helmcheck.emulator.missionfile import DirectoryCatalog, builtin_dir
 from helmcheck.profile import DEFAULT
 from tests.virtual_vehicle import VirtualVehicle, osi_fields
+
+M_PER_DEG = 111_320.0
 
 
 def session(path: Path, through: bool = True) -> list:
@@ -86,3 +93,42 @@ def _shorten(line: str) -> str:
     f[10] = f"P{max(0, int(f[10][1:]) - 60)}"
     body = ",".join(f)
     return f"{head}${body}*{checksum_hex(body)}\n"
+
+
+def in_flight_session(path: Path, margin_m: float) -> list:
+    """A waypoint queued 30 m north with a 20 s park; reports every 0.5 s until it is 4.5 m off,
+    then the plant alone until it is ``margin_m`` from on station (3 m), then a report — the
+    vehicle arrives while that report is on its way — and reports for 4 s. The log keeps its notes.
+    Returns the lines of the log from that report's ``$OSD`` to its ``$OSI``."""
+    vv = VirtualVehicle(DEFAULT)
+    m = vv.core.model
+    vv.send("OMSTART,0,0,0,0,conformance.mis,")
+    vv.now += 5.0
+    f = osi_fields(vv.send("OSD,G,C,S"))
+    vv.send(f"OMW,{float(f[4]) + 30 / M_PER_DEG:.6f},{float(f[5]):.6f},2.0,,20,2.0,20,")
+    while float(f[7]) >= 4.5 and vv.now < 100:
+        vv.now += 0.5
+        f = osi_fields(vv.send("OSD,G,C,S"))
+    while m._distance() > 3.0 + margin_m:
+        vv.now += 0.005
+        vv.core.tick(vv.now)
+    mark = len(vv.buf.getvalue())
+    vv.send("OSD,G,C,S")
+    between = vv.buf.getvalue()[mark:].splitlines()
+    for _ in range(8):
+        vv.now += 0.5
+        vv.send("OSD,G,C,S")
+    path.write_text(vv.buf.getvalue())
+    return between[:next(i for i, ln in enumerate(between) if "$OSI," in ln) + 1]
+
+
+@pytest.mark.parametrize("margin_m", [0.01, 0.02, 0.04, 0.08])
+def test_a_plant_note_while_a_report_is_on_its_way_is_applied_after_it(tmp_path, margin_m):
+    path = tmp_path / "wire.log"
+    between = in_flight_session(path, margin_m)
+    if margin_m <= 0.04:  # the case in question: the note comes before the report it follows
+        assert any("plant: QueueWaypointReached" in ln for ln in between), between
+        assert ",P0," in between[-1], between[-1]
+    out = check_log(path, profile=DEFAULT, role="vehicle")
+    bad = {c["id"]: c["reason"] for c in out.clauses if c["verdict"] == "fail"}
+    assert not bad, bad

@@ -21,7 +21,10 @@
 
 Notes it acts on (:mod:`helmcheck.judge.wire`): ``case``/``case … end`` (attribution),
 ``not tested``/``inconclusive`` (tester facts), ``link:`` (RH-FRM-9), ``plant:`` and
-``fault injected`` (exact plant events from an emulator's own log).
+``fault injected`` (exact plant events from an emulator's own log: applied after a report asked
+for before them and still on its way, which shows the state before them; a mission waypoint
+reached whose park or end the observer has not learnt is left to the reports, from the note's
+moment on).
 
 A driver reads, besides the ledger: :attr:`sent` (every classified backseat line, with its
 outcome — the handle a live driver waits on), :attr:`last_osi`, :meth:`deadline` and
@@ -110,6 +113,8 @@ class VehicleObserver(Answers, Deadlines):
         self.interrupt_pairs: set = set()
         #: an answer that names two faults, held until a report tells them apart (:meth:`_hold`)
         self.held: Optional[tuple] = None
+        #: plant notes waiting for a report on its way to be judged first (:meth:`_note`)
+        self.notes_held: list = []
 
     # ------------------------------------------------------------------ helpers
     def v(self, t: float) -> float:
@@ -201,6 +206,8 @@ class VehicleObserver(Answers, Deadlines):
             self.vbytes += len(ev.data)
             for fe in self._frame(FROM_VEHICLE, ev.data):
                 self._vehicle(fe, ev)
+            if self.notes_held:
+                self._release_notes()
         elif ev.dir == NOTE:
             self._note(ev)
 
@@ -272,16 +279,36 @@ class VehicleObserver(Answers, Deadlines):
                     event = cls(**kwargs)
                 except TypeError:
                     return
-            for c in self.beliefs.cands:
-                if isinstance(event, P.WaypointReached) and self._unknown_waypoint(c.model, event.index):
-                    # what the waypoint holds is learnt from the reports (the closure), in a window
-                    # that begins when the note says it was reached: the model is brought to then
-                    c.model.advance(max(v, c.model.now or 0.0))
-                    c.noted = c.model.now
-                else:
-                    c.model.plant(event, max(v, c.model.now or 0.0))
-                c.drain()
-            self.event(ev.t, "lockout" if isinstance(event, P.SafetyViolation) else "note", ev.note[:80])
+            # a report asked for before the event, still on its way, shows the state before it (the
+            # vehicle answers an $OSD when it processes it): the event waits until it is judged
+            asked = next((q for q in self.pending if q.kind.ack_type == 8 and q.osi is None
+                          and "S" in getattr(q.kind.item, "requested", ())), None)
+            if asked is not None:
+                self.notes_held.append((event, v, ev, asked))
+            else:
+                self._plant_note(event, v, ev)
+
+    def _plant_note(self, event, v: float, ev: WireEvent) -> None:
+        """A plant event from a note, at vehicle time ``v``, to every candidate."""
+        for c in self.beliefs.cands:
+            if isinstance(event, P.WaypointReached) and self._unknown_waypoint(c.model, event.index):
+                # what the waypoint holds is learnt from the reports (the closure), in a window
+                # that begins when the note says it was reached: the model is brought to then
+                c.model.advance(max(v, c.model.now or 0.0))
+                c.noted = c.model.now
+            else:
+                c.model.plant(event, max(v, c.model.now or 0.0))
+            c.drain()
+        self.event(ev.t, "lockout" if isinstance(event, P.SafetyViolation) else "note", ev.note[:80])
+
+    def _release_notes(self, all_: bool = False) -> None:
+        """Plant notes held for a report on its way (:meth:`_note`), once it has come (or gone)."""
+        while self.notes_held:
+            event, v, ev, asked = self.notes_held[0]
+            if not all_ and asked.osi is None and any(q is asked for q in self.pending):
+                return
+            self.notes_held.pop(0)
+            self._plant_note(event, v, ev)
 
     def _unknown_waypoint(self, m, index: Optional[int]) -> bool:
         """Whether reaching mission waypoint ``index`` (the next one when None) does what the
@@ -415,6 +442,7 @@ class VehicleObserver(Answers, Deadlines):
         t = ev.t
         if self.held is not None:
             self._settle(None, False, [])
+        self.notes_held = []
         self.framers = {TO_VEHICLE: Framer(self.profile.max_line_bytes),  # a line cut by the
                         FROM_VEHICLE: Framer(max(4096, 4 * self.profile.max_line_bytes))}  # stop is nobody's
         for p in list(self.pending) + self.dead:
@@ -465,6 +493,7 @@ class VehicleObserver(Answers, Deadlines):
                 p.missing_booked = True
                 self._book_missing(p)
         self._mission_unshown("the record ended")
+        self._release_notes(all_=True)
         if self.held is not None:
             self._settle(None, False, [])
         self.checks.close()
