@@ -7,8 +7,9 @@ an event for a candidate state only when a report cannot be explained without it
 in an explicit **time window**: it happened after ``tp`` (the last observation that showed it had
 not, or the model's last input) and before the report that reveals it — or at ``tp`` exactly,
 where the emulator's own log has a plant note of that waypoint reached
-(:attr:`~.candidate.Candidate.noted`). The event is applied at the window's start and the window's width is carried as extra slack on every timer it started
-(:class:`~.candidate.Candidate`), so any moment in the window is accepted.
+(:attr:`~.candidate.Candidate.noted`). The event is applied at the window's start and the
+window's width is carried as extra slack on every timer it started (:class:`~.candidate.Candidate`),
+so any moment in the window is accepted.
 
 :func:`explain_osi` tries, in order of plausibility (fewest events first), the events that fit
 the candidate's mode, and keeps the first that explains the ``$OSI``:
