@@ -12,8 +12,9 @@ FAILed on a conforming vehicle (a distance taken as proof of which waypoint it h
 The sessions are the reference emulator's core driven in virtual time: two waypoints queued
 (the second 80 m beyond the first), reports every 0.5 s, a third waypoint appended when the
 vehicle is well on its way to the second, reports on; recorded without the emulator's notes and
-checked as ``check-log`` checks a recording. The faulty counterpart takes an appended waypoint
-first: still RH-OMW-2's FAIL.
+checked as ``check-log`` checks a recording. An ``$OPOS`` that puts the submerged vehicle on its
+head waypoint at once (RH-POS-2) is no disorder either. The faulty counterpart takes an appended
+waypoint first: still RH-OMW-2's FAIL.
 """
 
 from __future__ import annotations
@@ -82,6 +83,48 @@ def test_a_waypoint_appended_after_an_unseen_arrival_is_no_disorder(tmp_path, on
     bad = {c: r for c, (verdict, r) in v.items() if verdict == "fail"}
     assert not bad, bad
     assert v["RH-OMW-2"][0] == "pass", v["RH-OMW-2"]
+
+
+def opos_session(path: Path) -> list:
+    """Two waypoints queued 40 m apart; when the vehicle (submerged: no GPS fix) is 12 m short of
+    the first, an ``$OPOS`` puts it on it (RH-POS-2 applies it at once); reports on."""
+    vv = VirtualVehicle(DEFAULT)
+    m = vv.core.model
+    seen = []
+
+    def poll() -> list:
+        f = osi_fields(vv.send("OSD,G,C,S"))
+        seen.append((round(vv.now, 2), f[2], float(f[7])))
+        return f
+
+    vv.send("OMSTART,0,0,0,0,conformance.mis,")
+    vv.now += 5.0
+    f = poll()
+    w1 = (float(f[4]) + 40 / M_PER_DEG, float(f[5]))
+    w2 = (w1[0] + 40 / M_PER_DEG, w1[1])
+    for w in (w1, w2):
+        vv.send(f"OMW,{w[0]:.6f},{w[1]:.6f},2.0,,20,2.0,0,")
+    while (m.mode != "W" or float(f[7]) > 12.0 or m.gps_fix) and vv.now < 200:
+        vv.now += 0.5
+        f = poll()
+    vv.now += 0.2
+    vv.send(f"OPOS,{w1[0]:.6f},{w1[1]:.6f},2.0,33.0,12.0")
+    for _ in range(6):
+        vv.now += 0.5
+        poll()
+    vv.write(path)
+    return seen
+
+
+def test_an_opos_that_puts_the_vehicle_on_a_queued_waypoint_is_no_disorder(tmp_path):
+    """RH-POS-2 with RH-OMW-2: the fix moved the vehicle onto its head waypoint at once; it heads
+    for the next (its next report's field 7 is the distance to it), which no speed explains."""
+    path = tmp_path / "wire.log"
+    seen = opos_session(path)
+    assert any(d > 30 for _, mode, d in seen[-6:]), seen[-8:]  # heading for the second at once
+    v = judged(path)
+    bad = {c: r for c, (verdict, r) in v.items() if verdict == "fail"}
+    assert not bad, bad
 
 
 class AppendedFirst(Model):

@@ -32,7 +32,8 @@ A report carries more, and these checks use it:
   longer than the same allowance without taking it fails RH-SAF-4;
 * **``$OPOS``** (RH-POS-2): a candidate that applied an accepted ``$OPOS`` position keeps it as
   its latest position (``fix_seen``) and forgets the distance it last reported (``nav_seen``): it
-  moved there at once. After an accepted ``$OPOS`` the next report's position is where the
+  moved there at once (and the ``$OMW`` queue's heads forget where they were last seen,
+  :meth:`~.queuetarget.QueueTarget.moved`). After an accepted ``$OPOS`` the next report's position is where the
   mirror says (moved to the given position without a GPS fix, not moved with one) — judged only
   when the two readings are far enough apart to tell; every later ``$OCTD`` shows the
   conductivity and temperature it gave;
@@ -184,12 +185,16 @@ class OsiChecks:
         # until now no longer bounds where it is, so an unseen waypoint reached is bounded from
         # the fix on (:func:`.closure.reachable`), not from the reports before it.
         v, late = o.v(p.t) - 2 * o.slack_v(), o.v(p.t_ack) + o.slack_v()
+        moved = False
         for c in o.beliefs.cands:
             done = c.model.opos_records
             if done and done[-1].position_applied:
                 speed = c.fix_seen[-1] if c.fix_seen is not None else 0.0
                 c.fix_seen = (v, late, float(item.lat), float(item.lon), speed)
                 c.nav_seen = None
+                moved = True
+        if moved:  # so is a queued waypoint reached (RH-OMW-2): the way it made bounds it no longer
+            self.queue.moved()
         last = o.last_osi
         rec = o.beliefs.primary.model.opos_records
         if last is None or not rec:

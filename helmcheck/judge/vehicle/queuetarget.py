@@ -23,6 +23,8 @@ which it may have been (its position and time) — never as one guess:
   the waypoint it heads for (once per queue);
 * field 7 that fits no queued waypoint, or only waypoints before every head, is not judged here
   (what else the report shows is the mirror's), and changes nothing;
+* an ``$OPOS`` position applied (RH-POS-2, no GPS fix) moves the vehicle at once: the heads
+  forget where they were last seen (:meth:`QueueTarget.moved`);
 * the queue the mirror holds grows at its end (``$OMW`` in ``W`` appends, RH-RD-3) and loses its
   head when the mirror adopts a waypoint reached: the heads follow, shifted; a queue that is not
   such a continuation (control ended and a new queue began) sets out from where the last report
@@ -113,6 +115,14 @@ class QueueTarget:
              f"that far: the queue is not kept in arrival order")
         self.booked = True
         self.heads = {k: now for k in fits}  # followed from what it shows
+
+    def moved(self) -> None:
+        """An ``$OPOS`` position was applied (RH-POS-2): the vehicle is there at once, so the way
+        it can have made since a head was last seen no longer bounds which waypoints it has
+        reached; every later waypoint may be reached by the next report."""
+        self.heads = {j: None for j in self.heads}
+        if self.last is not None:
+            self.last = None  # nor does the report before it say where a new queue sets out from
 
     def _follow(self, queue: tuple, before) -> None:
         """The heads of :attr:`queue` carried over to ``queue`` (module docstring)."""
