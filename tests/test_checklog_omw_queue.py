@@ -145,3 +145,51 @@ def test_a_vehicle_that_takes_the_appended_waypoint_first_fails_RH_OMW_2(tmp_pat
     v = judged(path)
     assert v["RH-OMW-2"][0] == "fail", v["RH-OMW-2"]
     assert "not kept in arrival order" in v["RH-OMW-2"][1]
+
+
+def test_heads_that_may_have_been_the_popped_waypoint_go_on_to_the_next():
+    """Sans-IO, on :class:`~helmcheck.judge.vehicle.queuetarget.QueueTarget` with the reference model:
+    where the vehicle may have been heading for the first queued waypoint or a later one (an
+    ``$OPOS`` applied made every later one reachable, and field 7 fitted two), and the mirror then
+    drops the first (its park ended), the vehicle may now head for the new first one: a report
+    that fits it is no disorder (the heads kept only the later one, shifted, and a report fitting
+    the new first one, then one further on, was booked as out of order)."""
+    from helmcheck.grammar import parse
+    from helmcheck.grammar.checksum import checksum_hex
+    from helmcheck.judge.ledger import Ledger
+    from helmcheck.judge.vehicle.queuetarget import QueueTarget
+    from helmcheck.model.geo import distance_m
+    from helmcheck.model.plant import QueueWaypointReached
+    from helmcheck.model.testing import catalog
+    from helmcheck.model.vehicle import VehicleModel
+
+    def cmd(body: str):
+        return parse(f"${body}*{checksum_hex(body)}".encode())
+
+    lat0, lon0 = 41.52, -71.32
+    wps = [(lat0 + 20 / M_PER_DEG, lon0), (lat0, lon0 + 60 / 83_500), (lat0 + 20 / M_PER_DEG, lon0 + 3 / 83_500)]
+    m = VehicleModel(DEFAULT, catalog())
+    m.receive(cmd("OMSTART,0,0,0,0,conformance.mis,"), 0.0)
+    m.receive(cmd(f"OMW,{wps[0][0]:.6f},{wps[0][1]:.6f},2.0,,20,2.0,10,"), 1.0)
+    for w in wps[1:]:
+        m.receive(cmd(f"OMW,{w[0]:.6f},{w[1]:.6f},2.0,,20,2.0,0,"), 1.0)
+    booked = []
+    q = QueueTarget(Ledger(["RH-OMW-2"]), DEFAULT.on_station_m, DEFAULT.max_speed_kn)
+
+    def report(v: float, at: tuple, head: int) -> None:
+        d = distance_m(*at, *wps[head])
+        body = (f"OSI,8080808080,W,0,{at[0]:.8f},{at[1]:.8f},0.00,{d:.2f},N,38.00,P0,-14.5000,"
+                f"conformance.mis,4.5,0.0,2.00,94.7,False,IVER3-EMU,0.0,False,False")
+        q.report(parse(f"${body}*{checksum_hex(body)}".encode()), m, v, v + 0.1, [], "",
+                 lambda verdict, clauses, reason: booked.append(reason))
+
+    report(2.0, (lat0, lon0), 0)
+    q.moved()  # an $OPOS applied: every later waypoint reachable by the next report
+    report(2.5, (lat0 + 1 / M_PER_DEG, lon0), 0)  # fits waypoints 1 and 3 (as far as each)
+    assert set(q.heads) == {0, 2}, q.heads
+    m.plant(QueueWaypointReached(), 3.0)  # the first reached, its park begun ...
+    m.advance(14.0)                       # ... and over: the mirror drops it
+    assert len(m.queue) == 2
+    report(14.5, wps[0], 1)  # heading for the second queued (now the first)
+    assert booked == [], booked
+    assert 0 in q.heads, q.heads

@@ -14,7 +14,8 @@ what was adopted to explain the wire), most plausible first (fewest unseen event
   got there (:func:`~.closure.reachable`); an ``$OSD`` that every candidate can only have met
   in one state is answered in place, not on copies (it changes no state; ``_poll``). The
   candidates whose answer is the vehicle's survive.
-  When none does, unseen events that change the answer are tried (:func:`~.closure.explain_reply`);
+  When none does, unseen events that change the answer are tried (:func:`~.closure.explain_reply`,
+  for every candidate);
   when that fails too, the answer is a finding, and the observer follows the nominal state marked
   *desynchronised* until a state that is known again (an accepted ``$OMSTOP`` or ``$OMSTART``).
 * :meth:`Beliefs.osi` — an ``$OSI`` produced between ``v_sent`` and ``v_recv``. The candidates
@@ -151,16 +152,16 @@ class Beliefs:
             chosen = match[0]
             result = CommandResult(chosen[1], True, chosen[2], chosen[3], chosen[0].story[base:], False, desync)
         else:
-            found = None
+            explanations = []  # each candidate's own (they may differ in what no report shows yet)
             for c in self.cands:
                 tp = c.seen_v if c.seen_v is not None else (c.model.now or v)
-                found = explain_reply(c, item, v, observed, tp, self.catalog, self.profile.gps_fix_depth_m)
-                if found is not None:
-                    break
-            if found is not None:
-                cand, replies, mission_dep = found
+                got = explain_reply(c, item, v, observed, tp, self.catalog, self.profile.gps_fix_depth_m)
+                if got is not None:
+                    explanations.append(got)
+            if explanations:
+                cand, replies, mission_dep = explanations[0]
                 base = len(self.cands[0].story)
-                self._keep([cand])
+                self._keep([e[0] for e in explanations])
                 result = CommandResult(replies, True, nominal[2], nominal[3], cand.story[base:], mission_dep,
                                        desync)
             else:
@@ -334,10 +335,9 @@ class Beliefs:
             for c in self.cands:
                 tp = c.seen_v if c.seen_v is not None else (c.model.now or v_sent)
                 got = explain_osi(c, osi, v, slack, tp, self.catalog, fix, self.profile.depth_unit)
-                if got is not None:
-                    explained.append(got)
-                    result.adopted = got.story[len(c.story):]
-                    break
+                if got is not None:  # each candidate's own explanation: they differ in what no
+                    explained.append(got)  # report shows (a mission frozen in N or in P)
+                    result.adopted = result.adopted or got.story[len(c.story):]
         if not explained:
             p = self.primary
             result.findings = p.check(osi, v, slack)

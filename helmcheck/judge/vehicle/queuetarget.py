@@ -26,7 +26,8 @@ which it may have been (its position and time) — never as one guess:
 * an ``$OPOS`` position applied (RH-POS-2, no GPS fix) moves the vehicle at once: the heads
   forget where they were last seen (:meth:`QueueTarget.moved`);
 * the queue the mirror holds grows at its end (``$OMW`` in ``W`` appends, RH-RD-3) and loses its
-  head when the mirror adopts a waypoint reached: the heads follow, shifted; a queue that is not
+  head when the mirror adopts a waypoint reached or a park on it ends: the heads follow, shifted
+  (a vehicle that may have been heading for a waypoint now gone heads for the first left); a queue that is not
   such a continuation (control ended and a new queue began) sets out from where the last report
   saw the vehicle, heading for its first waypoint.
 
@@ -133,6 +134,9 @@ class QueueTarget:
         n = next((n for n in range(len(old)) if queue[:len(old) - n] == old[n:]), None) if old else None
         if n is not None:
             heads = {j - n: at for j, at in self.heads.items() if j >= n}
+            passed = [at for j, at in self.heads.items() if j < n]
+            if passed:  # heading for one the mirror now has reached: heading for the next since
+                heads.setdefault(0, None if None in passed else min(passed))
             self.heads = heads or {0: before}
             return
         self.heads, self.booked = {0: before}, False
