@@ -16,8 +16,11 @@ The sessions are the reference emulator's core driven in virtual time: ``conform
 its mission park (waypoint 1, 300 s), a report every 0.5 s, then, again and again, an ``$OPK``
 20 m away for a minute some seconds into the park, until the mission park runs again; checked
 as ``check-log`` checks a recording (no emulator notes), without and with the mission files.
-The faulty counterparts resume the mission park with the wrong time left, or let it count down
-during the ``$OPK`` park: still FAILed.
+The profile leaves room for a vehicle that counts the resumed park only once back on station at
+its waypoint (the paper: "once control is released the vehicle will park for the remaining
+time"): the emulator's ``resumed_park = "on station"``, which heads back first; it PASSes too.
+The faulty counterparts resume the mission park with the wrong time left, let it count down
+during the ``$OPK`` park, or hold it and never count once back on station: still FAILed.
 """
 
 from __future__ import annotations
@@ -103,6 +106,22 @@ def test_a_release_late_on_a_control_tick_resumes_the_park_late_and_is_not_a_vio
     assert not bad, bad
 
 
+@pytest.mark.parametrize("times", [1, 3])
+def test_a_resumed_park_that_counts_once_back_on_station_is_not_a_violation(tmp_path, times):
+    """The profile's other reading (RH-INT-2; the paper: "the vehicle will park for the remaining
+    time"): the resumed park counts only once the vehicle is back on station at its waypoint, which
+    it heads for first (``resumed_park = "on station"``)."""
+    path = tmp_path / "wire.log"
+    seen = session(path, 0.0, times=times, settings=EmulatorSettings(resumed_park="on station"))
+    i = next(i for i, (a, b) in enumerate(zip(seen, seen[1:])) if (a[1], b[1]) == ("mP", "P"))
+    held = [x for x in seen[i + 1:i + 8]]
+    assert len({x[3] for x in held}) == 1 and float(held[0][2]) > 10, held  # held while away
+    for missions in (False, True):
+        v = judged(path, missions)
+        bad = {c: r for c, (verdict, r) in v.items() if verdict == "fail"}
+        assert not bad, (missions, bad)
+
+
 class ResumesWithLess(Model):
     """RH-INT-2: the mission park resumes with ``LESS`` s less than was left when the ``$OPK`` came."""
 
@@ -132,11 +151,25 @@ class ParkRunsUnderOpk(Model):
         del left
 
 
-@pytest.mark.parametrize("fault,clauses", [(ResumesWithLess, {"RH-INT-2"}), (ParkRunsUnderOpk, {"RH-INT-2"})],
-                         ids=["resumes-with-less", "runs-under-opk"])
-def test_a_mission_park_resumed_with_the_wrong_time_left_fails(tmp_path, fault, clauses):
+class NeverResumes(Model):
+    """RH-INT-2: a resumed park held until back on station (the other reading) that does not count
+    down once there either."""
+
+    def plant(self, event, now):
+        if self.mode == "P" and self.park_waiting and type(event).__name__ == "OnStation":
+            self._run_due(now)
+            return []
+        return super().plant(event, now)
+
+
+@pytest.mark.parametrize("fault,clauses,settings", [
+    (ResumesWithLess, {"RH-INT-2"}, None),
+    (ParkRunsUnderOpk, {"RH-INT-2"}, None),
+    (NeverResumes, {"RH-INT-2"}, EmulatorSettings(resumed_park="on station")),
+], ids=["resumes-with-less", "runs-under-opk", "never-resumes"])
+def test_a_mission_park_resumed_with_the_wrong_time_left_fails(tmp_path, fault, clauses, settings):
     path = tmp_path / "wire.log"
-    session(path, 0.0, times=1, model_factory=fault)
+    session(path, 0.0, times=1, model_factory=fault, settings=settings)
     v = judged(path, True)
     failed = {c for c, (verdict, _) in v.items() if verdict == "fail"}
     assert clauses <= failed, {c: v[c] for c in failed}

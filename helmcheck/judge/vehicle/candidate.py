@@ -20,7 +20,8 @@ never their values) and keeps, besides the model, what judging needs and the mod
   bracket (:meth:`_bracket_release`), and the park time the reports show narrows it further
   (:func:`~.brackets.retime`), as for a countdown an adopted event began; ``resumed`` — the
   mission park counting is one resumed so: a park time no conforming state explains is its time
-  left's (RH-INT-2, for blame);
+  left's (RH-INT-2, for blame), and it may be one that counts only once back on station
+  (``left_known``: how well its time left is known, :func:`~.closure.explain_osi`);
 * ``pending`` — table rows applied since the last confirming ``$OSI``: their clauses pass when an
   ``$OSI`` confirms the state they led to (rows that change nothing visible pass at their ACK);
 * ``timed`` — timer-driven transitions awaiting their RH-TIM-1 bracket (:class:`Timed`);
@@ -100,7 +101,8 @@ class Candidate:
 
     __slots__ = ("model", "events", "story", "extra_v", "window", "pending", "timed", "abandoned",
                  "s_cause", "refused_locked", "seen_v", "seen_mode", "seen_at", "locked_v", "code_unknown",
-                 "refresh", "nav_seen", "fix_seen", "left_v", "release", "resumed", "noted", "_mode", "_phase")
+                 "refresh", "nav_seen", "fix_seen", "left_v", "release", "resumed", "left_known", "noted",
+                 "_mode", "_phase")
 
     def __init__(self, model: VehicleModel):
         if model.trace is None:
@@ -129,6 +131,7 @@ class Candidate:
         #: it) of a timed release
         self.release: Optional[tuple] = None
         self.resumed = False  #: the mission park counting is one resumed after remote control
+        self.left_known = 0.0  #: vehicle seconds: how well the time left of a resumed park is known
         #: vehicle time of a plant note of the next mission waypoint reached that the observer left
         #: to the reports (what the waypoint holds is not known yet): the closure places it then
         self.noted: Optional[float] = None
@@ -152,6 +155,7 @@ class Candidate:
         c.code_unknown = self.code_unknown
         c.nav_seen, c.fix_seen = self.nav_seen, self.fix_seen
         c.left_v, c.release, c.resumed, c.noted = self.left_v, self.release, self.resumed, self.noted
+        c.left_known = self.left_known
         c._mode, c._phase = self._mode, self._phase
         return c
 
@@ -213,6 +217,7 @@ class Candidate:
             return
         self.resumed = True
         left, self.left_v = self.left_v, 0.0
+        self.left_known = left
         half = left + (tolerance(st.duration) + self.extra_v if st.timer else 0.0)
         if half > 0:
             self.window = (st.at - half, st.at + half)

@@ -26,7 +26,10 @@ the candidate's mode, and keeps the first that explains the ``$OSI``:
                        after waypoints passed (learnt when none passed)
 ``mission end``        ``S`` where only the end of a mission of unknown length explains it
 ``on station``         ``mP``: the ``$OPK`` countdown starts; ``W``: the queued waypoint is
-                       reached (×n for the queue)
+                       reached (×n for the queue); ``P``: a mission park resumed after remote
+                       control, held until back on station (RH-INT-2), counts from then
+``resumed park held``  ``P``: a mission park resumed after remote control counts only once
+                       back on station at its waypoint (RH-INT-2's other reading)
 =====================  ===================================================================
 
 :func:`explain_reply` does the same for an ``$ACK`` the candidate cannot explain, with the events
@@ -245,6 +248,8 @@ def _motion_trials(c: Candidate, osi: s.OSI, tp: float, gap: float, catalog) -> 
             out = [(name, not_past(build), n, learn) for name, build, n, learn in out]
     elif m.mode == "P" and m.mission is not None and osi.mode == "S":
         out += _park_and_end(c, osi, tp, gap, catalog)
+    elif m.mode == "P" and osi.mode == "P" and m.mission is not None and c.resumed:
+        out += _resumed_park(c, osi, tp)
     elif m.mode == "mP":
         from ...model.timers import tolerance
         prof = m.profile
@@ -268,6 +273,41 @@ def _motion_trials(c: Candidate, osi: s.OSI, tp: float, gap: float, catalog) -> 
         for n in range(1, min(len(m.queue), MAX_WAYPOINTS) + 1):
             out.append(("queued waypoint reached" if n == 1 else f"{n} queued waypoints reached",
                         queue(n), n, None))
+    return out
+
+
+def _resumed_park(c: Candidate, osi: s.OSI, tp: float) -> list:
+    """A mission park resumed after remote control (RH-INT-2) that counts only once back on
+    station at its waypoint — the reading the profile leaves beside counting at once
+    (:meth:`~helmcheck.model.vehicle.VehicleModel.await_park_station`): the count held at the time
+    left (where the report shows it, within what the observer knows of that time:
+    :attr:`~.candidate.Candidate.left_known`); then on station there, as for the ``$OPK`` park
+    (field 7 at most ``on_station_m`` plus the way it can have drifted while its count ran)."""
+    from ...model.timers import tolerance
+    m = c.model
+    out: list = []
+    shown = float(osi.park_time)
+    if not m.park_waiting and m.timers.armed("park"):
+        def hold(t: Candidate) -> Optional[Candidate]:
+            if not t.model.await_park_station():
+                return None
+            left, u = t.model.park_left or 0.0, c.left_known
+            if left < shown - 1.0 - u or left > shown + u:
+                return None  # not the time that was left (RH-INT-2)
+            t.model.park_left = min(max(left, shown - 1.0 + 1e-6), shown)  # field 10 rounded up
+            t.left_known = 0.0
+            return t
+        out.append(("the resumed mission park waiting to be back on station", hold, 1, None))
+    elif m.park_waiting:
+        prof = m.profile
+        left = m.park_left or 0.0
+        knots = max([prof.max_speed_kn, float(osi.speed)] + [x[-1] for x in (c.nav_seen, c.fix_seen) if x is not None])
+        counted = max(0.0, left - shown) + 1.0 + tolerance(left)
+        if float(osi.distance) <= prof.on_station_m + knots * KNOT_MPS * counted:
+            def on_station(t: Candidate) -> Candidate:
+                t.model.plant(OnStation(), tp)
+                return t
+            out.append(("on station at the mission park's waypoint", on_station, 1, None))
     return out
 
 

@@ -21,7 +21,8 @@ A report carries more, and these checks use it:
   reports itself within ``on_station_m`` of its target for longer than
   :data:`~helmcheck.judge.timing.PLANT_REACT_S` (+ RH-TIM-1 tolerance and slack) without acting
   fails the clause of the act it owes: the queued waypoint (RH-OMW-4), the mission's end at its
-  last waypoint (RH-MSN-4; a waypoint of a mission of unknown length: RH-OUT-4);
+  last waypoint (RH-MSN-4; a waypoint of a mission of unknown length: RH-OUT-4), a mission park
+  resumed after remote control that counts only once back on station (RH-INT-2);
 * **the ``$OMW`` queue's order** (field 7 in ``W``, RH-OMW-2): :mod:`.queuetarget`;
 * **the way made** (fields 4, 5, 6 and 7): every report's position, and field 7 in ``N``/``P`` at
   the mission's next waypoint, are kept on the mirror's candidates (``fix_seen``, ``nav_seen``)
@@ -429,6 +430,10 @@ class OsiChecks:
         elif osi.mode == "W" and not m.queue_parking:
             key = ("W", m.control_generation)
             clause, what = ("RH-OMW-4",), f"on its queued waypoint ({d:g} m) without going on"
+        elif osi.mode == "P" and m.mode == "P" and m.park_waiting:
+            key = ("P", m.mission_wp)
+            clause, what = ("RH-INT-2",), (f"back on station at its park's waypoint ({d:g} m) without its "
+                                           f"mission park counting down the time left (P{osi.park_time})")
         elif osi.mode == "N" and m.mission is not None:
             key = ("N", osi.next_waypoint)
             last = not m.mission.is_open and m.mission_wp == m.mission.last
