@@ -34,7 +34,8 @@ A report carries more, and these checks use it:
 * **``$OPOS``** (RH-POS-2): a candidate that applied an accepted ``$OPOS`` position keeps it as
   its latest position (``fix_seen``) and forgets the distance it last reported (``nav_seen``): it
   moved there at once (and the ``$OMW`` queue's heads forget where they were last seen,
-  :meth:`~.queuetarget.QueueTarget.moved`). After an accepted ``$OPOS`` the next report's position is where the
+  :meth:`~.queuetarget.QueueTarget.moved`, as the ``$OPK`` park forgets the reports that showed
+  the vehicle away from its position). After an accepted ``$OPOS`` the next report's position is where the
   mirror says (moved to the given position without a GPS fix, not moved with one) — judged only
   when the two readings are far enough apart to tell; every later ``$OCTD`` shows the
   conductivity and temperature it gave;
@@ -47,6 +48,7 @@ A report carries more, and these checks use it:
 
 from __future__ import annotations
 
+import math
 from decimal import Decimal, InvalidOperation
 from typing import Optional
 
@@ -71,9 +73,10 @@ _ENDS_PARK = (s.OMS, s.OMP, s.OMW, s.OMWClear, s.OJW, s.OMSTOP, s.OMSTART, s.OMS
 class _OpkPark:
     """An accepted ``$OPK`` (RH-PK-2): its park seconds, when it was sent (vehicle seconds), the
     reports that showed the vehicle away from its position ``(earliest, latest, metres)``, the
-    fastest the vehicle can go (knots), when it was first reported on station."""
+    ``$OPOS`` positions applied since (RH-POS-2: each moved it at once), the fastest the vehicle
+    can go (knots), when it was first reported on station."""
 
-    __slots__ = ("seconds", "v0", "away", "knots", "on", "passed", "failed")
+    __slots__ = ("seconds", "v0", "away", "knots", "on", "passed", "failed", "jumps")
 
     def __init__(self, seconds: int, v0: float):
         self.seconds, self.v0 = seconds, v0
@@ -81,6 +84,30 @@ class _OpkPark:
         self.knots = 0.0
         self.on: Optional[float] = None
         self.passed = self.failed = False
+        #: (earliest, latest) vehicle seconds of each ``$OPOS`` position applied since (RH-POS-2):
+        #: the vehicle was moved at once, so a report on one side says nothing of the other
+        self.jumps: list[tuple[float, float]] = []
+
+    def moved(self, early: float, late: float) -> None:
+        self.jumps.append((early, late))
+
+    def possible(self, begin: tuple[float, float], radius: float) -> bool:
+        """:func:`_possible` for each stretch between the moves (:attr:`jumps`), with the reports
+        of that stretch: whether the vehicle can have been on station at some moment of ``begin``."""
+        mps = self.knots * KNOT_MPS
+        cuts = [-math.inf] + [j for jump in self.jumps for j in jump] + [math.inf]
+        for i in range(0, len(cuts), 2):
+            a, b = cuts[i], cuts[i + 1]  # a stretch with no move inside it
+            part = (max(begin[0], a), min(begin[1], b))
+            if part[0] > part[1] + 1e-9:
+                continue
+            away = [x for x in self.away if a <= x[0] and x[1] <= b]
+            if _possible(part, away, mps, radius):
+                return True
+        for early, late in self.jumps:  # at the move itself: anywhere
+            if early <= begin[1] and late >= begin[0]:
+                return True
+        return False
 
 
 def _possible(begin: tuple[float, float], away: list, mps: float, radius: float) -> bool:
@@ -194,8 +221,10 @@ class OsiChecks:
                 c.fix_seen = (v, late, float(item.lat), float(item.lon), speed)
                 c.nav_seen = None
                 moved = True
-        if moved:  # so is a queued waypoint reached (RH-OMW-2): the way it made bounds it no longer
-            self.queue.moved()
+        if moved:  # so is a queued waypoint reached (RH-OMW-2), or the $OPK position (RH-PK-2): the
+            self.queue.moved()  # way it made bounds them no longer
+            if self.park is not None:
+                self.park.moved(v, late)
         last = o.last_osi
         rec = o.beliefs.primary.model.opos_records
         if last is None or not rec:
@@ -381,7 +410,7 @@ class OsiChecks:
                 return
             if not near and park.on is None and not park.failed:
                 begin = (max(park.v0, lo - most), hi - least)
-                if not _possible(begin, park.away, park.knots * KNOT_MPS, prof.on_station_m):
+                if not park.possible(begin, prof.on_station_m):
                     park.failed = True
                     far = max(park.away, key=lambda a: a[2])
                     o.book("fail", ("RH-PK-2",), f"{what} {d:g} m from its position, not on station "
