@@ -193,3 +193,52 @@ def test_heads_that_may_have_been_the_popped_waypoint_go_on_to_the_next():
     report(14.5, wps[0], 1)  # heading for the second queued (now the first)
     assert booked == [], booked
     assert 0 in q.heads, q.heads
+
+
+def test_a_report_of_a_queued_park_s_last_moment_says_nothing_of_the_next_head():
+    """Sans-IO: the mirror has ended the park on the first queued waypoint at its nominal end; the
+    vehicle, within RH-TIM-1's tolerance, still parks (``W``, ``P1``, field 7 its distance to the
+    parked waypoint), and a later queued waypoint happens to be as far. That report says nothing of
+    which waypoint the vehicle heads for next (it was taken for the later one, and the next report,
+    heading for the new first one, was booked as out of order)."""
+    from helmcheck.grammar import parse
+    from helmcheck.grammar.checksum import checksum_hex
+    from helmcheck.judge.ledger import Ledger
+    from helmcheck.judge.vehicle.queuetarget import QueueTarget
+    from helmcheck.model.geo import distance_m
+    from helmcheck.model.plant import QueueWaypointReached
+    from helmcheck.model.testing import catalog
+    from helmcheck.model.vehicle import VehicleModel
+
+    def cmd(body: str):
+        return parse(f"${body}*{checksum_hex(body)}".encode())
+
+    lat0, lon0 = 41.52, -71.32
+    # the parked waypoint, one 60 m east, one as far from where the vehicle parks (3.9 m north of
+    # it) as the parked one, and one as far from there as the one 60 m east
+    # with one 50 m north of it between the last two
+    wps = [(lat0, lon0), (lat0, lon0 + 60 / 83_500), (lat0 + 3.9 / M_PER_DEG, lon0 + 3.9 / 83_500),
+           (lat0 + 54 / M_PER_DEG, lon0), (lat0 + 3.9 / M_PER_DEG, lon0 - 60.1 / 83_500)]
+    m = VehicleModel(DEFAULT, catalog())
+    m.receive(cmd("OMSTART,0,0,0,0,conformance.mis,"), 0.0)
+    m.receive(cmd(f"OMW,{wps[0][0]:.6f},{wps[0][1]:.6f},2.0,,20,2.0,10,"), 1.0)
+    for w in wps[1:]:
+        m.receive(cmd(f"OMW,{w[0]:.6f},{w[1]:.6f},2.0,,20,2.0,0,"), 1.0)
+    booked = []
+    q = QueueTarget(Ledger(["RH-OMW-2"]), DEFAULT.on_station_m, DEFAULT.max_speed_kn)
+    here = (lat0 + 3.9 / M_PER_DEG, lon0)  # parked 3.9 m north of it (on station: within tolerance)
+
+    def report(v: float, d: float, park: int) -> None:
+        body = (f"OSI,8080808080,W,0,{here[0]:.8f},{here[1]:.8f},0.00,{d:.2f},N,38.00,P{park},-14.5000,"
+                f"conformance.mis,4.5,0.0,2.00,94.7,False,IVER3-EMU,0.0,False,False")
+        q.report(parse(f"${body}*{checksum_hex(body)}".encode()), m, v, v + 0.1, [], "",
+                 lambda verdict, clauses, reason: booked.append(reason))
+
+    m.plant(QueueWaypointReached(), 3.0)  # parks 10 s
+    q.moved()  # an $OPOS applied: any later waypoint reachable by the next report
+    report(12.0, distance_m(*here, *wps[0]), 1)
+    m.advance(13.05)  # the mirror ends the park at its nominal end
+    assert len(m.queue) == 4
+    report(13.05, distance_m(*here, *wps[0]), 1)  # the vehicle's last moment of the park
+    report(13.5, distance_m(*here, *wps[1]), 0)   # heading for the next queued, in order
+    assert booked == [], booked

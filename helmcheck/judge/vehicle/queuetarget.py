@@ -22,7 +22,9 @@ which it may have been (its position and time) — never as one guess:
   every conforming explanation: the queue was not kept in arrival order, RH-OMW-2 fails, naming
   the waypoint it heads for (once per queue);
 * field 7 that fits no queued waypoint, or only waypoints before every head, is not judged here
-  (what else the report shows is the mirror's), and changes nothing;
+  (what else the report shows is the mirror's), and changes nothing; nor is a report while the
+  vehicle parks on a queued waypoint, or as the park ends (within its RH-TIM-1 tolerance the
+  report may show its last moment, field 7 still the parked waypoint's distance);
 * an ``$OPOS`` position applied (RH-POS-2, no GPS fix) moves the vehicle at once: the heads
   forget where they were last seen (:meth:`QueueTarget.moved`);
 * the queue the mirror holds grows at its end (``$OMW`` in ``W`` appends, RH-RD-3) and loses its
@@ -84,8 +86,13 @@ class QueueTarget:
             return
         queue = tuple(model.queue)
         self._follow(queue, before)
-        if model.queue_parking:
-            return  # parked on the head: where it heads next is the queue's business after the park
+        cp = model.checkpoint
+        if (model.queue_parking or osi.park_time > 0
+                or (cp is not None and cp.mode == "W" and cp.queue_parking)):
+            # parked on the head (as the mirror or the report says: the mirror may have ended the
+            # park a little before the vehicle, within RH-TIM-1's tolerance), or the park ended
+            # within the report's uncertainty: where it heads next is for the reports after it
+            return
         here = (lat, lon)
         mps = max(self.max_speed_kn, float(osi.speed)) * KNOT_MPS
         d7 = float(osi.distance)
