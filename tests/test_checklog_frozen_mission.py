@@ -80,3 +80,46 @@ def test_the_mission_behaviour_an_opk_froze_is_followed_both_ways(tmp_path, reac
     out = check_log(path, profile=DEFAULT, role="vehicle", catalog=DirectoryCatalog([builtin_dir()]))
     bad = {c["id"]: c["reason"] for c in out.clauses if c["verdict"] == "fail"}
     assert not bad, bad
+
+
+def park_violation_session(path: Path, phase: float) -> list:
+    """To the mission park of ``conformance.mis``, reports every 0.5 s for 20 s of it, then a
+    violation the vehicle raises by itself ``phase`` s after a report (no report between), and
+    reports for 5 s: the lockout shows the mission park frozen with the time left then (RH-RD-11)."""
+    vv = VirtualVehicle(DEFAULT)
+    m = vv.core.model
+    seen = []
+
+    def poll() -> list:
+        f = osi_fields(vv.send("OSD,S"))
+        seen.append((round(vv.now, 2), f[2], f[8], f[10]))
+        return f
+
+    vv.send("OMSTART,0,0,0,0,conformance.mis,")
+    while m.mode != "P" and vv.now < 400:
+        vv.now += 0.5
+        poll()
+    until = vv.now + 20.0
+    while vv.now < until:
+        vv.now += 0.5
+        poll()
+    vv.now += phase
+    vv.core.inject_fault("Sfp", vv.now, source="the vehicle's own rule")
+    for _ in range(10):
+        vv.now += 0.5
+        poll()
+    vv.write(path)
+    return seen
+
+
+@pytest.mark.parametrize("phase", [0.25])
+def test_a_violation_in_a_mission_park_shows_its_time_left_frozen(tmp_path, phase):
+    """The park's time left frozen at a moment the observer places in a window (the violation is
+    unseen until the next report) is as uncertain as that moment: field 10 may show it a second
+    either way of the window's start."""
+    path = tmp_path / "wire.log"
+    seen = park_violation_session(path, phase)
+    assert seen[-1][1:3] == ("P", "Sfp"), seen[-3:]
+    out = check_log(path, profile=DEFAULT, role="vehicle")
+    bad = {c["id"]: c["reason"] for c in out.clauses if c["verdict"] == "fail"}
+    assert not bad, bad

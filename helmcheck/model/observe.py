@@ -25,12 +25,12 @@ through. The slow one is at some ``s_j``, the fast one at ``s_k`` (``j ≤ k``);
 countdowns *display* its own clock's count (start + duration − now, unskewed), so the park time
 of each acceptable state is the interval between what the two shadows show (the fast shadow in
 it now or as it left it; the slow shadow in it now or the fast one as it entered it), widened by
-``slack`` and rounded outwards to whole seconds (field 10 is rounded up, RH-RD-5). Only a
-running count is widened (``slack`` is when the report was made; a count that does not run —
-an ``$OPK`` park not yet on station, a mission park frozen in a lockout — shows the same at any
-moment), and a running count also where it has reached 0: the slow shadow, still counting past
-its own count's end, shows how far past (a report made up to ``slack`` earlier may still show
-``P1``). A state that shows no park shows ``P0`` exactly.
+``slack`` and rounded outwards to whole seconds (field 10 is rounded up, RH-RD-5). The
+``$OPK`` park before its count begins is not widened: it shows the minutes the command gave,
+exactly (a report showing one second less shows the count begun); and a running count is widened
+also where it has reached 0: the slow shadow, still counting past its own count's end, shows how
+far past (a report made up to ``slack`` earlier may still show ``P1``). A state that shows no park
+shows ``P0`` exactly.
 
 So that the slow shadow can still be "before" a timer the model itself already ran, the model
 keeps a checkpoint: a copy of itself taken just before the first timer fires after a
@@ -154,20 +154,19 @@ class Expectation:
         return out
 
 
-#: A park time a state shows: ``None`` (no park, ``P0``) or ``(seconds, running)``.
+#: A park time a state shows: ``None`` (no park, ``P0``) or ``(seconds, widened)``.
 Shown = Optional[tuple[float, bool]]
-
-#: The timer whose count field 10 shows, by mode (``W`` only while parked on a queued waypoint).
-_COUNT = {"P": "park", "mP": "opk", "W": "qpark"}
 
 
 def _shown(m, at: float, clip: bool = True) -> Shown:
-    """What field 10 of ``m`` shows at ``at`` (before rounding), and whether that count runs."""
+    """What field 10 of ``m`` shows at ``at`` (before rounding), and whether it is widened by the
+    observer's uncertainty: every count but the ``$OPK`` park's before it begins, which shows the
+    minutes the command gave, exactly, at any moment (a count frozen — a mission park in a
+    lockout, or held — shows what was left at a moment the observer knows as well as the rest)."""
     left = m.park_remaining(at, clip)
     if left is None:
         return None
-    name = _COUNT.get(m.mode)
-    return left, name is not None and m.timers.armed(name)
+    return left, not (m.mode == "mP" and not m.timers.armed("opk"))
 
 
 @dataclass
@@ -228,7 +227,8 @@ def expectation(model, now: float, slack: float = 0.0) -> Expectation:
 
 def _acceptable(sig: tuple, values: list[Shown], slack: float) -> Acceptable:
     """The state ``sig`` with the park times ``values`` may show (module docstring): ``None`` is no
-    park (``P0`` exactly); a running count, also one at or past its end, is widened by ``slack``."""
+    park (``P0`` exactly); a count, also one at or past its end, is widened by ``slack`` (not the
+    ``$OPK`` park's before it begins)."""
     lo = hi = 0.0
     first = True
     for v in values:
