@@ -187,6 +187,8 @@ class Answers:
         if p.branched:  # already in the mirror, unanswered: judge the late answer's content only
             self._late_answer(p, a, observed, ev)
             return
+        if self.held is not None and not isinstance(p.kind.item, s.OSD):
+            self._settle(None, False, [])  # another command before any report: both stay named
         # RH-RD-15: the command took effect the instant its ACK went out, which its arrival bounds
         # (less the replies' transmit time), however long the vehicle took to answer
         took = min(dt, transmit_time(replies, self.baud))
@@ -225,6 +227,8 @@ class Answers:
             if res.desync:
                 self.book("inconclusive", cands, f"{what} — not judged: the observer lost track of the "
                                                  f"vehicle's state before ({res.desync})", ev, at=p, stated=stated)
+            elif res.ignored:  # or the command before it was not carried out: the next report says
+                self._hold(p, cands, res.ignored, what, ev)
             else:
                 self.book("fail", cands, what, ev, at=p, stated=stated)
         for tt, verdict, reason in res.timings:
@@ -323,6 +327,8 @@ class Answers:
         t_from = max(p.t, t - transmit_time(len(evd.text) + 2, self.baud))
         self._bound_oxflt(p, t_from)
         res = self.beliefs.osi(osi, self.v(t_from), self.v(t), self.slack_v())
+        if self.held is not None:
+            self._settle(res.ignored, not res.findings, ev)
         if res.findings:
             named = tuple(dict.fromkeys(c for c, _ in res.findings if c != "RH-OUT-4"))  # a field's own clause
             cands = (("RH-OUT-4",) + named + tuple(c for c in res.causes if c != "RH-OUT-4" and c not in named)
