@@ -61,6 +61,8 @@ def build_results(outcome: Optional[RunRecord], *, profile: Profile, settings: d
                           "bytes_from_backseat": outcome.observer.stats["bytes"],
                           "lines_from_backseat": outcome.observer.stats["lines"],
                           "vehicle": outcome.vehicle_stats}
+        if outcome.gaps:  # helmcheck's port gone and waited for (.runner, link life)
+            results["link_gaps"] = [dict(g) for g in outcome.gaps]
     apply(results, a, duration_s=round(outcome.ended_at - (outcome.connected_at or 0.0), 3) if outcome else 0.0)
     return results
 
