@@ -39,7 +39,8 @@ Decisions (the reference profile is silent on the tester's link):
 * The vehicle helmcheck started (``--exec``) is not waited for: its port going away is its
   process ending (a finding, :mod:`.exec_child`), or the run's own pty. ``pty`` and ``loop://``
   name nothing that can come back (:func:`helmcheck.line.reopen.reopenable`). A wait of 0 turns
-  waiting off.
+  waiting off: the run stops at once, as one whose port did not come back (the ``--resume``
+  command included).
 * A case cut by :data:`MAX_CUTS` gaps in a row is not run a fourth time: a line that drops out
   that often is not one to certify over; the run stops as if the port had not come back.
 """
@@ -51,18 +52,23 @@ from typing import Any
 from ...line.reopen import reopenable, wait_for_port
 from .flow import CaseStop, LinkLost, LinkSilent
 
-__all__ = ["MAX_CUTS", "rejoin", "can_rejoin"]
+__all__ = ["MAX_CUTS", "rejoin", "can_rejoin", "vanished"]
 
 #: Gaps in a row that may cut the same case (or start-up, or exploration) before the run stops.
 MAX_CUTS = 3
 
 
-def can_rejoin(run: Any, err: BaseException) -> bool:
-    """Whether ``err`` is a vanished port the run may wait for (module docstring)."""
+def vanished(run: Any, err: BaseException) -> bool:
+    """Whether ``err`` is the run's port gone (EIO, closed, dropped), not the vehicle helmcheck
+    started ending (:mod:`.exec_child`) nor a vehicle that stopped answering (``LinkSilent``)."""
     link = run.link
     return (isinstance(err, LinkLost) and not isinstance(err, LinkSilent) and link is not None
-            and link.lost is not None and run.session is not None and not run.o.exec_cmd
-            and run.o.reconnect_wait_s > 0 and reopenable(run.o.port))
+            and link.lost is not None and run.session is not None and not run.o.exec_cmd)
+
+
+def can_rejoin(run: Any, err: BaseException) -> bool:
+    """Whether ``err`` is a vanished port the run may wait for (module docstring)."""
+    return vanished(run, err) and run.o.reconnect_wait_s > 0 and reopenable(run.o.port)
 
 
 def rejoin(run: Any, err: LinkLost, what: str, cuts: int = 1) -> bool:
@@ -70,7 +76,7 @@ def rejoin(run: Any, err: LinkLost, what: str, cuts: int = 1) -> bool:
     exploration"``): wait for the port, record the gap, verify the vehicle's state (module
     docstring). True when the run can run ``what`` again; False when it cannot (the run is then
     partial, its reason saying how to go on). ``cuts``: the gaps in a row that cut ``what``."""
-    if not can_rejoin(run, err):
+    if not vanished(run, err):
         return False
     link, rec, port = run.link, run.recorder, run.o.port
     wait_s = float(run.o.reconnect_wait_s)
@@ -84,6 +90,9 @@ def rejoin(run: Any, err: LinkLost, what: str, cuts: int = 1) -> bool:
         if cuts > MAX_CUTS:
             return _gone(run, gap, lost_t, f"cut by {cuts} link gaps in a row; the line is not stable enough "
                                            f"to certify over")
+        if not can_rejoin(run, err):
+            return _gone(run, gap, lost_t, "was not waited for" + (" (--reconnect-wait 0)" if wait_s <= 0 else
+                                                                   f": {port} names nothing that can come back"))
         rec.note(lost_t, f"link gap: waiting up to {wait_s:g} s for {port} to come back (--reconnect-wait)")
         run.progress.note(f"link lost ({why}) during {what}; waiting up to {wait_s:g} s for {port} to come back")
         raw, last = wait_for_port(port, baud=run.p.baud, within_s=wait_s)
@@ -105,10 +114,10 @@ def rejoin(run: Any, err: LinkLost, what: str, cuts: int = 1) -> bool:
                           f"then {what} starts again")
         try:
             _verify(run)
-        except LinkLost as e:
-            if not can_rejoin(run, e):
+        except LinkLost as e:  # gone again during the reset: another gap
+            if not vanished(run, e):
                 raise
-            cuts += 1
+            err, cuts = e, cuts + 1
             continue
         run.save()
         return True
