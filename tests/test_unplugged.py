@@ -345,7 +345,7 @@ def test_matrix_certify_backseat_whose_device_never_comes_back_is_inconclusive_n
     out = _certify_backseat(tmp_path, "cut=20s@4", wait=2.0)
     r = out.results
     assert out.exit_code == 2 and r["run"]["status"] == "disconnected" and r["partial"] is True
-    assert f"helmcheck's port {tmp_path / 'vehicle'} was gone" in r["verdict_reason"]
+    assert f"elmcheck's port {tmp_path / 'vehicle'} was gone" in r["verdict_reason"]  # H… at a sentence's start
     assert "did not come back within 2 s" in r["verdict_reason"]
     assert not [c for c in r["clauses"] if c["verdict"] == "fail"]
     assert cli_main(["verify", str(tmp_path / "r")]) == 0

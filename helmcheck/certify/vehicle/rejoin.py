@@ -41,8 +41,9 @@ Decisions (the reference profile is silent on the tester's link):
   name nothing that can come back (:func:`helmcheck.line.reopen.reopenable`). A wait of 0 turns
   waiting off: the run stops at once, as one whose port did not come back (the ``--resume``
   command included).
-* A case cut by :data:`MAX_CUTS` gaps in a row is not run a fourth time: a line that drops out
-  that often is not one to certify over; the run stops as if the port had not come back.
+* After :data:`MAX_CUTS` gaps in a row have cut the same case (or the link check, or the
+  exploration), one more stops the run as if the port had not come back: a line that drops out
+  that often is not one to certify over.
 """
 
 from __future__ import annotations
@@ -54,7 +55,8 @@ from .flow import CaseStop, LinkLost, LinkSilent
 
 __all__ = ["MAX_CUTS", "rejoin", "can_rejoin", "vanished"]
 
-#: Gaps in a row that may cut the same case (or start-up, or exploration) before the run stops.
+#: Gaps in a row that may cut the same case (or the link check, or the exploration) and be waited
+#: for; one more stops the run.
 MAX_CUTS = 3
 
 
@@ -88,8 +90,8 @@ def rejoin(run: Any, err: LinkLost, what: str, cuts: int = 1) -> bool:
         run.results.setdefault("link_gaps", []).append(gap)
         run.save()  # everything up to the cut, atomically, before the wait
         if cuts > MAX_CUTS:
-            return _gone(run, gap, lost_t, f"cut by {cuts} link gaps in a row; the line is not stable enough "
-                                           f"to certify over")
+            return _gone(run, gap, lost_t, f"came back, but {what} was cut by {cuts} gaps in a row: the line is "
+                                           f"not stable enough to certify over")
         if not can_rejoin(run, err):
             return _gone(run, gap, lost_t, "was not waited for" + (" (--reconnect-wait 0)" if wait_s <= 0 else
                                                                    f": {port} names nothing that can come back"))
