@@ -198,7 +198,7 @@ def test_a_vehicle_port_that_does_not_come_back_exits_2_with_the_resume_command_
         assert "did not come back within 1 s" in part["verdict_reason"]
         done = [c["id"] for c in part["cases"] if not c.get("cut")]
         notes = [text for _, text in _notes(rdir / "wire.log")]
-        assert notes[-1].startswith("run partial: the vehicle's port") and "Traceback" not in first.stderr
+        assert notes[-1].startswith("run partial: link fault: the vehicle's port") and "Traceback" not in first.stderr
         _wait_for_path(tmp_path / "vehicle")  # plugged back
         second = _helmcheck(*argv[1:], "--no-progress")
     r = load_results(rdir)

@@ -9,7 +9,9 @@ its link waits for is therefore the *name* it opened: :func:`wait_for_port` trie
 
 Which names can come back (:func:`reopenable`): a device path and a ``socket://`` a client
 connects to, and pyserial URLs (``rfc2217://``, whose server drops and accepts like a TCP one).
-``pty`` cannot: it names a pseudo-terminal the opener makes, and a new one is another device.
+``pty`` cannot: it names a pseudo-terminal the opener makes, and a new one is another device. Nor
+can ``/dev/pts/N``: the number names whichever pseudo-terminal is made next (a terminal window,
+say), never the one that closed — a symbolic link to it (what the line-fault relay keeps) can.
 
 Decisions: :data:`DEFAULT_WAIT_S` (30 s) is how long a run waits by default — a connector
 re-seated or an adapter plugged back takes a few seconds, and a run waiting longer for a vehicle
@@ -42,7 +44,9 @@ def reopenable(port: str | PortSpec) -> bool:
         spec = port if isinstance(port, PortSpec) else parse_port_spec(port)
     except ValueError:
         return False
-    return spec.kind in ("device", "socket", "url") and not spec.text.lower().startswith("loop://")
+    if spec.kind == "device":
+        return not spec.path.startswith("/dev/pts/")
+    return spec.kind in ("socket", "url") and not spec.text.lower().startswith("loop://")
 
 
 def wait_for_port(port: str | PortSpec, *, baud: int, within_s: float, role: str = "client",

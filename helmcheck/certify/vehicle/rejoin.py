@@ -37,10 +37,10 @@ Decisions (the reference profile is silent on the tester's link):
   late (RH-ACK-2) for an answer the cut lost. The note's text gives both times, and the records
   after it carry the real ones.
 * The vehicle helmcheck started (``--exec``) is not waited for: its port going away is its
-  process ending (a finding, :mod:`.exec_child`), or the run's own pty. ``pty`` and ``loop://``
-  name nothing that can come back (:func:`helmcheck.line.reopen.reopenable`). A wait of 0 turns
-  waiting off: the run stops at once, as one whose port did not come back (the ``--resume``
-  command included).
+  process ending (a finding, :mod:`.exec_child`), or the run's own pty. ``pty``, ``/dev/pts/N``
+  and ``loop://`` name nothing that can come back (:func:`helmcheck.line.reopen.reopenable`); nor
+  is a port waited for with a wait of 0. Either way the run stops at once, as one whose port did
+  not come back (the ``--resume`` command included).
 * After :data:`MAX_CUTS` gaps in a row have cut the same case (or the link check, or the
   exploration), one more stops the run as if the port had not come back: a line that drops out
   that often is not one to certify over.
@@ -150,7 +150,7 @@ def _gone(run: Any, gap: dict, lost_t: float, how: str) -> bool:
     run.gone = f"{port} was gone from {lost_t:.1f} s and {how}"
     run.resume_command = run.results["resume_command"] = cmd
     run.partial = True
-    run.aborted = f"the vehicle's port {run.gone}; --resume {run.dir} goes on from {gap['cut']}"
+    run.aborted = f"link fault: the vehicle's port {run.gone}; --resume {run.dir} goes on from {gap['cut']}"
     run.progress.note(f"{port} {how}")
     return False
 
