@@ -29,6 +29,7 @@ import os
 import shlex
 import subprocess
 import sys
+import threading
 import time
 from pathlib import Path
 
@@ -123,7 +124,6 @@ def test_a_port_is_opened_as_soon_as_its_name_is_back_and_not_waited_for_past_th
     link = tmp_path / "by-id"
     try:
         t0 = time.monotonic()
-        import threading
         threading.Timer(0.4, lambda: os.symlink(pty.name, link)).start()
         got, why = wait_for_port(str(link), baud=19200, within_s=5.0)
         assert got is not None and why == "" and 0.4 <= time.monotonic() - t0 < 2.0
