@@ -30,7 +30,7 @@ from .link import Link
 from .port_spec import PortSpec, parse_port_spec
 from .transport import open_link
 
-__all__ = ["DEFAULT_WAIT_S", "RETRY_S", "reopenable", "wait_for_port"]
+__all__ = ["DEFAULT_WAIT_S", "RETRY_S", "reopenable", "wait_for_port", "gap_event"]
 
 #: How long a run waits for a vanished port to come back, unless told otherwise (module docstring).
 DEFAULT_WAIT_S = 30.0
@@ -69,3 +69,16 @@ def wait_for_port(port: str | PortSpec, *, baud: int, within_s: float, role: str
         if left <= 0:
             return None, why
         sleep(min(retry_s, left))
+
+
+def gap_event(gap: dict) -> dict:
+    """A run's ``link_gaps`` entry (``lost_at_s``, ``back_at_s``, ``gap_s``, ``port``, and what it
+    ``cut`` or which ``side``) as a ``results.json`` event (kind ``note``) for the report's timeline."""
+    what = f"the {gap['side']} side's port {gap['port']}" if gap.get("side") else str(gap.get("port"))
+    if gap.get("gap_s") is not None:
+        text = f"link gap: {what} gone {gap['gap_s']:.1f} s"
+    else:
+        text = f"link gap: {what} gone, not back"
+    if gap.get("cut"):
+        text += f" (it cut {gap['cut']})"
+    return {"t": max(0.0, round(float(gap["lost_at_s"]), 6)), "kind": "note", "label": text[:120]}

@@ -35,7 +35,7 @@ from .. import __version__
 from ..failures import describe_interrupt
 from ..grammar.wirelog import run_header
 from ..line.link import Link
-from ..line.reopen import DEFAULT_WAIT_S
+from ..line.reopen import DEFAULT_WAIT_S, gap_event
 from ..line.transport import open_link, parse_port_spec
 from ..profile import Profile
 from ..reports.certificate import RunDeclaration, finish_run
@@ -174,6 +174,7 @@ def monitor(opts: Options) -> Result:
     results = _results(out, opts, ended, relay, live)
     if gaps.gaps:
         results["monitor"]["link_gaps"] = [dict(g) for g in gaps.gaps]
+        results["events"] = sorted([*results.get("events", []), *map(gap_event, gaps.gaps)], key=lambda e: e["t"])
     results["monitor"]["reconnect_wait_s"] = float(opts.reconnect_wait)
     finish_run(results, d, opts.profile.replace(time_scale=opts.time_scale, baud=opts.baud), opts.certificate)
     if opts.render:
