@@ -28,6 +28,8 @@ entry point is :func:`.runner.certify`. Modules, one concern each:
   declared time scale (sans-IO); :mod:`.clockprobe` reads the clock at start.
 * :mod:`.restore` — leaving the vehicle as it was found: its settings and its mode.
 * :mod:`.resume` — ``--resume DIR``: an interrupted run goes on from its last completed case.
+* :mod:`.rejoin` — a port that vanished mid-run, waited for under the same name: the gap
+  recorded, the vehicle's state verified again, the case it cut run again (or ``--resume``).
 * :mod:`.plan` — ``--plan``: the run's estimated time, from the cases run in virtual time
   (:mod:`.virtual`: a serial line in virtual time with the reference vehicle at its far end).
 * :mod:`.runner` — one certification run: cases, exploration, results and reports;
