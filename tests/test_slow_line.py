@@ -40,9 +40,10 @@ SIM = ROOT.parent / "shared" / "third-party" / "uvc_sim.py"
 SLOW = "baud=19200,<line-delay=0.6" if MATRIX else "baud=19200,<line-delay=0.5"
 
 #: The clauses whose cases set timers going (and restart one), confirm what they set, wait out a
-#: lockout and find the ascent after it; RH-TIM-1/2 are judged on each of those timers.
+#: lockout and find the ascent after it (RH-TIM-1's tolerance is applied to each of those timers; the
+#: clauses not selected stay NOT-TESTED "not selected", whatever was observed of them).
 TIMING = ["RH-SRV-3", "RH-PRM-4", "RH-SAF-1", "RH-SAF-3"]
-JUDGED = TIMING + ["RH-TIM-1", "RH-TIM-2"]
+JUDGED = TIMING
 
 
 def _certify(port: str, profile, k: float, out: Path, select=None, examples: int = 0):
@@ -55,8 +56,10 @@ def _judged_pass(out, select) -> None:
     assert not bad, bad
     judged = {c["id"] for c in out.results["clauses"] if c["verdict"] == "pass"}
     assert set(select) <= judged, {c["id"]: c["reason"] for c in out.results["clauses"] if c["id"] in select}
-    timing = next(c for c in out.results["clauses"] if c["id"] == "RH-TIM-1")
-    assert timing["precision"]["widened_s"] > timing["precision"]["nominal_s"] > 0, timing  # said how coarse
+    timed = [c for c in out.results["clauses"] if c["id"] in select and c.get("precision")]
+    assert timed, select  # a timer judged, and how coarsely
+    for c in timed:
+        assert c["precision"]["widened_s"] > c["precision"]["nominal_s"] > 0, c  # said how coarse
     budget = out.results["settings"]["line_budget"]
     assert budget["measured"] and budget["latency_p50_s"] >= 0.45, budget  # it saw the line it ran on
 
