@@ -397,7 +397,7 @@ CASES: tuple[Case, ...] = (
        *_off("OPK,{opk_in_lat},{lon},{opk_min},{speed}", (1, "90.1"), (1, "-90.1"), (2, "180.1"), (2, "-180.1"),
              (3, "0"), (3, "1441"), (4, "-0.1"), (4, "{speed_out}")),
        Poll(mode="mP")),
-    _c("V-68", "RH-RD-9", "$OMW at each edge of its ranges",
+    _c("V-68", "RH-ACK-3 RH-RD-9", "$OMW at each edge of its ranges",
        "waypoints at latitude ±90, longitude ±180, depths ±100, pitch 0 and 45, speed 0 and max_speed_kn, "
        "park 0 and 86400 s are queued (W); 0.1 (or 1) past each bound is refused (36); Clr ends the queue",
        "N",
@@ -407,24 +407,25 @@ CASES: tuple[Case, ...] = (
              (3, "100.1"), (3, "-100.1"), (4, "100.1"), (4, "-100.1"), (5, "-0.1"), (5, "45.1"), (6, "-0.1"),
              (6, "{speed_out}"), (7, "-1"), (7, "86401")),
        Poll(mode="W"), *_ok("OMW,Clr"), Poll(mode="N|P")),
-    _c("V-69", "RH-RD-4 RH-OMW-3", "$OMW keywords in any case",
+    _c("V-69", "RH-OMW-3 RH-RD-4", "$OMW keywords in any case",
        "each keyword of omw_clear_keywords in lower, upper and title case (clr, Clear, stop …) clears a "
        "queued waypoint and resumes the mission; a word beside them (CLEARS) is refused (36)", "N",
        ClearWords(FAR_OMW)),
     _c("V-70", "RH-POS-2 RH-RD-10", "$OPOS on each side of the GPS fix",
-       "in a mission started normally an $OPOS is not applied at the surface and is applied under water; "
-       "after an ignore-GPS start it is applied at the surface; once that mission is stopped, at the "
-       "surface in S, it is not applied again (each judged by the next report)", "S",
-       Start(), *_ok(HOLD_SURFACE), Until("the surface in A", mode="A", surface=True, budget_v=300.0), Wait(5.0),
+       "an $OPOS is applied at the surface in a mission started with ignore-GPS; once that mission is "
+       "stopped, at the surface in S, it is not; in a mission started normally it is not applied at the "
+       "surface, and is applied under water (each judged by the next report, the depth held steady around "
+       "it)", "S",
+       Start(ignore_gps=1), *_ok(HOLD_SURFACE), Until("the surface in A", mode="A", surface=True, budget_v=300.0),
+       Wait(3.0), *_ok(OPOS_FAR), Poll(mode="A"),
+       Send("OMSTOP,0"), Until("the surface in S", mode="S", surface=True, budget_v=300.0), Wait(3.0),
+       *_ok(OPOS_FAR), Poll(mode="S"),
+       Start(), *_ok(HOLD_SURFACE), Until("the surface in A", mode="A", surface=True, budget_v=300.0), Wait(3.0),
        *_ok(OPOS_FAR), Poll(mode="A"),
-       *_ok("OMS,90,2,20,{speed},{to_long}"), Until("under water", mode="A", submerged=True, depth_at_least=1.8,
-                                               budget_v=300.0), Wait(5.0),
-       *_ok(OPOS_FAR), Poll(mode="A"),
-       Send("OMSTOP,0"), Start(ignore_gps=1), *_ok(HOLD_SURFACE),
-       Until("the surface in A", mode="A", surface=True, budget_v=300.0), Wait(5.0), *_ok(OPOS_FAR), Poll(mode="A"),
-       Send("OMSTOP,0"), Until("the surface in S", mode="S", surface=True, budget_v=300.0), Wait(5.0),
-       *_ok(OPOS_FAR), Poll(mode="S")),
-    _c("V-71", "RH-RD-9 RH-POS-1 RH-DVL-1", "$OPOS and $ODVL at each edge of their ranges",
+       *_ok("OMS,90,2,45,{speed},{to_long}"), Until("under water", mode="A", submerged=True, depth_at_least=1.8,
+                                                budget_v=300.0), Wait(5.0),
+       *_ok(OPOS_FAR), Poll(mode="A")),
+    _c("V-71", "RH-POS-1 RH-DVL-1 RH-RD-9", "$OPOS and $ODVL at each edge of their ranges",
        "at the surface in S (a fix: the position is not applied): latitude ±90, longitude ±180, speed 0 and "
        "max_speed_kn, conductivity 0 and 100, temperature -5 and 50 are accepted, 0.1 past each refused "
        "(18); $ODVL x and y ±5 and the timeout range's ends accepted, one step past each refused (35)", "S",
@@ -435,7 +436,7 @@ CASES: tuple[Case, ...] = (
        *_ok("OPOS,{lat},{lon},0,35,12", "ODVL,5,-5,{to_lo}", "ODVL,-5,5,{to_hi}"),
        *_off("ODVL,0.5,0,{to}", (1, "5.1"), (1, "-5.1"), (2, "5.1"), (2, "-5.1"), (3, "{to_under}"), (3, "{to_over}")),
        Poll(mode="S")),
-    _c("V-72", "RH-RD-6 RH-MSN-2", "$OMSTART at each edge of its fields",
+    _c("V-72", "RH-MSN-2 RH-RD-6", "$OMSTART at each edge of its fields",
        "each rh5 flag 1 and an SRP inside the mission directory start the mission, each paper-form flag "
        "1–3 starts the loaded one ($OMSTOP after each); a flag 2, paper flag 4, and a name or SRP name that "
        "is empty, absolute, with a drive letter or a '..' component are refused (30)", "S",
@@ -449,7 +450,7 @@ CASES: tuple[Case, ...] = (
        *_off("OMSTART,0,0,0,0,{mission},{mission}", (6, "/{mission}"), (6, "C:{mission}"),
              (6, "sub/../../{mission}")),
        *_no("OMSTART,4", "OMLOAD,,0"), Poll(mode="S")),
-    _c("V-73", "RH-RD-8 RH-SET-2", "$ORWSET writes at each edge",
+    _c("V-73", "RH-SET-2 RH-RD-8", "$ORWSET writes at each edge",
        "a write of state 0 with no value and of state 1 with three values is accepted, four values or "
        "state 2 refused (23); SafetyAction takes srp and park, not Park or dive (23); each setting is "
        "written back as it was found", "S",
