@@ -413,18 +413,17 @@ CASES: tuple[Case, ...] = (
        ClearWords(FAR_OMW)),
     _c("V-70", "RH-POS-2 RH-RD-10", "$OPOS on each side of the GPS fix",
        "an $OPOS is applied at the surface in a mission started with ignore-GPS; once that mission is "
-       "stopped, at the surface in S, it is not; in a mission started normally it is not applied at the "
-       "surface, and is applied under water (each judged by the next report, the depth held steady around "
-       "it)", "S",
+       "stopped, at the surface in S, it is not; in a mission started normally it is applied under water "
+       "and not at the surface (each judged by the next report, the depth held steady around it)", "S",
        Start(ignore_gps=1), *_ok(HOLD_SURFACE), Until("the surface in A", mode="A", surface=True, budget_v=300.0),
-       Wait(3.0), *_ok(OPOS_FAR), Poll(mode="A"),
-       Send("OMSTOP,0"), Until("the surface in S", mode="S", surface=True, budget_v=300.0), Wait(3.0),
+       Wait(2.0), *_ok(OPOS_FAR), Poll(mode="A"),
+       Send("OMSTOP,0"), Until("the surface in S", mode="S", surface=True, budget_v=300.0), Wait(2.0),
        *_ok(OPOS_FAR), Poll(mode="S"),
-       Start(), *_ok(HOLD_SURFACE), Until("the surface in A", mode="A", surface=True, budget_v=300.0), Wait(3.0),
+       Start(), *_ok("OMS,90,1.5,45,{speed},{to_long}"),
+       Until("under water", mode="A", submerged=True, depth_at_least=1.4, budget_v=300.0), Wait(2.0),
        *_ok(OPOS_FAR), Poll(mode="A"),
-       *_ok("OMS,90,2,45,{speed},{to_long}"), Until("under water", mode="A", submerged=True, depth_at_least=1.8,
-                                                budget_v=300.0), Wait(5.0),
-       *_ok(OPOS_FAR), Poll(mode="A")),
+       *_ok("OMS,90,0,45,{speed},{to_long}"), Until("the surface in A", mode="A", surface=True, budget_v=300.0),
+       Wait(2.0), *_ok(OPOS_FAR), Poll(mode="A")),
     _c("V-71", "RH-POS-1 RH-DVL-1 RH-RD-9", "$OPOS and $ODVL at each edge of their ranges",
        "at the surface in S (a fix: the position is not applied): latitude ±90, longitude ±180, speed 0 and "
        "max_speed_kn, conductivity 0 and 100, temperature -5 and 50 are accepted, 0.1 past each refused "
