@@ -29,7 +29,7 @@ __all__ = ["CASES", "select_cases", "unmet_need", "line_needs"]
 # this line at this time scale, ``{to_long}`` one that outlasts several steps, and so on.
 OMS = "OMS,90,2,20,{speed},{to}"
 OMS0 = "OMS,90,2,20,0,{to}"  # speed 0: the vehicle holds its position
-OMS_DIVE = "OMS,90,{dive_depth},20,{speed},120"  # down to a depth an ascent takes a while to leave
+OMS_DIVE = "OMS,90,{dive_depth},20,{speed},{to_hi}"  # down to a depth an ascent takes a while to leave
 OMP_HOLD = "OMP,8080808080,00,{to_long}"  # neutral: holds depth, outlasts what follows (RH-RD-12)
 OMS_RESTART = "OMS,90,2,20,{speed},{to_restart}"  # restarted {gap} into it, both deadlines told apart
 FAR_OMW = "OMW,{near_lat},{lon},2,,15,{speed},0,"
@@ -217,8 +217,8 @@ CASES: tuple[Case, ...] = (
     _c("V-34", "RH-JW-2", "$OJW ends remote control",
        "$OJW from A, M, mP and W gives the mission toward the new next waypoint", "N",
        Send(OMS), Send("OJW,{wp_other}"), Poll(mode_not="A"), Send("OMP,8080808080,00,{to}"),
-       Send("OJW,0"), Poll(mode_not="M"), Send("OPK,{lat},{lon},5,{speed}"), Send("OJW,{wp_other}"),
-       Poll(mode_not="mP"), Send(FAR_OMW), Send("OJW,0"), Poll(mode_not="W")),
+       Send("OJW,{wp_first}"), Poll(mode_not="M"), Send("OPK,{lat},{lon},5,{speed}"), Send("OJW,{wp_other}"),
+       Poll(mode_not="mP"), Send(FAR_OMW), Send("OJW,{wp_first}"), Poll(mode_not="W")),
     _c("V-35", "RH-JW-2", "$OJW ends a mission park",
        "$OJW during the mission park gives the mission toward the new next waypoint", "P",
        Send("OJW,{wp_other}"), Poll()),
@@ -253,10 +253,11 @@ CASES: tuple[Case, ...] = (
        Send(FAR_OMW), Send("OMW,{near_lat},{near_lon},2,3,15,{speed},0,"), Poll(mode="W"), Wait(5.0),
        Poll(mode="W")),
     _c("V-41", "RH-OMW-3", "$OMW,Clr and its synonyms",
-       "Clr, CLEAR and STOP clear the queue and resume the mission; in N the keyword changes nothing",
+       "Clr, CLEAR and STOP (the profile's omw_clear_keywords) clear the queue and resume the mission; in N "
+       "the keyword changes nothing",
        "N",
-       Send(FAR_OMW), Send("OMW,Clr"), Poll(mode="N|P"), Send(FAR_OMW), Send("OMW,CLEAR"), Poll(mode="N|P"),
-       Send(FAR_OMW), Send("OMW,STOP"), Poll(mode="N|P"), Send("OMW,Clr", expect="$ACK,16,0,0"),
+       Send(FAR_OMW), Send("OMW,{kw_a}"), Poll(mode="N|P"), Send(FAR_OMW), Send("OMW,{kw_b}"), Poll(mode="N|P"),
+       Send(FAR_OMW), Send("OMW,{kw_c}"), Poll(mode="N|P"), Send("OMW,{kw_a}", expect="$ACK,16,0,0"),
        Poll(mode="N|P")),
     _c("V-42", "RH-OMW-4", "The mission resumes when the queue is done",
        "a queued waypoint at the vehicle's position is reached at once; the mission resumes", "N",
@@ -406,7 +407,7 @@ CASES: tuple[Case, ...] = (
        *_off("OMW,{near_lat},{lon},2,,15,{speed},0,", (1, "90.1"), (1, "-90.1"), (2, "180.1"), (2, "-180.1"),
              (3, "100.1"), (3, "-100.1"), (4, "100.1"), (4, "-100.1"), (5, "-0.1"), (5, "45.1"), (6, "-0.1"),
              (6, "{speed_out}"), (7, "-1"), (7, "86401")),
-       Poll(mode="W"), *_ok("OMW,Clr"), Poll(mode="N|P")),
+       Poll(mode="W"), *_ok("OMW,{kw_a}"), Poll(mode="N|P")),
     _c("V-69", "RH-OMW-3 RH-RD-4", "$OMW keywords in any case",
        "each keyword of omw_clear_keywords in lower, upper and title case (clr, Clear, stop …) clears a "
        "queued waypoint and resumes the mission; a word beside them (CLEARS) is refused (36)", "N",
@@ -415,6 +416,7 @@ CASES: tuple[Case, ...] = (
        "an $OPOS is applied at the surface in a mission started with ignore-GPS; once that mission is "
        "stopped, at the surface in S, it is not; in a mission started normally it is applied under water "
        "and not at the surface (each judged by the next report, the depth held steady around it)", "S",
+       Until("the surface in S", mode="S", surface=True, budget_v=300.0),
        Start(ignore_gps=1), *_ok(HOLD_SURFACE), Until("the surface in A", mode="A", surface=True, budget_v=300.0),
        Wait(2.0), *_ok(OPOS_FAR), Poll(mode="A"),
        Send("OMSTOP,0"), Until("the surface in S", mode="S", surface=True, budget_v=300.0), Wait(2.0),

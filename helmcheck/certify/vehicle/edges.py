@@ -495,8 +495,8 @@ class EdgeTally:
                 continue
             ack = next((r for r in sent.expected if isinstance(r, S.ACK)), None)
             for e, need in cands:
-                if e.id in self.reached or not self._answered(sent, ack, need, e):
-                    continue
+                if self.reached.get(e.id) or not self._answered(sent, ack, need, e):
+                    continue  # the first case that reached it (a line outside any case, until one does)
                 self.reached[e.id] = sent.case or ""
         self._pending = keep
 

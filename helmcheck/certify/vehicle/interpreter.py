@@ -50,6 +50,8 @@ def context(session: Session) -> dict:
            "dive_depth": f"{min(p.max_depth / 2, 10.0 if p.depth_unit == 'm' else 33.0):g}"}
     ctx.update(session.durations().context())
     ctx.update(edge_values(p), opk_in_m=opk_edge_m(p, "in"), opk_out_m=opk_edge_m(p, "out"))
+    kws = (list(p.omw_clear_keywords) or ["Clr"]) * 3  # the profile's $OMW keywords, first three (RH-OMW-3)
+    ctx.update(kw_a=kws[0], kw_b=kws[1], kw_c=kws[2])
     _position(ctx, lat, lon)
     _other(session, ctx)
     return ctx

@@ -19,7 +19,9 @@ reported position, ``{near_lat}``/``{near_lon}`` a point ~110 m north/east of it
 the ends of ``timeout_range`` and ``{to_under}``/``{to_over}`` one past them, ``{depth_max}``/``{depth_out}``
 and ``{speed_max}``/``{speed_out}`` the ceiling and 0.1 past it, ``{wp_first}``/``{wp_under}`` the first
 waypoint and one below; ``{opk_in_lat}``/``{opk_out_lat}`` a point due north of the vehicle's last
-reported position just inside and just outside the ``$OPK`` limit (``opk_max_distance_m``, :data:`.edges.OPK_EDGE`).
+reported position just inside and just outside the ``$OPK`` limit (``opk_max_distance_m``, :data:`.edges.OPK_EDGE`);
+``{kw_a}``, ``{kw_b}``, ``{kw_c}`` the profile's ``$OMW`` keywords (``omw_clear_keywords``), the first three, repeated
+when there are fewer.
 """
 
 from __future__ import annotations
