@@ -62,9 +62,9 @@ OPK_EDGE = 0.005
 #: Metres an ``$OPOS`` must be from the vehicle for a GPS-fix edge (the judge tells applied from not
 #: applied only beyond 30 m and three times the way the vehicle can make between two reports).
 OPOS_APART_M = 100.0
-#: The kinds of mission name a vehicle must refuse (:func:`~helmcheck.grammar.ranges.mission_name_problem`),
-#: each with a name of that kind built from the test mission's.
-NAME_KINDS = {"empty": "", "absolute path": "/{m}", "drive letter": "C:{m}", "'..' component": "sub/../../{m}"}
+#: The kinds of mission name a vehicle must refuse, as :func:`~helmcheck.grammar.ranges.mission_name_problem`
+#: words them (RH-MSN-1, RH-RD-6).
+NAME_KINDS = ("empty", "absolute path", "drive letter", "'..' component")
 #: The commands whose model check (:data:`helmcheck.model.handlers.CHECKS`) has edges here; the others
 #: look files up (err 1, 3, 17, 31: no bound to be on either side of).
 STATE_CHECKED = ("OJW", "OLOGD", "OPK")
@@ -94,9 +94,9 @@ class Edge:
 # ============================================================================ the list
 
 def _text(v) -> str:
+    """A number as the edges write it: ``100``, ``4.6``, ``-0.1``."""
     if isinstance(v, Decimal):
-        t = format(v.normalize(), "f")
-        return t
+        return format(v.normalize(), "f")
     if isinstance(v, float):
         return _text(Decimal(repr(v)))
     return str(v)
