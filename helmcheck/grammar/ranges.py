@@ -5,6 +5,11 @@ Each rule names its clause and field. Commands that fail answer with the command
 ``[D]`` in the reference profile come from the :class:`~helmcheck.profile.Profile`; the fixed
 ones (heading below 360, pitch at most 45) are the profile's own text.
 
+A command's checks are data: :data:`COMMAND_CHECKS` holds, per sentence class and in field order,
+its numeric ranges (:class:`Bound`), its closed sets of values (:class:`Choice`) and its mission
+names (:class:`NameRule`); the checks run from those rows, and the range edges a certification
+must reach (:mod:`helmcheck.certify.vehicle.edges`) are generated from the same rows.
+
 State-dependent checks (``$OJW`` against the mission length, ``$OPK`` distance) belong to the
 model, not here: this module looks at one sentence and the profile only.
 """
