@@ -21,6 +21,9 @@ entry point is :func:`.runner.certify`. Modules, one concern each:
   in wall and vehicle seconds; :mod:`.generate` — what they draw (every claimed command at its
   range edges and error codes, every mutation of a line); :mod:`.modelcover` — what of the
   model they reached (rows, interrupt pairs, timer boundaries, error codes).
+* :mod:`.edges` — the range edges of §4–8b (both sides of every bound and keyword, generated from
+  the command checks, the grammar and the model's state checks) and which of them the lines sent
+  reached (``stats.edges``).
 * :mod:`.replay` — version-independent replay files: write, read, re-drive from the verified
   reset, naming the step that failed or went another way; :mod:`.relocate` moves the positions
   a replay's lines send to where the vehicle begins it.

@@ -68,6 +68,7 @@ def save(run, final: bool = False) -> None:
         r["restore"] = run.custodian.record()
     if run.session is not None:
         run.stats["forced_wait_s"] = round(run.session.forced_wait, 3)
+        run.stats["edges"] = run.session.edges.summary()  # the range edges reached (:mod:`.edges`)
         if run.session.meter.measured:  # the line the verdicts were reached on (:mod:`.linemeter`)
             r["settings"]["line_budget"] = run.session.meter.budget().as_dict()
     run.stats["wall_s"] = round(time.monotonic() - run.t_start
