@@ -34,6 +34,9 @@ OMP_HOLD = "OMP,8080808080,00,{to_long}"  # neutral: holds depth, outlasts what 
 OMS_RESTART = "OMS,90,2,20,{speed},{to_restart}"  # restarted {gap} into it, both deadlines told apart
 FAR_OMW = "OMW,{near_lat},{lon},2,,15,{speed},0,"
 HOLD_SURFACE = "OMS,90,0,20,0,{to_long}"  # stays where it is, at the surface, for several steps
+#: V-70's controls, each sent again just before its $OPOS so that what follows fits its timeout on a slow line
+_DIVE_HOLD = "OMS,90,1.5,45,{speed},{to_long}"  # down to 1.5 m and held there
+_RISE = "OMS,90,0,45,{speed},{to_long}"  # back up to the surface, under way
 OPOS_FAR = "OPOS,{opos_lat},{lon},0,,"  # far enough that the next report tells applied from not (RH-POS-2)
 ACCEPTED = {"OMS": "$ACK,9,0,0", "OMP": "$ACK,10,0,0", "OPK": "$ACK,11,0,0", "OMW": "$ACK,16,0,0",
             "OPOS": "$ACK,6,0,0", "ODVL": "$ACK,15,0,0", "OMSTART": "$ACK,3,0,0", "ORWSET": "$ACK,12,0,0",
@@ -417,15 +420,16 @@ CASES: tuple[Case, ...] = (
        "stopped, at the surface in S, it is not; in a mission started normally it is applied under water "
        "and not at the surface (each judged by the next report, the depth held steady around it)", "S",
        Until("the surface in S", mode="S", surface=True, budget_v=300.0),
-       Start(ignore_gps=1), *_ok(HOLD_SURFACE), Until("the surface in A", mode="A", surface=True, budget_v=300.0),
-       Wait(2.0), *_ok(OPOS_FAR), Poll(mode="A"),
+       Start(ignore_gps=1), *_ok(HOLD_SURFACE),
+       Until("the surface in A", mode="A", surface=True, budget_v=300.0, refresh=HOLD_SURFACE),
+       *_ok(HOLD_SURFACE), Wait(2.0), *_ok(OPOS_FAR), Poll(mode="A"),
        Send("OMSTOP,0"), Until("the surface in S", mode="S", surface=True, budget_v=300.0), Wait(2.0),
        *_ok(OPOS_FAR), Poll(mode="S"),
-       Start(), *_ok("OMS,90,1.5,45,{speed},{to_long}"),
-       Until("under water", mode="A", submerged=True, depth_at_least=1.4, budget_v=300.0), Wait(2.0),
-       *_ok(OPOS_FAR), Poll(mode="A"),
-       *_ok("OMS,90,0,45,{speed},{to_long}"), Until("the surface in A", mode="A", surface=True, budget_v=300.0),
-       Wait(2.0), *_ok(OPOS_FAR), Poll(mode="A")),
+       Start(), *_ok(_DIVE_HOLD),
+       Until("under water", mode="A", submerged=True, depth_at_least=1.4, budget_v=300.0, refresh=_DIVE_HOLD),
+       *_ok(_DIVE_HOLD), Wait(2.0), *_ok(OPOS_FAR), Poll(mode="A"),
+       *_ok(_RISE), Until("the surface in A", mode="A", surface=True, budget_v=300.0, refresh=_RISE),
+       *_ok(_RISE), Wait(2.0), *_ok(OPOS_FAR), Poll(mode="A")),
     _c("V-71", "RH-POS-1 RH-DVL-1 RH-RD-9", "$OPOS and $ODVL at each edge of their ranges",
        "at the surface in S (a fix: the position is not applied): latitude ±90, longitude ±180, speed 0 and "
        "max_speed_kn, conductivity 0 and 100, temperature -5 and 50 are accepted, 0.1 past each refused "
@@ -469,8 +473,8 @@ CASES: tuple[Case, ...] = (
     # --- §8 time ---------------------------------------------------------------------------------
     _c("V-62", "RH-TIM-1 RH-TIM-2", "Durations hold at the declared time scale",
        "a servo timeout of 30 s or more and a primitive timeout end within max(0.5 s, 5 %) plus the "
-       "measured slack, at the declared time scale k (30 s: a clock 30 % off is told apart from the "
-       "slack at k = 25)", "N",
+       "measured slack, at the declared time scale k (the servo timeout is the shortest whose end a "
+       "clock 30 % fast moves by more than the precision the line allows, else the longest allowed)", "N",
        Send("OMS,90,2,20,{speed},{to_tim}"), Settle("remote"), Poll(mode="N|P"),
        Send("OMP,8080808080,00,{to}"), Settle("remote"), Poll(mode="N|P")),
 )
