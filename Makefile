@@ -26,7 +26,7 @@ example-report: $(STAMP)
 	$(PY) -m helmcheck.demo --out reports/demo
 
 # The suite mostly waits on ptys and scaled time, so it runs on more workers than cores.
-TEST_WORKERS ?= 4
+TEST_WORKERS ?= 6
 
 test: $(STAMP)
 	$(PY) -m pytest -n $(TEST_WORKERS) --dist loadgroup
@@ -45,9 +45,11 @@ explore-reach: $(STAMP)
 # every faulty vehicle over lines in virtual time (time scales 1-40, replies 3 ms-0.9 s, 9600-115200
 # baud, the timing freedoms at their bounds), and whole certifications on real ptys of the emulator
 # at each line-timing freedom's bound at x5, x20 and x40 and of the independent simulator behind a
-# slow line (tests/test_line_budget.py, tests/test_slow_line.py).
+# slow line (tests/test_line_budget.py, tests/test_slow_line.py); and ports unplugged mid-run: the
+# independent simulator certified whole behind a 5 s cut, cuts in a case and in the exploration, a
+# backseat device and a monitored side that never come back (tests/test_unplugged.py).
 matrix: $(STAMP)
-	HELMCHECK_MATRIX=1 $(PY) -m pytest -n 2 tests/test_line_budget.py tests/test_slow_line.py
+	HELMCHECK_MATRIX=1 $(PY) -m pytest -n 2 tests/test_line_budget.py tests/test_slow_line.py tests/test_unplugged.py
 
 # Not run by CI (several minutes): every --help example, the slow ones and those that need a
 # vehicle too (run against the emulator on their port); make test runs the others.

@@ -1,9 +1,9 @@
 """Realistic wire logs for the benchmarks: a long session of the reference vehicle driven by a
 scripted backseat, in virtual time.
 
-``write_session(path, lines, seed=0, faults=False)`` writes a helmcheck wire log (format 1, the
-one ``helmcheck emulate --log`` writes and ``check-log`` reads) of about ``lines`` lines and
-returns the number of lines written. The vehicle is the project's own emulator core
+``write_session(path, lines, seed=0, faults=False, notes=False)`` writes a helmcheck wire log
+(format 1, the one ``helmcheck emulate --log`` writes and ``check-log`` reads) of about ``lines``
+lines and returns the number of lines written. The vehicle is the project's own emulator core
 (:class:`helmcheck.emulator.core.EmulatorCore`: the reference model and the plant, sans-IO), run
 at time scale 1 and 19200 baud with the clock an argument, so every vehicle line is what a
 conforming vehicle answers at that moment — positions, times, attitude, battery, modes and park
@@ -22,22 +22,23 @@ RH-BS-1 finding too), an ``$ACK`` is lost (RH-ACK-1, RH-ACK-2), and an out-of-ra
 have refused it by). They go in between 15 % and 90 % of the lines, each while a mission runs:
 a session of fewer than some thousands of lines may have room for none.
 
-Three things the backseat never does, because ``check-log`` reads them wrongly today (a judge
-matter, not the log's: a conforming vehicle's answers get a FAIL): an ``$OPK`` over a mission
-park (the resumed park's countdown is expected to wait for the vehicle to be back on station,
-the reference model counts at once), an ``$OMW`` waypoint with park time (the unseen on-station
-instant is bracketed too early), and an ``$OPOS`` that moves a submerged vehicle by metres
-(RH-POS-2 applies it; when that put the vehicle on its next waypoint, the judge did not see how
-it got there — fixed since, ``tests/test_checklog_opos_arrival.py``; the sessions keep their
-bytes): its ``$OPOS`` position is the vehicle's own last reported one. The
-emulator's own notes (plant and model events) are left out: a recording of a real vehicle's line
-has none.
+The backseat does what once made ``check-log`` FAIL a conforming vehicle's answers, so that
+the sessions keep those situations judged: an ``$OPK`` over a running mission park (and the
+mission park resumed when the ``$OPK`` time is up, RH-INT-2 —
+``tests/test_checklog_opk_over_park.py``), ``$OMW`` waypoints with a park time (RH-OMW-4 —
+``tests/test_checklog_omw_park.py``), waypoints appended to a queue the vehicle is following
+(RH-OMW-2 — ``tests/test_checklog_omw_queue.py``), and
+``$OPOS`` fixes a few metres off the vehicle's own last reported position (RH-POS-2 applies them
+while it is submerged — ``tests/test_checklog_opos_arrival.py``). The emulator's own notes (plant
+and model events) are left out: a recording of a real vehicle's line has none; ``notes=True``
+(``--notes``) keeps them, as ``helmcheck emulate --log`` writes them
+(``tests/test_checklog_emulator_notes.py``).
 
 The same seed gives the same bytes; different seeds differ. ``cached_session`` keeps generated
-files under the system temp directory, keyed by lines, seed, faults and a hash of the sources
-the log depends on (this file, the emulator, the model, the grammar).
+files under the system temp directory, keyed by lines, seed, faults, notes and a hash of the
+sources the log depends on (this file, the emulator, the model, the grammar).
 
-CLI: ``python benchmarks/realistic_log.py OUT --lines N [--seed S] [--faults]``.
+CLI: ``python benchmarks/realistic_log.py OUT --lines N [--seed S] [--faults] [--notes]``.
 """
 
 from __future__ import annotations
@@ -89,10 +90,11 @@ class TamperingWriter(WireLogWriter):
     """The wire log writer with the injected vehicle faults: the next ``$ACK`` of a type lost,
     or the next refusal of a type rewritten as an acceptance."""
 
-    def __init__(self, stream, meta):
+    def __init__(self, stream, meta, notes: bool = False):
         super().__init__(stream, meta)
         self.lose: set[bytes] = set()      #: ACK types whose next ACK is lost
         self.accept: set[bytes] = set()    #: ACK types whose next refusal reads accepted
+        self.notes = notes                 #: keep the emulator's own notes
 
     def bytes(self, t, direction, raw):
         if direction == FROM_VEHICLE and raw.startswith(b"$ACK,"):
@@ -107,8 +109,8 @@ class TamperingWriter(WireLogWriter):
 
     def note(self, t, text):
         """The emulator's notes (its plant's and model's events) are not on the wire: a recording
-        of a real vehicle's line has none, so neither has this log."""
-        return None
+        of a real vehicle's line has none, so neither has this log — unless asked for."""
+        return super().note(t, text) if self.notes else None
 
 
 class Backseat:
@@ -219,7 +221,8 @@ class Backseat:
             return [f"OMSTART,0,0,0,0,{name}"]
         if now >= self.next_opos:
             self.next_opos = now + rng.uniform(20, 40)
-            out.append(f"OPOS,{self.lat:.6f},{self.lon:.6f},"  # its navigation follows the vehicle's
+            north, east = rng.gauss(0.0, 3.0) / 111_320, rng.gauss(0.0, 3.0) / 83_500  # its own fix, metres off
+            out.append(f"OPOS,{self.lat + north:.6f},{self.lon + east:.6f},"
                        f"{rng.uniform(1.5, 2.5):.1f},{rng.uniform(30, 36):.2f},{rng.uniform(8, 16):.1f}")
         if self.logging and now >= self.next_logd:
             self.next_logd = now + rng.uniform(8, 12)
@@ -236,9 +239,9 @@ class Backseat:
         if act is None:
             if now < self.next_activity:
                 return []
-            act = rng.choices(("servo", "park", "omw", "jump"), (5, 2, 2, 1))[0]
-            if act == "park" and self.mode == "P":  # no $OPK over a mission park (module docstring)
-                act = "servo"
+            # in a mission park the $OPK over it is as likely as a servo episode (module docstring)
+            weights = (3, 4, 2, 1) if self.mode == "P" else (5, 2, 2, 1)
+            act = rng.choices(("servo", "park", "omw", "jump"), weights)[0]
             if now < self.backoff.get({"servo": "9", "park": "11", "omw": "16", "jump": "7"}[act], 0):
                 return []
             self.activity = act
@@ -253,9 +256,7 @@ class Backseat:
                         f"{self.lon + rng.uniform(-3e-4, 3e-4):.6f},{rng.randint(1, 3)},2.0"]
             elif act == "omw":
                 self.activity_until = now + rng.uniform(120, 300)
-                return [f"OMW,{self.lat + rng.uniform(-5e-4, 5e-4):.6f},{self.lon + rng.uniform(-5e-4, 5e-4):.6f},"
-                        f"{rng.uniform(1, 4):.1f},,20,2.0,0,"
-                        for _ in range(rng.randint(1, 3))]
+                return [self._omw() for _ in range(rng.randint(1, 3))]
             else:
                 self.activity = None
                 self.next_activity = now + rng.uniform(30, 90)
@@ -276,7 +277,15 @@ class Backseat:
             return [f"OMS,{sv['hdg']:.1f},{sv['depth']:.1f},20,{rng.uniform(1.8, 2.4):.1f},{sv['t']}"]
         if now >= self.activity_until or self.mode in ("N", "P") and now > self.activity_until - 50:
             return self._end_activity(now, "OMW,Clr" if self.mode in ("W", "mP") else None)
+        if act == "omw" and self.mode == "W" and rng.random() < 0.02:  # one more, behind the queue
+            return [self._omw()]
         return []
+
+    def _omw(self) -> str:
+        """An ``$OMW`` near the vehicle, with a park time now and then."""
+        rng = self.rng
+        return (f"OMW,{self.lat + rng.uniform(-5e-4, 5e-4):.6f},{self.lon + rng.uniform(-5e-4, 5e-4):.6f},"
+                f"{rng.uniform(1, 4):.1f},,20,2.0,{rng.randint(5, 60) if rng.random() < 0.4 else 0},")
 
     def _end_activity(self, now: float, command: Optional[str]) -> list[str]:
         self.activity = None
@@ -284,13 +293,14 @@ class Backseat:
         return [command] if command else []
 
 
-def write_session(path: Path, lines: int, seed: int = 0, faults: bool = False) -> int:
-    """Write a wire log of about ``lines`` lines (see the module docstring); the number written."""
+def write_session(path: Path, lines: int, seed: int = 0, faults: bool = False, notes: bool = False) -> int:
+    """Write a wire log of about ``lines`` lines (see the module docstring); the number written.
+    ``notes``: keep the emulator's own notes (their lines count)."""
     rng = random.Random(seed)
     path = Path(path)
     with open(path, "w", encoding="ascii", newline="\n", buffering=1 << 20) as f:
         log = TamperingWriter(_NoFlush(f), (f"started 2026-11-25T08:00:00.000000Z  port virtual "
-                                            f"seed {seed}  baud {BAUD}  time_scale {TIME_SCALE:g}",))
+                                            f"seed {seed}  baud {BAUD}  time_scale {TIME_SCALE:g}",), notes)
         core = EmulatorCore(DEFAULT, DirectoryCatalog([builtin_dir()]), start=0.0,
                             time_scale=TIME_SCALE, baud=BAUD, log=log)
         bs = Backseat(rng)
@@ -362,16 +372,17 @@ def _source_hash() -> str:
     return h.hexdigest()[:16]
 
 
-def cached_session(lines: int, seed: int = 0, faults: bool = False) -> tuple[Path, bool]:
+def cached_session(lines: int, seed: int = 0, faults: bool = False, notes: bool = False) -> tuple[Path, bool]:
     """The session for these arguments from the cache, generated when missing: (path, generated)."""
     d = Path(tempfile.gettempdir()) / "helmcheck-realistic"
     d.mkdir(exist_ok=True)
-    path = d / f"session-{lines}-{seed}-{'faults' if faults else 'clean'}-{_source_hash()}.log"
+    kind = ("faults" if faults else "clean") + ("-notes" if notes else "")
+    path = d / f"session-{lines}-{seed}-{kind}-{_source_hash()}.log"
     if path.exists():
         return path, False
     tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
     try:
-        write_session(tmp, lines, seed, faults)
+        write_session(tmp, lines, seed, faults, notes)
         os.replace(tmp, path)
     finally:
         tmp.unlink(missing_ok=True)
@@ -384,11 +395,12 @@ def main(argv: Optional[list[str]] = None) -> int:
     ap.add_argument("--lines", type=int, default=1_000_000)
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--faults", action="store_true", help="inject a handful of vehicle faults")
+    ap.add_argument("--notes", action="store_true", help="keep the emulator's own notes (plant and model events)")
     args = ap.parse_args(argv)
     if args.lines < 1:
         ap.error("--lines must be at least 1")
     t0 = time.perf_counter()
-    n = write_session(args.out, args.lines, args.seed, args.faults)
+    n = write_session(args.out, args.lines, args.seed, args.faults, args.notes)
     print(f"{args.out}: {n} lines, {args.out.stat().st_size / 1e6:.1f} MB in {time.perf_counter() - t0:.1f} s")
     return 0
 

@@ -12,7 +12,8 @@ The logs: ``tests/fixtures/logs/**`` (wire logs, socat ``-v``/``-x`` captures, a
 emulator's gzipped logs of those captures), the wire logs of ``tests/fixtures/reports/*`` (also
 under the run's own ``profile.toml``), ``reports/demo/wire.log``, and realistic sessions from
 ``realistic_log.py`` (clean and with faults, 100,000 lines, one of 300,000 so that the backseat
-role is judged in a second process; the clean ones also with the built-in mission directory).
+role is judged in a second process, one with the emulator's own notes kept; the clean ones also
+with the built-in mission directory).
 
 Left out of the comparison, because they vary from run to run and say nothing of the verdicts:
 ``started``, ``finished``, ``duration_s`` and ``log.check_seconds`` (the run's own clock),
@@ -39,7 +40,9 @@ from realistic_log import cached_session  # noqa: E402
 
 VOLATILE = ("started", "finished", "duration_s", "command")
 MISSIONS = ROOT / "helmcheck" / "emulator" / "missions"
-REALISTIC = ((100_000, 0, False), (100_000, 1, True), (100_000, 2, True), (300_000, 3, False))
+#: (lines, seed, faults, the emulator's own notes kept)
+REALISTIC = ((100_000, 0, False, False), (100_000, 1, True, False), (100_000, 2, True, False),
+             (300_000, 3, False, False), (100_000, 4, False, True))
 
 
 def checks(work: Path) -> list[tuple[str, Path, list[str]]]:
@@ -62,10 +65,10 @@ def checks(work: Path) -> list[tuple[str, Path, list[str]]]:
         if (p.parent / "profile.toml").exists():
             # relative to the checkout (check-log runs there): results name the profile file
             out.append((name + " --profile", p, ["--profile", str((p.parent / "profile.toml").relative_to(ROOT))]))
-    for lines, seed, faults in REALISTIC:
-        name = f"realistic-{lines}-{seed}-{'faults' if faults else 'clean'}"
+    for lines, seed, faults, notes in REALISTIC:
+        name = f"realistic-{lines}-{seed}-{'faults' if faults else 'clean'}{'-notes' if notes else ''}"
         path = work / f"{name}.log"  # under one name whatever the cache calls it (reports name the log)
-        shutil.copyfile(cached_session(lines, seed, faults)[0], path)
+        shutil.copyfile(cached_session(lines, seed, faults, notes)[0], path)
         out.append((name, path, []))
         if not faults:
             out.append((name + " --missions", path, ["--missions", str(MISSIONS)]))

@@ -67,12 +67,10 @@ typical use:
   helmcheck emulate --port pty --time-scale 20 &     # a reference vehicle; prints port: /dev/pts/N
   helmcheck certify vehicle --port /dev/pts/N --time-scale 20 --profile helmcheck/profiles/emulator.toml
   helmcheck certify backseat --duration 10 --time-scale 10 \\
-      --exec 'python3 tests/backseats/good_backseat.py {port} --time-scale {time_scale}'
+      --exec 'python3 examples/backseat.py --port {port} --time-scale {time_scale}'
   helmcheck check-log reports/vehicle/wire.log      # judge a recorded log as the run that wrote it did
   helmcheck monitor --tap /dev/ttyUSB0 /dev/ttyUSB1  # judge a live session from a Y-cable, live
   helmcheck relay --between pty /dev/ttyUSB0 --impair 'flip=1e-5,cut=5s@60'  # test on a bad line
-  helmcheck parse wire.log                         # validate a capture line by line
-  helmcheck profile init iver3.toml                # a commented profile for a vehicle to fill in
   helmcheck diff --port /dev/pts/5 --port /dev/pts/7 # two vehicles, same sequences: first divergence
   helmcheck report reports/vehicle                  # render results.json to HTML/JUnit/Markdown again
   helmcheck verify reports/vehicle                  # re-judge the wire log; check the signature

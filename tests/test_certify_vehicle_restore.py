@@ -142,5 +142,5 @@ def test_a_conforming_vehicle_is_left_stopped_with_its_settings_verified(tmp_pat
     rec = out.results["restore"]
     assert out.exit_code == 0 and rec["verified"] is True, rec
     assert rec["found"]["mode"] == "S" and rec["left"]["mode"] == "S"
-    assert [x["name"] for x in rec["settings"] if x["written"]] == ["Sop"]
+    assert [x["name"] for x in rec["settings"] if x["written"]] == ["Sop", "Sle", "SafetyAction"]  # V-55, V-73
 

@@ -122,6 +122,18 @@ def test_RH_PRM_1_RH_PRM_4_primitive_from_stopped(helm):
     assert (o.mode, o.actuators) == ("S", "8080808080")  # RH-PRM-4
 
 
+def test_RH_RD_9_a_waypoint_at_the_pole_at_a_slow_speed_is_followed(helm):
+    """A queued waypoint at the edge of the latitude range, months away at 0.1 kn: the emulator
+    goes on answering (its next wakeup is past what a selector can wait; it wakes sooner)."""
+    start_mission(helm)
+    assert ok(helm.ack("OMW,90,180,0,,15,0.1,0,", 16)) == (16, 0, 0)  # at the surface: no depth to cross
+    for _ in range(10):
+        assert helm.osi().mode == "W"
+        time.sleep(0.05)
+    assert ok(helm.ack("OMW,Clr", 16)) == (16, 0, 0)
+    assert helm.osi().mode in ("N", "P")
+
+
 def test_RH_JW_2_jump_ends_remote_control(helm):
     start_mission(helm)
     assert ok(helm.ack("OMS,90,2,20,2,60", 9)) == (9, 0, 0)

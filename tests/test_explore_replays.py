@@ -22,7 +22,7 @@ from tests.faulty_vehicles import EMU_PROFILE, MUTANTS, make_core, serve
 
 K = 25.0
 #: fault -> (its clause, the fixed seed the exploration runs at)
-FAULTS = {"lockout-10s": ("RH-SAF-1", 2), "opk-kept-after-interrupt": ("RH-INT-3", 1)}
+FAULTS = {"lockout-10s": ("RH-SAF-1", 1), "opk-kept-after-interrupt": ("RH-INT-3", 1)}
 
 
 def _mutant(name):

@@ -203,3 +203,28 @@ def test_every_faulty_vehicle_still_fails_its_clause_on_a_slow_line(mutant, k, l
     plan = estimate(tester, k, select=list(mutant.select), examples=0, latency_s=delay, vehicle=vehicle)
     assert plan.verdicts.get(mutant.clause) == "fail", {c: v for c, v in plan.verdicts.items() if v != "pass"
                                                        and c in mutant.select}
+
+
+def test_RH_TIM_1_a_timing_verdict_carries_the_finest_tolerance_it_was_judged_with():
+    """Issue "Find the small faults": every timing verdict says how precisely it was judged, and
+    a PASS coarser than nominal says so on the verdict line, with the time scale that would not be."""
+    from helmcheck.judge import Ledger
+    from helmcheck.reports.scope import precision_note
+
+    led = Ledger(["RH-SRV-4", "RH-TIM-1"])
+    for widened in (6.2, 2.9, 4.0):
+        led.passed("RH-SRV-4", "ended within the tolerance")
+        led.precision("RH-SRV-4", 0.65, widened, 20.0)
+    entry = next(e for e in led.entries() if e["id"] == "RH-SRV-4")
+    assert entry["precision"] == {"nominal_s": 0.65, "widened_s": 2.9, "time_scale": 20.0}
+    assert "within ±2.90 s" in entry["reason"] and "nominal tolerance ±0.65 s" in entry["reason"]
+    budget = LineBudget(k=20.0, baud=19200, latency_s=0.02, measured=True)
+    results = {"clauses": led.entries(), "settings": {"line_budget": budget.as_dict()}}
+    note = precision_note(results)
+    assert "1 timing clause(s) judged coarser" in note and "RH-SRV-4 within ±2.9 s" in note
+    assert f"run at ×{budget.nominal_scale():g}" in note
+    # within nominal precision: nothing to say
+    led2 = Ledger(["RH-SRV-4"])
+    led2.passed("RH-SRV-4", "ok")
+    led2.precision("RH-SRV-4", 0.5, 0.75, 1.0)
+    assert precision_note({"clauses": led2.entries()}) == ""

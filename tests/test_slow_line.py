@@ -39,8 +39,11 @@ SIM = ROOT.parent / "shared" / "third-party" / "uvc_sim.py"
 #: may hold the relay's own thread a few hundred ms more, which 0.6 s would push past the window)
 SLOW = "baud=19200,<line-delay=0.6" if MATRIX else "baud=19200,<line-delay=0.5"
 
-#: The clauses whose cases set timers going, confirm what they set, wait out a lockout or an ascent.
-TIMING = ["RH-SRV-3", "RH-SRV-4", "RH-PRM-4", "RH-INT-2", "RH-SAF-1", "RH-SAF-3", "RH-TIM-1", "RH-TIM-2"]
+#: The clauses whose cases set timers going (and restart one), confirm what they set, wait out a
+#: lockout and find the ascent after it (RH-TIM-1's tolerance is applied to each of those timers; the
+#: clauses not selected stay NOT-TESTED "not selected", whatever was observed of them).
+TIMING = ["RH-SRV-3", "RH-PRM-4", "RH-SAF-1", "RH-SAF-3"]
+JUDGED = TIMING
 
 
 def _certify(port: str, profile, k: float, out: Path, select=None, examples: int = 0):
@@ -53,6 +56,10 @@ def _judged_pass(out, select) -> None:
     assert not bad, bad
     judged = {c["id"] for c in out.results["clauses"] if c["verdict"] == "pass"}
     assert set(select) <= judged, {c["id"]: c["reason"] for c in out.results["clauses"] if c["id"] in select}
+    timed = [c for c in out.results["clauses"] if c["id"] in select and c.get("precision")]
+    assert timed, select  # a timer judged, and how coarsely
+    for c in timed:
+        assert c["precision"]["widened_s"] > c["precision"]["nominal_s"] > 0, c  # said how coarse
     budget = out.results["settings"]["line_budget"]
     assert budget["measured"] and budget["latency_p50_s"] >= 0.45, budget  # it saw the line it ran on
 
@@ -67,7 +74,7 @@ def test_the_emulator_answering_every_line_0_6_s_late_at_x20_passes(tmp_path):
     delay = "0.6" if MATRIX else "0.5"
     with EmulatorProcess(["--set", f"reply_delay_s={delay}"], time_scale=20.0, baud=19200) as emu:
         out = _certify(emu.port, profile, 20.0, tmp_path / "r", select=TIMING)
-    _judged_pass(out, TIMING)
+    _judged_pass(out, JUDGED)
 
 
 def _sim_profile(tmp: Path) -> object:
@@ -84,7 +91,7 @@ def test_a_vehicle_we_did_not_write_behind_a_slow_line_passes(tmp_path):
     from tests.test_third_party_vehicle import uvc_sim
     with uvc_sim(tmp_path, 20.0) as port, impaired_line(port, SLOW, link=tmp_path / "vehicle") as line:
         out = _certify(str(line.port), _sim_profile(tmp_path), 20.0, tmp_path / "r", select=TIMING)
-    _judged_pass(out, TIMING)
+    _judged_pass(out, JUDGED)
 
 
 def test_a_faulty_vehicle_behind_a_slow_line_still_fails_its_clause(tmp_path):

@@ -34,14 +34,16 @@ def osi_fields(data: bytes) -> Optional[list]:
 
 class VirtualVehicle:
     """The emulator core at 19200 baud, time scale 1, its clock set by hand (``now``); its model
-    ``model_factory`` (a faulty vehicle's) when given."""
+    ``model_factory`` (a faulty vehicle's) when given; ``settings``: the emulator's freedoms
+    (:class:`~helmcheck.emulator.freedoms.EmulatorSettings`)."""
 
-    def __init__(self, profile: Profile, model_factory=None):
+    def __init__(self, profile: Profile, model_factory=None, settings=None):
         self.buf = io.StringIO()
         log = WireLogWriter(self.buf, ("started 2026-11-26T08:00:00.000000Z  port virtual  baud 19200  "
                                        "time_scale 1",))
         self.core = EmulatorCore(profile, DirectoryCatalog([builtin_dir()]), start=0.0, time_scale=1.0,
-                                 baud=19200, log=log, **({"model_factory": model_factory} if model_factory else {}))
+                                 baud=19200, log=log, settings=settings,
+                                 **({"model_factory": model_factory} if model_factory else {}))
         self.now = 0.0
 
     def send(self, body: str) -> bytes:

@@ -24,3 +24,6 @@ class Outcome:
     #: ``--precision nominal`` stopped a vehicle run after its link check: the time scale at which
     #: this line judges timing to nominal precision (a vehicle helmcheck starts is run again at it)
     nominal_time_scale: float | None = None
+    #: a vehicle run whose port vanished and did not come back in time: the command that goes on
+    #: from the case the gap cut (``certify vehicle --resume DIR``)
+    resume_command: str | None = None

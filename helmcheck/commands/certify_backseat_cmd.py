@@ -59,13 +59,21 @@ process group), then SIGKILL after --exec-grace seconds. A backseat that exits o
 before the end fails the run: results.json "process" has its exit and last output, the clauses
 whose scenarios had not finished are NOT-TESTED.
 
+a vanished port: when helmcheck's own device (--port /dev/..., a USB adapter) goes away mid-run,
+helmcheck waits up to --reconnect-wait seconds (default 30) for it to come back under the same
+name (/dev/serial/by-id/...), records the gap (time the judge did not see: the next poll is due
+from the return, nothing the backseat may have learnt meanwhile is held against it) and runs the
+scenario it cut again from its start. Not back in time: INCONCLUSIVE (exit 2), the report holding
+everything up to the cut. A backseat that closes a pty helmcheck made, or leaves its TCP port,
+is the backseat going away: not waited for.
+
 certificate: --implementation names the backseat in every report; --sign-key signs the run
   (helmcheck keygen); helmcheck verify DIR --public-key lab.pub checks it against its evidence.
 
 examples:
   helmcheck certify backseat                          # pty: prints 'port: /dev/pts/N', waits for a backseat
   helmcheck certify backseat --duration 10 --time-scale 10 \\
-      --exec 'python3 tests/backseats/good_backseat.py {port} --time-scale {time_scale}'
+      --exec 'python3 examples/backseat.py --port {port} --time-scale {time_scale}'
   helmcheck certify backseat --port socket://127.0.0.1:0 --scenario lockout   # a TCP server; prints its port
   helmcheck certify backseat --port /dev/ttyUSB0 --profile iver3.toml --strict
   helmcheck keygen --out lab                          # a signing key pair, once
@@ -93,6 +101,10 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--wire-log", metavar="FILE", help="also keep a copy of the wire log here")
     p.add_argument("--connect-timeout", type=float, default=30.0, metavar="S",
                    help="seconds to wait for the backseat's first byte (default 30)")
+    p.add_argument("--reconnect-wait", type=float, default=None, metavar="SECONDS",
+                   help="how long helmcheck's own device (a serial adapter: --port /dev/...) that vanished "
+                        "mid-run is waited for under the same name; the scenario it cut then runs again "
+                        "(default 30; 0: not waited for)")
     p.add_argument("--baud", type=int, metavar="N", help="line rate (default: the profile's)")
     p.add_argument("--exec", dest="exec_cmd", metavar="CMD",
                    help="start the backseat under test on the port ({port} is replaced, or the port appended)")
@@ -110,6 +122,7 @@ def run(args: argparse.Namespace, *, on_port: Optional[Callable[[str], None]] = 
     """Carry out ``certify backseat``; returns the exit status. ``on_port(name)`` is called
     once the port is open (after the ``port:`` line), for callers that start the backseat."""
     from ..certify.backseat.certifier import Options, certify, problems
+    from ..line.reopen import DEFAULT_WAIT_S
     from ..profile import ProfileError, load_profile
     from ..reports.scope import headline
     from .certificate_opts import DeclarationError, declaration
@@ -122,6 +135,8 @@ def run(args: argparse.Namespace, *, on_port: Optional[Callable[[str], None]] = 
     opts = Options(profile=profile, report_dir=Path("."), port=args.port, time_scale=args.time_scale,
                    baud=args.baud, duration=args.duration, scenarios=args.scenario, strict=bool(args.strict),
                    connect_timeout=args.connect_timeout, exec_cmd=getattr(args, "exec_cmd", None),
+                   reconnect_wait=(DEFAULT_WAIT_S if getattr(args, "reconnect_wait", None) is None
+                                   else args.reconnect_wait),
                    exec_grace_s=args.exec_grace, progress=not getattr(args, "no_progress", False))
     wrong = problems(opts)
     if wrong:

@@ -28,7 +28,7 @@ EPILOG = """\
 examples:
   helmcheck certify vehicle --port /dev/pts/N --time-scale 20 --profile helmcheck/profiles/emulator.toml
   helmcheck certify backseat --duration 10 --time-scale 10 \\
-      --exec 'python3 tests/backseats/good_backseat.py {port} --time-scale {time_scale}'
+      --exec 'python3 examples/backseat.py --port {port} --time-scale {time_scale}'
 
 Run 'helmcheck certify vehicle --help' or 'helmcheck certify backseat --help' for each role's options.
 

@@ -75,6 +75,15 @@ the vehicle left as found: before it writes a setting helmcheck reads it (in S),
   is exit 2 (1 when the run also failed) and a message naming what to set by hand; the report's
   "Vehicle restored" section lists each setting before and after.
 
+a vanished port: when the vehicle's device goes away mid-run (a USB adapter unplugged: EIO; the
+  socket dropped), helmcheck waits up to --reconnect-wait seconds (default 30) for it to come back
+  under the same name (/dev/serial/by-id/... names an adapter plugged back), records the gap in the
+  wire log (time the judge did not see: a command it cut off is INCONCLUSIVE, never FAIL), stops
+  the vehicle and sees it in S again, and runs the case the gap cut from its start. Not back in
+  time: the run stops (exit 2; the wire log and a partial report hold everything up to the cut)
+  and prints the command that goes on from that case:
+    resume: helmcheck certify vehicle --port /dev/serial/by-id/usb-... --resume reports/vehicle
+
 results: DIR/results.json (schema 1), DIR/wire.log, DIR/profile.toml, DIR/signature.json (signed runs),
   DIR/report.html, DIR/junit.xml, DIR/report.md. A DIR that holds an earlier run is refused
   unless --overwrite. SIGINT, SIGTERM and SIGHUP end the run early: results marked partial,
@@ -91,6 +100,7 @@ examples:
   helmcheck certify vehicle --port socket://10.0.0.5:4001 --profile iver3.toml --select 'RH-SRV-*' \\
       --select RH-ACK-2
   helmcheck certify vehicle --port /dev/ttyUSB0 --resume reports/vehicle   # go on after an interruption
+  helmcheck certify vehicle --port /dev/ttyUSB0 --profile iver3.toml --reconnect-wait 120   # a flaky adapter
 
 exit status: 0 pass (or non-strict without --strict), 1 fail, 2 inconclusive, link fault, tester
   error, a vehicle not verified as restored after a run that did not fail, or an output that could
@@ -131,6 +141,10 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--resume", metavar="DIR",
                    help="continue the interrupted run in DIR from its last completed case, into the same "
                         "report (its profile, selection, time scale and seed are the run's own)")
+    p.add_argument("--reconnect-wait", type=float, default=None, metavar="SECONDS",
+                   help="how long a vehicle port that vanished mid-run (an adapter unplugged, a socket "
+                        "dropped) is waited for under the same name before the run stops with the --resume "
+                        "command to go on (default 30; 0: not waited for)")
     p.add_argument("--precision", choices=("any", "nominal"), default="any",
                    help="nominal: timing must be judged to RH-TIM-1's tolerance + 0.3 s at most; the line "
                         "is measured first, and a vehicle started with --exec is run at the time scale that "
@@ -196,6 +210,7 @@ def run(args: argparse.Namespace) -> int:  # noqa: C901 - argument checks, then 
         raise UsageError("--port pty creates a new pseudo-terminal; give the vehicle's port (e.g. /dev/pts/N) "
                          "or --exec CMD to start the vehicle on it")
     select = _selection(args)
+    wait = _reconnect_wait(args)
     from .certificate_opts import DeclarationError, declaration
     try:
         cert = declaration(args, "vehicle")
@@ -231,7 +246,8 @@ def run(args: argparse.Namespace) -> int:  # noqa: C901 - argument checks, then 
                        link=link, log_opener=open_wire_log, exec_cmd=args.exec_cmd,
                        exec_grace_s=args.exec_grace, exec_ready_s=args.exec_ready, certificate=cert,
                        operator=_at_a_terminal(), resume=resume, clock_check=args.clock_check,
-                       precision=args.precision)
+                       precision=args.precision, reconnect_wait_s=wait,
+                       resume_command=resume_command(args, report_dir))
         out = certify(opts)
         if out.nominal_time_scale is not None and args.exec_cmd is not None:
             # --precision nominal with a vehicle helmcheck starts: run it again at the time scale
@@ -254,6 +270,8 @@ def run(args: argparse.Namespace) -> int:  # noqa: C901 - argument checks, then 
     notes = [x for x in (what_to_change(out.results), precision_note(out.results)) if x]
     print(f"{headline(out.results)}. {out.reason}{''.join(' ' + x for x in notes)}")
     print(report_line(out.report_dir))
+    if out.resume_command:  # the port did not come back: one line that goes on from the cut
+        print(f"resume: {out.resume_command}")
     sys.stdout.flush()
     restore = out.results.get("restore")
     if restore is not None and restore.get("attempted") and not restore.get("verified"):
@@ -299,6 +317,47 @@ def _resume_args(args: argparse.Namespace) -> str:
     args.strict = bool(st.get("strict", False))
     args.hypothesis_profile = st.get("hypothesis_profile")
     return ""
+
+
+def _reconnect_wait(args: argparse.Namespace) -> float:
+    """``--reconnect-wait`` in seconds (:data:`helmcheck.line.reopen.DEFAULT_WAIT_S` when not given)."""
+    from ..line.reopen import DEFAULT_WAIT_S
+
+    if args.reconnect_wait is None:
+        return DEFAULT_WAIT_S
+    if not math.isfinite(args.reconnect_wait) or args.reconnect_wait < 0:
+        raise UsageError(f"--reconnect-wait must be 0 or a positive number of seconds (got {args.reconnect_wait:g})")
+    if args.exec_cmd is not None and args.reconnect_wait > 0:
+        raise UsageError("--reconnect-wait: a vehicle started with --exec is not waited for (its port going "
+                         "away is its process ending); drop one of them")
+    return float(args.reconnect_wait)
+
+
+#: Options of this invocation a resumed run is given again (each: attribute, flag, takes a value).
+_RESUME_AGAIN = (("reconnect_wait", "--reconnect-wait", True), ("precision", "--precision", True),
+                 ("clock_check", "--no-clock-check", False), ("no_progress", "--no-progress", False),
+                 ("sign_key", "--sign-key", True), ("operator", "--operator", True),
+                 ("site", "--site", True), ("implementation", "--implementation", True))
+
+
+def resume_command(args: argparse.Namespace, report_dir: Path) -> str:
+    """The command that goes on with this run after a port that did not come back: ``--port`` and
+    ``--resume DIR``, and this invocation's own options a resumed run takes from its command line
+    (the run's profile, selection, time scale and seed are the record's, :data:`_RESUME_FIXED`)."""
+    out = ["helmcheck", "certify", "vehicle", "--port", args.port, "--resume", str(report_dir)]
+    for attr, flag, valued in _RESUME_AGAIN:
+        value = getattr(args, attr, None)
+        if attr == "clock_check":
+            if value is False:
+                out.append(flag)
+        elif attr == "precision":
+            if value not in (None, "any"):
+                out += [flag, value]
+        elif valued and value is not None:
+            out += [flag, f"{value:g}" if isinstance(value, float) else str(value)]
+        elif not valued and value:
+            out.append(flag)
+    return shlex.join(out)
 
 
 def _at_a_terminal() -> bool:

@@ -42,6 +42,12 @@ wire.002.log, … (judged as one session); at the end (and a check of the sessio
 rotation) results.json and the reports, exactly as check-log gives them for that log, signable
 with --sign-key and checked by 'helmcheck verify'.
 
+a side that vanishes (an adapter unplugged, a serial server's connection dropped): the other side
+is still relayed and judged, and the gone one is opened again under the same name
+(/dev/serial/by-id/...) when it is back, for up to --reconnect-wait seconds (default 30). The gap
+is in the wire log: a violation seen while a side was gone is INCONCLUSIVE (the gap may explain
+it), and nothing across the gap is judged; results.json "monitor.link_gaps" lists the gaps.
+
 end: --duration S, --until HH:MM[:SS] (local time) or an ISO date-time, Ctrl-C or SIGTERM.
 
 examples:
@@ -76,6 +82,9 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
                                                        "(default: reports/monitor-<UTC time>)")
     p.add_argument("--duration", type=float, metavar="S", help="end after S seconds")
     p.add_argument("--until", metavar="TIME", help="end at HH:MM[:SS] (local time, today or tomorrow) or an ISO date-time")
+    p.add_argument("--reconnect-wait", type=float, default=None, metavar="SECONDS",
+                   help="how long a side whose device vanished is waited for under the same name, the "
+                        "other side still relayed and judged (default 30; 0: not waited for)")
     p.add_argument("--rotate-mb", type=float, default=64.0, metavar="MB",
                    help="start a new wire-log segment every MB megabytes (default 64)")
     p.add_argument("--strict", action="store_true", help="a SHOULD not met fails the session")
@@ -133,6 +142,10 @@ def run(args: argparse.Namespace) -> int:
     if not (math.isfinite(args.rotate_mb) and args.rotate_mb > 0):
         raise UsageError(f"--rotate-mb must be a positive number (got {args.rotate_mb})")
     until = _until(args.until) if args.until else None
+    from ..line.reopen import DEFAULT_WAIT_S
+    wait = DEFAULT_WAIT_S if args.reconnect_wait is None else args.reconnect_wait
+    if not (math.isfinite(wait) and wait >= 0):
+        raise UsageError(f"--reconnect-wait must be 0 or a positive number of seconds (got {wait:g})")
     mode, (b_port, v_port) = ("tap", args.tap) if args.tap else ("between", args.between)
     for port in (b_port, v_port):
         port_spec(port, f"--{mode}")
@@ -161,6 +174,9 @@ def run(args: argparse.Namespace) -> int:
     def on_port(side: str, name: str) -> None:
         print(f"{side} port: {name}", flush=True)
 
+    def on_gap(text: str) -> None:
+        print(f"helmcheck monitor: {text}", file=sys.stderr, flush=True)
+
     def on_relay(priority: str) -> None:
         hint = "" if priority.startswith("real-time") or args.no_realtime else \
             " — for the lowest added latency allow it real-time priority (README: At sea)"
@@ -174,7 +190,8 @@ def run(args: argparse.Namespace) -> int:
                           time_scale=float(scale), baud=baud, duration=args.duration, until=until,
                           rotate_bytes=int(args.rotate_mb * 1024 * 1024), strict=bool(args.strict),
                           command=command, certificate=cert, on_finding=on_finding, on_port=on_port,
-                          view=screen, links=links, realtime=not args.no_realtime, on_relay=on_relay))
+                          view=screen, links=links, realtime=not args.no_realtime, on_relay=on_relay,
+                          reconnect_wait=float(wait), on_gap=on_gap))
     from .messages import report_line
     print(f"{headline(out.results)}. {out.reason} ({out.ended}; {out.findings} finding(s))")
     print(report_line(out.report_dir), flush=True)

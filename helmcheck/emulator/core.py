@@ -62,6 +62,8 @@ from ..grammar import format as format_sentence
 from ..grammar import sentences as s
 from ..grammar.wirelog import NOTE, TO_VEHICLE, WireLogWriter, escape
 from ..grammar.errors import SentenceError
+from ..model import events as ev
+from ..model.geo import distance_m
 from ..model.missions import MissionCatalog
 from ..model.plant import SafetyViolation
 from ..model.vehicle import VehicleModel
@@ -348,11 +350,24 @@ class EmulatorCore(Timeline, Outbox):
             self.rules.observe(self.model, self.v)
 
     def _after_model(self, now: float) -> None:
-        """Flush the model's pending events to the log and let the plant see the new goal."""
+        """Flush the model's pending events to the log and let the plant see the new goal. A
+        mission park resumed after remote control waits to be back on station when the settings
+        say so (``resumed_park``, RH-INT-2)."""
         evs = self._model_call(self.model.drain_events, now) or ()
         for e in evs:
-            self._note(now, f"model: {event_text(e)}")
+            self._model_event(e, now)
         self.plant.sync(self.model)
+
+    def _model_event(self, e, wall: float) -> None:
+        """Log a model event; a mission park resumed after remote control waits to be back on
+        station at its waypoint when the settings say so (``resumed_park``, RH-INT-2)."""
+        self._note(wall, f"model: {event_text(e)}")
+        if type(e) is ev.ControlReleased and e.mode == "P" and self.settings.resumed_park == "on station":
+            m = self.model
+            target = m.navigation_target()
+            away = target is None or distance_m(self.plant.lat, self.plant.lon, *target) > self.profile.on_station_m
+            if away and m.await_park_station():
+                self._note(wall, "model: the resumed park waits to be back on station")
 
     def _write_main_log(self) -> None:
         """RH-LOG-2: the rows the model wrote since the last call go to the main log."""

@@ -28,6 +28,10 @@ Settings (wall seconds where the line is concerned, vehicle seconds otherwise; R
   (``$OMS``/``$OMP``/``$ODVL`` timeouts, parks, the lockout) really lasts
   ``duration × factor + offset`` (:class:`SkewedTimers`); its ``$OSI`` park countdown runs on
   the same clock.
+* the mission: ``resumed_park`` — a mission park resumed after remote control (RH-INT-2) counts
+  ``"at once"`` from the release, wherever the vehicle is (the reference model), or, ``"on
+  station"``, only once the vehicle is back within ``on_station_m`` of the park's waypoint, which
+  it heads for (the paper: "the vehicle will park for the remaining time").
 * the plant: ``speed_factor`` (speed made good ÷ commanded), ``turn_rate_dps``,
   ``dive_pitch_deg`` (pitch of the mission's dives), ``ascent_mps`` (the ascent after a
   lockout), ``buoyancy_rise_mps``, ``water_depth_m``, ``start_lat``/``start_lon``/
@@ -99,6 +103,9 @@ class EmulatorSettings:
     control_tick_s: float = _s(0.0, "vehicle seconds between control-loop ticks (0: continuous)", "RH-TIM-1")
     timer_factor: float = _s(1.0, "every timed duration lasts duration × factor + offset", "RH-TIM-1")
     timer_offset_s: float = _s(0.0, "vehicle seconds added to every timed duration", "RH-TIM-1")
+    # --- the mission
+    resumed_park: str = _s("at once", "a mission park resumed after remote control counts from the release "
+                           "(at once) or once back on station at its waypoint (on station)", "RH-INT-2")
     # --- the plant
     speed_factor: float = _s(1.0, "speed made good ÷ commanded speed")
     turn_rate_dps: float = _s(15.0, "turn rate, degrees per vehicle second")
@@ -163,7 +170,7 @@ class EmulatorSettings:
 
 DEFAULT_SETTINGS = EmulatorSettings()
 
-_CHOICES = {"pacing": ("baud", "burst"), "idle_distance": ("zero", "last")}
+_CHOICES = {"pacing": ("baud", "burst"), "idle_distance": ("zero", "last"), "resumed_park": ("at once", "on station")}
 _POSITIVE = ("timer_factor", "speed_factor", "turn_rate_dps", "dive_pitch_deg", "ascent_mps",
              "buoyancy_rise_mps", "water_depth_m")
 _COMPASS_LETTERS = ("M", "Mx", "My", "Mz", "A", "Ax", "Ay", "Az")
@@ -340,7 +347,7 @@ class SkewedTimers(Timers):
         start, dur = t
         return start + self._length(dur)
 
-    def remaining(self, name: str, now: float) -> Optional[float]:
+    def remaining(self, name: str, now: float, clip: bool = True) -> Optional[float]:
         t = self._t.get(name)
         if t is None:
             return None
@@ -348,7 +355,8 @@ class SkewedTimers(Timers):
         length = self._length(dur)
         if length <= 0:
             return 0.0
-        return max(0.0, dur * (start + length - now) / length)
+        left = dur * (start + length - now) / length
+        return left if not clip or left > 0.0 else 0.0
 
 
 def _quantize(value: Decimal, places: int, heading: bool = False) -> Decimal:

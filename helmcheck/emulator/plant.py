@@ -158,6 +158,12 @@ class Plant:
                           max_pitch=self.params.default_max_pitch_deg, arrive="wp",
                           key=("wp", m.mission, i))
         if mode == "P":
+            if m.park_waiting and m.mission is not None:  # back to the park's waypoint first (RH-INT-2)
+                w = m.mission.waypoints[m.mission_wp]
+                lat, lon = m.navigation_target()
+                return Target("goto", depth=w.depth, speed_kn=w.speed, lat=lat, lon=lon,
+                              max_pitch=self.params.default_max_pitch_deg, arrive="station",
+                              key=("park", m.mission, m.mission_wp, m.control_generation))
             return Target("hold", depth=0.0 if m.error_state != "N" else None)
         if mode == "mP" and m.opk is not None:
             if m.opk_counting:

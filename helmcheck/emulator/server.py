@@ -28,9 +28,13 @@ from typing import Any, Callable, Optional
 from ..line.transport import Link, LinkClosed
 from .core import EmulatorCore
 
-__all__ = ["Server", "MAX_PENDING"]
+__all__ = ["Server", "MAX_PENDING", "MAX_SLEEP_S"]
 
 MAX_PENDING = 256 * 1024
+#: The longest the loop sleeps at once (seconds): a wakeup further off (a waypoint thousands of
+#: kilometres away at a slow speed, at time scale 1) is met by waking sooner and looking again —
+#: a selector takes no timeout beyond about 24 days.
+MAX_SLEEP_S = 3600.0
 
 
 class Server:
@@ -144,7 +148,7 @@ class Server:
                 due = r if due is None else min(due, r)
         if due is None:
             return None
-        return max(0.0, due - now)
+        return min(max(0.0, due - now), MAX_SLEEP_S)
 
     def _drain_wake(self) -> None:
         try:

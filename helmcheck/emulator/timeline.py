@@ -78,7 +78,7 @@ class Timeline:
                 self._push_snapshot()
                 wall = self.wall_time(self.v)
                 for me in self._model_call(lambda: m.advance(self.v), wall) or ():
-                    self._note(wall, f"model: {event_text(me)}")
+                    self._model_event(me, wall)
                 p.sync(m)
                 continue
             rd = self.rules.due_v
@@ -91,7 +91,7 @@ class Timeline:
                 self.stats["faults"] += 1
                 self._note(wall, f"plant: {event_text(ev)} at v={self.v:.3f}")
                 for me in self._model_call(lambda: m.plant(ev, self.v), wall) or ():
-                    self._note(wall, f"model: {event_text(me)}")
+                    self._model_event(me, wall)
                 p.sync(m)
                 continue
             seg_end = min(x for x in (target, md, rd) if x is not None)
@@ -114,7 +114,7 @@ class Timeline:
             for e in evs:
                 self._note(wall, f"plant: {event_text(e)} at v={self.v:.3f}")
                 for me in self._model_call(lambda e=e: m.plant(e, self.v), wall) or ():
-                    self._note(wall, f"model: {event_text(me)}")
+                    self._model_event(me, wall)
             p.sync(m)
         self._push_snapshot()
         return self.v

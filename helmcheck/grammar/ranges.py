@@ -5,6 +5,11 @@ Each rule names its clause and field. Commands that fail answer with the command
 ``[D]`` in the reference profile come from the :class:`~helmcheck.profile.Profile`; the fixed
 ones (heading below 360, pitch at most 45) are the profile's own text.
 
+A command's checks are data: :data:`COMMAND_CHECKS` holds, per sentence class and in field order,
+its numeric ranges (:class:`Bound`), its closed sets of values (:class:`Choice`) and its mission
+names (:class:`NameRule`); the checks run from those rows, and the range edges a certification
+must reach (:mod:`helmcheck.certify.vehicle.edges`) are generated from the same rows.
+
 State-dependent checks (``$OJW`` against the mission length, ``$OPK`` distance) belong to the
 model, not here: this module looks at one sentence and the profile only.
 """
@@ -12,6 +17,7 @@ model, not here: this module looks at one sentence and the profile only.
 from __future__ import annotations
 
 import re
+from dataclasses import dataclass
 from decimal import Decimal
 from functools import lru_cache
 from typing import Callable, Iterator, Optional
@@ -20,7 +26,8 @@ from ..profile import Profile, SAFETY_CODES
 from . import sentences as S
 from .errors import RANGE, SentenceError
 
-__all__ = ["check_ranges", "range_errors", "field_text", "mission_name_problem"]
+__all__ = ["check_ranges", "range_errors", "field_text", "mission_name_problem", "COMMAND_CHECKS", "Bound", "Choice",
+           "NameRule"]
 
 _D = Decimal
 Problem = tuple[str, str, str]  # (clause, field, message)
@@ -46,67 +53,15 @@ def mission_name_problem(name: str) -> Optional[str]:
     return None
 
 
-def _between(v, lo, hi, clause, field, hi_open=False) -> Iterator[Problem]:
+def _between(v, lo, hi, clause, field, hi_open=False, lo_name="") -> Iterator[Problem]:
     if v is None:
         return
-    if v < lo or (v >= hi if hi_open else v > hi):
+    if hi is None:
+        if v < lo:
+            yield clause, field, f"{field} {v} is below {lo_name or 'the lowest allowed'} {lo}"
+    elif v < lo or (v >= hi if hi_open else v > hi):
         right = ")" if hi_open else "]"
         yield clause, field, f"{field} {v} is outside [{lo}, {hi}{right}"
-
-
-@lru_cache(maxsize=64)
-def _num(x: float) -> Decimal:
-    return _D(repr(float(x)))
-
-
-def _oms(s: S.OMS, p: Profile) -> Iterator[Problem]:
-    c = "RH-SRV-2"
-    yield from _between(s.heading, 0, 360, c, "heading", hi_open=True)
-    yield from _between(s.depth, 0, _num(p.max_depth), c, "depth")
-    yield from _between(s.max_pitch, 0, 45, c, "max_pitch")
-    yield from _between(s.speed, 0, _num(p.max_speed_kn), c, "speed")
-    yield from _between(s.timeout, *p.timeout_range, c, "timeout")
-
-
-def _omp(s: S.OMP, p: Profile) -> Iterator[Problem]:
-    if s.reserved != "00":
-        yield "RH-PRM-2", "reserved", f"reserved field must be 00, not {s.reserved!r} (RH-RD-9)"
-    yield from _between(s.timeout, *p.timeout_range, "RH-PRM-2", "timeout")
-
-
-def _ojw(s: S.OJW, p: Profile) -> Iterator[Problem]:
-    if s.waypoint < p.waypoint_base:
-        yield "RH-JW-1", "waypoint", f"waypoint {s.waypoint} is below the first waypoint {p.waypoint_base}"
-
-
-def _omstop(s: S.OMSTOP, p: Profile) -> Iterator[Problem]:
-    if s.flag != 0:
-        yield "RH-MSN-3", "flag", f"flag must be 0, not {s.flag}"
-
-
-def _omload(s: S.OMLOAD, p: Profile) -> Iterator[Problem]:
-    why = mission_name_problem(s.name)
-    if why:
-        yield "RH-MSN-1", "name", why
-
-
-def _omstart(s: S.OMSTART, p: Profile) -> Iterator[Problem]:
-    for f in ("ignore_gps", "ignore_sounder", "calibrate_pressure", "mission_type"):
-        v = getattr(s, f)
-        if v not in (0, 1):
-            yield "RH-RD-6", f, f"{f} must be 0 or 1, not {v}"
-    why = mission_name_problem(s.name)
-    if why:
-        yield "RH-RD-6", "name", why
-    if s.srp:
-        why = mission_name_problem(s.srp)
-        if why:
-            yield "RH-RD-6", "srp", "SRP " + why
-
-
-def _omstart_paper(s: S.OMSTARTPaper, p: Profile) -> Iterator[Problem]:
-    if s.flag not in (0, 1, 2, 3):
-        yield "RH-MSN-2", "flag", f"flag must be 0, 1, 2 or 3, not {s.flag}"
 
 
 def _latlon(s, clause) -> Iterator[Problem]:
@@ -114,11 +69,153 @@ def _latlon(s, clause) -> Iterator[Problem]:
     yield from _between(s.lon, -180, 180, clause, "lon")
 
 
-def _opos(s: S.OPOS, p: Profile) -> Iterator[Problem]:
-    yield from _latlon(s, "RH-POS-1")
-    yield from _between(s.speed, 0, _num(p.max_speed_kn), "RH-RD-9", "speed")
-    yield from _between(s.conductivity, 0, 100, "RH-RD-9", "conductivity")
-    yield from _between(s.temperature, -5, 50, "RH-RD-9", "temperature")
+@lru_cache(maxsize=64)
+def _num(x: float) -> Decimal:
+    return _D(repr(float(x)))
+
+
+# --------------------------------------------------------------------------- commands, as data
+#
+# Every value check of a command field is one row below, in field order: a numeric range
+# (:class:`Bound`), a closed set of values (:class:`Choice`) or the mission-name path rules
+# (:class:`NameRule`). The checks run from these rows, and the list of range edges a certification
+# must reach (:mod:`helmcheck.certify.vehicle.edges`) is generated from the same rows, so a range
+# added here is an edge there.
+
+
+@dataclass(frozen=True)
+class Bound:
+    """A command field's numeric range: ``[lo, hi]`` (``[lo, hi)`` with ``hi_open``); ``limits(profile)``
+    gives ``(lo, hi)``, either ``None`` where that side has no bound here (``$OJW``'s upper bound is
+    the mission's length: the model's)."""
+
+    sentence: type
+    field: str
+    clause: str
+    limits: Callable[[Profile], tuple]
+    hi_open: bool = False
+    lo_name: str = ""  #: what the lower bound is, for a one-sided bound's message
+
+
+@dataclass(frozen=True)
+class Choice:
+    """A command field whose value must be one of ``allowed(profile)`` (compared as text; ``fold``:
+    regardless of case, RH-RD-4). ``refused``: values just outside the set — a neighbour of an
+    allowed one — that the edge list probes; ``message(value, allowed)`` is the problem's words."""
+
+    sentence: type
+    field: str
+    clause: str
+    allowed: Callable[[Profile], tuple]
+    refused: tuple
+    message: Callable[[object, tuple], str]
+    fold: bool = False
+    single: bool = False  #: the field is a tuple of values of which exactly one is allowed
+
+    def problem(self, value, profile: Profile) -> Optional[str]:
+        allowed = tuple(str(a) for a in self.allowed(profile))
+        if self.single:
+            ok = len(value) == 1 and str(value[0]) in allowed
+        elif self.fold:
+            ok = str(value).lower() in {a.lower() for a in allowed}
+        else:
+            ok = str(value) in allowed
+        return None if ok else self.message(value, allowed)
+
+
+@dataclass(frozen=True)
+class NameRule:
+    """A mission name that must resolve inside the mission directory (:func:`mission_name_problem`);
+    ``optional``: an absent or empty field is no name (``$OMSTART``'s SRP)."""
+
+    sentence: type
+    field: str
+    clause: str
+    prefix: str = ""
+    optional: bool = False
+
+
+def _ms(p: Profile) -> tuple:
+    return (0, _num(p.max_speed_kn))
+
+
+def _to(p: Profile) -> tuple:
+    return tuple(p.timeout_range)
+
+
+def _lat(cls, clause) -> tuple:
+    return (Bound(cls, "lat", clause, lambda p: (-90, 90)), Bound(cls, "lon", clause, lambda p: (-180, 180)))
+
+
+_FLAGS = ("ignore_gps", "ignore_sounder", "calibrate_pressure", "mission_type")
+
+_OMW = (*_lat(S.OMW, "RH-RD-9"),
+        Bound(S.OMW, "depth1", "RH-RD-9", lambda p: (-100, 100)),
+        Bound(S.OMW, "depth2", "RH-RD-9", lambda p: (-100, 100)),
+        Bound(S.OMW, "max_pitch", "RH-RD-9", lambda p: (0, 45)),
+        Bound(S.OMW, "speed", "RH-RD-9", _ms),
+        Bound(S.OMW, "park_s", "RH-RD-9", lambda p: (0, 86400)))
+
+#: sentence class -> its value checks, in field order (module comment above).
+COMMAND_CHECKS: dict[type, tuple] = {
+    S.OMS: (Bound(S.OMS, "heading", "RH-SRV-2", lambda p: (0, 360), hi_open=True),
+            Bound(S.OMS, "depth", "RH-SRV-2", lambda p: (0, _num(p.max_depth))),
+            Bound(S.OMS, "max_pitch", "RH-SRV-2", lambda p: (0, 45)),
+            Bound(S.OMS, "speed", "RH-SRV-2", _ms),
+            Bound(S.OMS, "timeout", "RH-SRV-2", _to)),
+    S.OMP: (Choice(S.OMP, "reserved", "RH-PRM-2", lambda p: ("00",), ("01",),
+                   lambda v, a: f"reserved field must be 00, not {v!r} (RH-RD-9)"),
+            Bound(S.OMP, "timeout", "RH-PRM-2", _to)),
+    S.OJW: (Bound(S.OJW, "waypoint", "RH-JW-1", lambda p: (p.waypoint_base, None),
+                  lo_name="the first waypoint"),),
+    S.OMSTOP: (Choice(S.OMSTOP, "flag", "RH-MSN-3", lambda p: (0,), (1,), lambda v, a: f"flag must be 0, not {v}"),),
+    S.OMLOAD: (NameRule(S.OMLOAD, "name", "RH-MSN-1"),),
+    S.OMSTART: (*(Choice(S.OMSTART, f, "RH-RD-6", lambda p: (0, 1), (2,),
+                         (lambda f: lambda v, a: f"{f} must be 0 or 1, not {v}")(f)) for f in _FLAGS),
+                NameRule(S.OMSTART, "name", "RH-RD-6"),
+                NameRule(S.OMSTART, "srp", "RH-RD-6", prefix="SRP ", optional=True)),
+    S.OMSTARTPaper: (Choice(S.OMSTARTPaper, "flag", "RH-MSN-2", lambda p: (0, 1, 2, 3), (4,),
+                            lambda v, a: f"flag must be 0, 1, 2 or 3, not {v}"),),
+    S.OPOS: (*_lat(S.OPOS, "RH-POS-1"),
+             Bound(S.OPOS, "speed", "RH-RD-9", _ms),
+             Bound(S.OPOS, "conductivity", "RH-RD-9", lambda p: (0, 100)),
+             Bound(S.OPOS, "temperature", "RH-RD-9", lambda p: (-5, 50))),
+    S.ORWSET: (Choice(S.ORWSET, "state", "RH-RD-8", lambda p: (0, 1), (2,),
+                      lambda v, a: f"state must be 0 or 1, not {v}"),
+               Choice(S.ORWSET, "values", "RH-RD-8", lambda p: ("park", "srp"), ("Park", "dive"),
+                      lambda v, a: "SafetyAction takes exactly one value, park or srp", single=True)),
+    S.ODVL: (Bound(S.ODVL, "x", "RH-RD-9", lambda p: (-5, 5)),
+             Bound(S.ODVL, "y", "RH-RD-9", lambda p: (-5, 5)),
+             Bound(S.ODVL, "timeout", "RH-DVL-1", _to)),
+    S.OPK: (*_lat(S.OPK, "RH-PK-1"),
+            Bound(S.OPK, "minutes", "RH-PK-1", lambda p: (1, 1440)),
+            Bound(S.OPK, "speed", "RH-PK-1", _ms)),
+    S.OMW: _OMW,
+    S.OMWClear: (Choice(S.OMWClear, "keyword", "RH-OMW-3", lambda p: tuple(p.omw_clear_keywords), ("CLEARS",),
+                        lambda v, a: f"keyword {v!r} is not one of {', '.join(a)}", fold=True),),
+}
+
+
+def _check(row, s, p: Profile) -> Iterator[Problem]:
+    v = getattr(s, row.field)
+    if isinstance(row, Bound):
+        lo, hi = row.limits(p)
+        yield from _between(v, lo, hi, row.clause, row.field, row.hi_open, row.lo_name)
+    elif isinstance(row, NameRule):
+        if row.optional and not v:
+            return
+        why = mission_name_problem(v)
+        if why:
+            yield row.clause, row.field, row.prefix + why
+    elif v is not None:
+        why = row.problem(v, p)
+        if why:
+            yield row.clause, row.field, why
+
+
+def _command(s: S.Command, p: Profile) -> Iterator[Problem]:
+    for row in COMMAND_CHECKS[type(s)]:
+        yield from _check(row, s, p)
 
 
 def _orwset(s: S.ORWSET, p: Profile) -> Iterator[Problem]:
@@ -130,39 +227,16 @@ def _orwset(s: S.ORWSET, p: Profile) -> Iterator[Problem]:
     if s.state is None:
         yield c, "state", "a write needs a state 0 or 1"
         return
-    if s.state not in (0, 1):
-        yield c, "state", f"state must be 0 or 1, not {s.state}"
-    if s.setting == "SafetyAction" and (len(s.values) != 1 or s.values[0] not in ("park", "srp")):
-        yield c, "values", "SafetyAction takes exactly one value, park or srp"
-
-
-def _odvl(s: S.ODVL, p: Profile) -> Iterator[Problem]:
-    yield from _between(s.x, -5, 5, "RH-RD-9", "x")
-    yield from _between(s.y, -5, 5, "RH-RD-9", "y")
-    yield from _between(s.timeout, *p.timeout_range, "RH-DVL-1", "timeout")
-
-
-def _opk(s: S.OPK, p: Profile) -> Iterator[Problem]:
-    yield from _latlon(s, "RH-PK-1")
-    yield from _between(s.minutes, 1, 1440, "RH-PK-1", "minutes")
-    yield from _between(s.speed, 0, _num(p.max_speed_kn), "RH-PK-1", "speed")
-
-
-def _omw(s: S.OMW, p: Profile) -> Iterator[Problem]:
-    yield from _latlon(s, "RH-RD-9")
-    yield from _between(s.depth1, -100, 100, "RH-RD-9", "depth1")
-    yield from _between(s.depth2, -100, 100, "RH-RD-9", "depth2")
-    yield from _between(s.max_pitch, 0, 45, "RH-RD-9", "max_pitch")
-    yield from _between(s.speed, 0, _num(p.max_speed_kn), "RH-RD-9", "speed")
-    yield from _between(s.park_s, 0, 86400, "RH-RD-9", "park_s")
+    state, values = COMMAND_CHECKS[S.ORWSET]
+    yield from _check(state, s, p)
+    if s.setting == "SafetyAction":
+        yield from _check(values, s, p)
 
 
 def _omw_clear(s: S.OMWClear, p: Profile) -> Iterator[Problem]:
-    allowed = {k.lower() for k in p.omw_clear_keywords}
-    if s.keyword.lower() not in allowed:
-        yield "RH-OMW-3", "keyword", f"keyword {s.keyword!r} is not one of {', '.join(p.omw_clear_keywords)}"
+    yield from _command(s, p)
     if s.waypoint is not None:
-        yield from _omw(s.waypoint, p)
+        yield from _command(s.waypoint, p)
 
 
 # --------------------------------------------------------------------------- replies
@@ -227,9 +301,7 @@ def _oins(s: S.OINS, p: Profile) -> Iterator[Problem]:
 
 
 _RULES: dict[type, Callable[..., Iterator[Problem]]] = {
-    S.OMS: _oms, S.OMP: _omp, S.OJW: _ojw, S.OMSTOP: _omstop, S.OMLOAD: _omload,
-    S.OMSTART: _omstart, S.OMSTARTPaper: _omstart_paper, S.OPOS: _opos, S.ORWSET: _orwset,
-    S.ODVL: _odvl, S.OPK: _opk, S.OMW: _omw, S.OMWClear: _omw_clear,
+    **{cls: _command for cls in COMMAND_CHECKS}, S.ORWSET: _orwset, S.OMWClear: _omw_clear,
     S.ACK: _ack, S.OSI: _osi, S.Compass: _compass, S.GPRMC: _gprmc, S.OPI: _opi, S.OINS: _oins,
 }
 

@@ -74,7 +74,7 @@ class ClauseVerdict:
     lines: tuple[int, ...] = ()
     offending_count: int = 0
     observations: int = 0
-    #: a timing clause's precision: the coarsest RH-TIM-1 tolerance it was judged with (the
+    #: a timing clause's precision: the finest RH-TIM-1 tolerance it was judged with (the
     #: nominal ``max(0.5 s, 5 %)`` and the tolerance widened by what the observer could not see),
     #: vehicle seconds, and the time scale (:meth:`Ledger.precision`); None for other clauses
     precision: Optional[tuple[float, float, float]] = None
@@ -105,7 +105,7 @@ class _Entry:
     cases: dict = field(default_factory=dict)
     remarks: list = field(default_factory=list)
     withdrawn: Optional[tuple[str, str]] = None  #: (reason, prefix of an observed violation's reason)
-    precision: Optional[tuple[float, float, float]] = None  #: the coarsest (nominal, widened, k) so far
+    precision: Optional[tuple[float, float, float]] = None  #: the finest (nominal, widened, k) so far
     spoiled: int = 0  #: observations a faulty line may have spoilt, made again (not judged)
     spoiled_reason: str = ""
     spoiled_evidence: list = field(default_factory=list)
@@ -274,11 +274,12 @@ class Ledger:
     def precision(self, cid: str, nominal: float, widened: float, k: float) -> None:
         """A duration of ``cid`` was judged within ``widened`` vehicle seconds (RH-TIM-1's nominal
         ``nominal`` widened by what the observer could not see, at time scale ``k``): the clause
-        keeps the coarsest, the widening its verdict rests on (a PASS holds to that precision)."""
+        keeps the finest — the observation that tells the closest timing fault from a conforming
+        duration (a duration off by more than it is certain to have failed there)."""
         e = self._e.get(cid)
         if e is None:
             return
-        if e.precision is None or widened - nominal > e.precision[1] - e.precision[0]:
+        if e.precision is None or widened - nominal < e.precision[1] - e.precision[0]:
             e.precision = (nominal, widened, k)
 
     def remark(self, cid: str, text: str) -> None:

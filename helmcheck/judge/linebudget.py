@@ -32,7 +32,11 @@ measured, a stated assumption) and turns it into:
   :meth:`LineBudget.advice`: the time scale, or the baud, at which it would be);
 * :meth:`LineBudget.precision_v` — the widened RH-TIM-1 tolerance a duration is judged with on
   this line: the nominal ``max(0.5 s, 5 %)``, the observer's uncertainty and the spacing of the
-  reports that sample the deadline (a transition later than that is certain to be seen as late).
+  reports that sample the deadline (a transition later than that is certain to be seen as late);
+  :meth:`LineBudget.widening_v` what is added to the nominal, :meth:`LineBudget.nominal_scale` the
+  time scale at which that is at most :data:`NOMINAL_WIDENING_S` (``--precision nominal``);
+* :attr:`LineBudget.spread_s` — how much later one line may be answered than another written with
+  it (the latencies' spread): what a lockout's burst of commands after ``$OXFLT`` must fit in.
 
 The planning latency is the largest reply latency measured so far with a margin
 (:func:`planning_latency`), never more than the ACK window (a slower answer is itself a finding,
@@ -184,10 +188,14 @@ class LineBudget:
 
     def nominal_scale(self) -> Optional[float]:
         """The largest whole time scale (at most this one) at which the observer judges durations to
-        nominal precision (:data:`NOMINAL_WIDENING_S`) on this line, or None (not even at x1)."""
+        nominal precision (:data:`NOMINAL_WIDENING_S`) on this line, or None (not even at x1). The
+        line's typical reply (its 99th percentile, when measured) counts here, not one slow
+        exchange: it is advice on where to run, not a duration a case rests on."""
+        typical = self if self.latency_p99 is None else replace(
+            self, latency_s=min(self.latency_s, self.latency_p99 * 1.1 + 0.01))
         k = math.floor(self.k)
         while k >= 1:
-            if self.at(k=float(k)).widening_v() <= NOMINAL_WIDENING_S:
+            if typical.at(k=float(k)).widening_v() <= NOMINAL_WIDENING_S:
                 return float(k)
             k -= 1
         return None
@@ -249,7 +257,9 @@ def from_settings(d: dict) -> Optional[LineBudget]:
     try:
         return LineBudget(k=float(d["time_scale"]), baud=int(d["baud"]), latency_s=float(d["latency_planned_s"]),
                           jitter_s=float(d["jitter_s"]), osi_bytes=int(d["osi_bytes"]),
-                          spread_s=float(d.get("spread_planned_s", d["latency_planned_s"])), measured=True)
+                          spread_s=float(d.get("spread_planned_s", d["latency_planned_s"])), measured=True,
+                          latency_p50=d.get("latency_p50_s"), latency_p99=d.get("latency_p99_s"),
+                          samples=int(d.get("samples", 0)))
     except (KeyError, TypeError, ValueError):
         return None
 

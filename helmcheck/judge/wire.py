@@ -47,9 +47,10 @@ wire-log format (``docs/contracts.md``):
                                             (also when the record ends, or resumes, first)
 ``confirmed RH-X,RH-Y: <how>``              the same for these clauses' held violations only;
 ``unconfirmed RH-X: <how>``                 holding goes on for the others
-``run resumed: <what>``                     an interrupted run goes on (``--resume``): the
-                                            vehicle's state is unknown again; commands left
-                                            unanswered at the interruption are not judged
+``run resumed: <what>``                     an interrupted run goes on (``--resume``), or a
+                                            link gap ended: the vehicle's state is unknown
+                                            again; commands left unanswered at the
+                                            interruption are not judged
 ``line fault <dir> <kind>: <detail>``       what a line-fault relay did to the line
                                             (:mod:`helmcheck.grammar.faultnote`): the judges
                                             give what it touched to the line

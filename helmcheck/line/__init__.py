@@ -23,6 +23,8 @@
   there are none (a pty, a socket);
 * :mod:`.recorder` — every event of a live run to the wire log (by the one wire-log writer,
   :mod:`helmcheck.grammar.wirelog`) and to the judges, identically;
+* :mod:`.reopen` — a port that vanished (an adapter unplugged, a server that dropped its client),
+  opened again under the same name once it is back, within the time a run waits for it;
 * :mod:`.launcher` — start, watch and stop the implementation under test (``--exec CMD``);
 * :mod:`.exec_port` — the tester's end of a port that a started implementation opens.
 

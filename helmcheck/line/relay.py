@@ -43,7 +43,13 @@ least :data:`RT_PRIORITY`) it runs at normal priority; :attr:`Relay.priority` sa
 :meth:`started` returns. Sides coming and going are ``on_event(t, kind, side)``:
 ``connect``/``disconnect`` (a TCP server link's client), ``closed`` (the link raised
 :class:`~helmcheck.line.link.LinkClosed`: a pty or device gone), ``unplugged``/``replugged``
-(a stage's cut); the relay keeps serving the other side. RH-FRM-9: the line is 8N1 and a TCP
+(a stage's cut), ``lost``/``reopened`` (with ``reopen``: a side whose link closed, and the same
+side opened again); the relay keeps serving the other side. With ``reopen(side)`` a side whose
+link closes is not gone for good: it is set aside like a cut one (nothing read from it, nothing
+written to it: what was on its way to it is lost) and ``reopen(side)`` is called every
+:data:`REPLUG_RETRY_S` from the relay's thread — a new link plugs it back, None (or an
+``OSError``) means not yet, :class:`~helmcheck.line.link.LinkClosed` that it is gone for good
+(``closed``). RH-FRM-9: the line is 8N1 and a TCP
 byte stream carries the same bytes, so every link is the same byte stream here. The caller
 opens and closes links (a replugged one included).
 """
@@ -113,7 +119,8 @@ class Relay(threading.Thread):
                  on_note: Callable[[float, str], None] = _no_note, cut_side: str = "backseat",
                  unplug: Optional[Callable[[str, Link], None]] = None,
                  replug: Optional[Callable[[str], Optional[Link]]] = None,
-                 on_idle: Optional[Callable[[float], None]] = None):
+                 on_idle: Optional[Callable[[float], None]] = None,
+                 reopen: Optional[Callable[[str], Optional[Link]]] = None):
         super().__init__(name=name, daemon=True)
         if stage is not None and not forward:
             raise ValueError("an impairment stage needs the relay in line (forward=True)")
@@ -125,7 +132,9 @@ class Relay(threading.Thread):
         self._unplug_cb = unplug
         self._replug_cb = replug
         self.on_idle = on_idle
-        self.unplugged: set[str] = set()  #: sides a cut has unplugged, not yet back
+        self.unplugged: set[str] = set()  #: sides a cut has unplugged (or whose link closed), not yet back
+        self.reopen = reopen
+        self.lost: set[str] = set()  #: of those, the sides whose link closed (``reopen`` brings them back)
         self._replug_at: dict[str, float] = {}  # side -> when to try plugging it back (again)
         self.realtime = realtime
         #: the thread's scheduling, once running: "real-time" or "normal (…why…)"
@@ -214,9 +223,10 @@ class Relay(threading.Thread):
             if self.forward and self._pending[_READS[_other(side)]]:
                 wfds[fd] = side
         timeout = _NO_FD_WAIT if unselectable else _IDLE
-        if self.stage is not None:
+        if self.stage is not None or self._replug_at:
             now = self.clock()
-            wake = [t for t in (self.stage.next_due(), *self._replug_at.values()) if t is not None]
+            due = self.stage.next_due() if self.stage is not None else None
+            wake = [t for t in (due, *self._replug_at.values()) if t is not None]
             if wake:
                 left = min(wake) - now
                 timeout = min(timeout, 0.0 if left <= 0 else max(left, PACE_TICK_S))
@@ -235,6 +245,8 @@ class Relay(threading.Thread):
                 self._read(side)
         if self.stage is not None:
             self._run_stage()
+        elif self._replug_at:
+            self._replug_due()
         if self.forward:
             for side in unselectable:  # no descriptor to wait on for writability
                 self._flush(_READS[_other(side)])
@@ -246,7 +258,7 @@ class Relay(threading.Thread):
         try:
             events = link.poll() if self.stage is None else link.poll(STAGE_READ)
         except LinkClosed:
-            self._gone(side)
+            self._closed(side)
             return
         t = self.clock()  # right after the read, before forwarding
         direction = _READS[side]
@@ -299,6 +311,9 @@ class Relay(threading.Thread):
                 self._unplug(self.cut_side)
             elif a.kind == REPLUG:
                 self._replug_at[self.cut_side] = self.clock()
+        self._replug_due()
+
+    def _replug_due(self) -> None:
         now = self.clock()
         for side, when in list(self._replug_at.items()):
             if when <= now:
@@ -318,9 +333,16 @@ class Relay(threading.Thread):
             self._replug_at.pop(side, None)
             return
         link = None
-        if self._replug_cb is not None:
+        cb = self.reopen if side in self.lost else self._replug_cb
+        if cb is not None:
             try:
-                link = self._replug_cb(side)
+                link = cb(side)
+            except LinkClosed:  # given up on: gone for good
+                self._replug_at.pop(side, None)
+                self.unplugged.discard(side)
+                self.lost.discard(side)
+                self._gone(side)
+                return
             except OSError:
                 link = None
         else:
@@ -331,7 +353,9 @@ class Relay(threading.Thread):
         self._replug_at.pop(side, None)
         self.links[side] = link
         self.unplugged.discard(side)
-        self.on_event(self.clock(), "replugged", side)
+        kind = "reopened" if side in self.lost else "replugged"
+        self.lost.discard(side)
+        self.on_event(self.clock(), kind, side)
 
     def _flush(self, direction: str) -> None:
         pending = self._pending[direction]
@@ -350,8 +374,19 @@ class Relay(threading.Thread):
         try:
             return self.links[side].write_some(data)
         except (LinkClosed, BrokenPipeError, ConnectionError):
-            self._gone(side)
+            self._closed(side)
             return 0
+
+    def _closed(self, side: str) -> None:
+        """A side's link closed: gone for good, or (with ``reopen``) set aside until it is back."""
+        if self.reopen is None or side in self.closed or side in self.unplugged:
+            self._gone(side)
+            return
+        self.unplugged.add(side)
+        self.lost.add(side)
+        self._forget(_READS[_other(side)])
+        self._replug_at[side] = self.clock() + REPLUG_RETRY_S
+        self.on_event(self.clock(), "lost", side)
 
     def _gone(self, side: str) -> None:
         """A side closed for good: report it, forget what waited for it, serve the other."""

@@ -48,12 +48,16 @@ class StateEffects:
         self.control_generation += 1
 
     def _transition(self, row: Row, now: float) -> None:
-        """Set mode and phase from ``row``; keep the mission park counting only in P (RH-RD-5)."""
+        """Set mode and phase from ``row``; keep the mission park counting only in P (RH-RD-5), and
+        not while a resumed park waits to be back on station (:meth:`await_park_station`)."""
         if row.target != STAY:
             self.mode = row.target
         if row.phase_to is not None:
             self.phase = row.phase_to
         counting = self.mode == "P" and self.phase == "none" and self.mission is not None
+        if self.mode != "P":
+            self.park_waiting = False
+        counting = counting and not self.park_waiting
         armed = self.timers.armed("park")
         if counting and not armed and self.park_left is not None:
             self.timers.arm("park", now, self.park_left)
@@ -100,6 +104,7 @@ class StateEffects:
         self.mission_mode = "N"
         self.mission_wp = 0
         self.park_left = None
+        self.park_waiting = False
         self.ignore_gps = ignore_gps
         self.srp_mission = srp
         self.srp_active = as_srp

@@ -25,7 +25,12 @@ through. The slow one is at some ``s_j``, the fast one at ``s_k`` (``j ≤ k``);
 countdowns *display* its own clock's count (start + duration − now, unskewed), so the park time
 of each acceptable state is the interval between what the two shadows show (the fast shadow in
 it now or as it left it; the slow shadow in it now or the fast one as it entered it), widened by
-``slack`` and rounded outwards to whole seconds (field 10 is rounded up, RH-RD-5).
+``slack`` and rounded outwards to whole seconds (field 10 is rounded up, RH-RD-5). The
+``$OPK`` park before its count begins is not widened: it shows the minutes the command gave,
+exactly (a report showing one second less shows the count begun); and a running count is widened
+also where it has reached 0: the slow shadow, still counting past its own count's end, shows how
+far past (a report made up to ``slack`` earlier may still show ``P1``). A state that shows no park
+shows ``P0`` exactly.
 
 So that the slow shadow can still be "before" a timer the model itself already ran, the model
 keeps a checkpoint: a copy of itself taken just before the first timer fires after a
@@ -149,11 +154,26 @@ class Expectation:
         return out
 
 
+#: A park time a state shows: ``None`` (no park, ``P0``) or ``(seconds, widened)``.
+Shown = Optional[tuple[float, bool]]
+
+
+def _shown(m, at: float, clip: bool = True) -> Shown:
+    """What field 10 of ``m`` shows at ``at`` (before rounding), and whether it is widened by the
+    observer's uncertainty: every count but the ``$OPK`` park's before it begins, which shows the
+    minutes the command gave, exactly, at any moment (a count frozen — a mission park in a
+    lockout, or held — shows what was left at a moment the observer knows as well as the rest)."""
+    left = m.park_remaining(at, clip)
+    if left is None:
+        return None
+    return left, not (m.mode == "mP" and not m.timers.armed("opk"))
+
+
 @dataclass
 class _Visit:
     sig: tuple
-    entry_park: Optional[float]
-    exit_park: Optional[float] = None
+    entry_park: Shown
+    exit_park: Shown = None
 
 
 def _sig(m) -> tuple:
@@ -163,16 +183,16 @@ def _sig(m) -> tuple:
 def _run(shadow, now: float) -> list[_Visit]:
     """Advance ``shadow`` to ``now`` one expiry at a time, recording distinct states."""
     t0 = shadow.now if shadow.now is not None else now
-    visits = [_Visit(_sig(shadow), shadow.park_remaining(t0))]
+    visits = [_Visit(_sig(shadow), _shown(shadow, t0))]
     timers = shadow.timers
     while timers.due is not None and timers.due <= now:
         d = timers.due
-        before = shadow.park_remaining(d)
+        before = _shown(shadow, d)
         shadow._run_due(d)
         sig = _sig(shadow)
         if sig != visits[-1].sig:
             visits[-1].exit_park = before
-            visits.append(_Visit(sig, shadow.park_remaining(d)))
+            visits.append(_Visit(sig, _shown(shadow, d)))
     shadow._run_due(now)
     return visits
 
@@ -196,8 +216,8 @@ def expectation(model, now: float, slack: float = 0.0) -> Expectation:
     states: list[Acceptable] = []
     if aligned:
         for i in range(j, k + 1):
-            values = [fast.park_remaining(now) if i == k else fv[i].exit_park,
-                      slow.park_remaining(now) if i == j else fv[i].entry_park]
+            values = [_shown(fast, now, clip=False) if i == k else fv[i].exit_park,
+                      _shown(slow, now, clip=False) if i == j else fv[i].entry_park]
             states.append(_acceptable(fv[i].sig, values, slack))
     else:  # pragma: no cover - only if two state-changing timers ever race
         for v in fv + sv:
@@ -205,13 +225,22 @@ def expectation(model, now: float, slack: float = 0.0) -> Expectation:
     return Expectation(now, slack, tuple(dict.fromkeys(states)))
 
 
-def _acceptable(sig: tuple, values: list[Optional[float]], slack: float) -> Acceptable:
-    vals = [0.0 if v is None else v for v in values]
-    lo, hi = min(vals), max(vals)
-    if hi > 0:
-        lo, hi = max(0.0, lo - slack), hi + slack
+def _acceptable(sig: tuple, values: list[Shown], slack: float) -> Acceptable:
+    """The state ``sig`` with the park times ``values`` may show (module docstring): ``None`` is no
+    park (``P0`` exactly); a count, also one at or past its end, is widened by ``slack`` (not the
+    ``$OPK`` park's before it begins)."""
+    lo = hi = 0.0
+    first = True
+    for v in values:
+        if v is None:
+            a = b = 0.0
+        else:
+            w = slack if v[1] else 0.0
+            a, b = v[0] - w, v[0] + w
+        lo, hi = (a, b) if first else (min(lo, a), max(hi, b))
+        first = False
     mode, wp, err, srp = sig
-    return Acceptable(mode, wp, err, srp, max(0, math.floor(lo)), math.ceil(hi))
+    return Acceptable(mode, wp, err, srp, max(0, math.floor(lo)), max(0, math.ceil(hi)))
 
 
 def _timer_near(model, now: float, slack: float) -> bool:
@@ -238,11 +267,12 @@ def _steady(model, now: float, slack: float) -> Optional[tuple]:
         return None
     base = model.now if model.now is not None and model.now > now else now
     mode, wp, err, park, srp = model.state(base)
-    p = model.park_remaining(base)
-    if p is None or p <= 0:
+    shown = _shown(model, base)
+    if shown is None or shown[0] <= 0:
         lo = hi = 0
     else:
-        lo, hi = max(0, math.floor(max(0.0, p - slack))), math.ceil(p + slack)
+        p, w = shown[0], (slack if shown[1] else 0.0)
+        lo, hi = max(0, math.floor(max(0.0, p - w))), math.ceil(p + w)
         lo = min(lo, park)
         hi = max(hi, park)
     return mode, wp, err, srp, lo, hi

@@ -88,20 +88,22 @@ class VehicleStatus:
             return []
         return list(self.log_rows)[-new:]
 
-    def park_remaining(self, now: Optional[float] = None) -> Optional[float]:
-        """Seconds of park left as ``$OSI`` field 10 would show them (before rounding up)."""
+    def park_remaining(self, now: Optional[float] = None, clip: bool = True) -> Optional[float]:
+        """Seconds of park left as ``$OSI`` field 10 would show them (before rounding up); None
+        when no park is shown. ``clip=False``: a running count past its end is negative
+        (:meth:`~helmcheck.model.timers.Timers.remaining`)."""
         now = self.now if now is None else now
         t = self.timers
         if self.mode == "P":
             if t.armed("park"):
-                return t.remaining("park", now)
+                return t.remaining("park", now, clip)
             return self.park_left
         if self.mode == "mP":
             if t.armed("opk"):
-                return t.remaining("opk", now)
+                return t.remaining("opk", now, clip)
             return float(self.opk_seconds)
         if self.mode == "W" and self.queue_parking:
-            return t.remaining("qpark", now)
+            return t.remaining("qpark", now, clip)
         return None
 
     @property

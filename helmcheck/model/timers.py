@@ -75,14 +75,19 @@ class Timers:
             self._t = {k: v for k, v in self._t.items() if k != name}
             self._recompute()
 
-    def remaining(self, name: str, now: float) -> Optional[float]:
+    def remaining(self, name: str, now: float, clip: bool = True) -> Optional[float]:
         """Seconds left *on the vehicle's own countdown*: ``start + duration - now``, unskewed.
 
         A skewed shadow expires early or late, but what it displays (``$OSI`` field 10) and
-        what it saves when a park is frozen is its own clock's count (RH-TIM-1).
+        what it saves when a park is frozen is its own clock's count (RH-TIM-1). Not below 0,
+        unless ``clip`` is false: a slow shadow still counting past its own count's end (an
+        observer widening the count by its uncertainty needs how far past).
         """
         t = self._t.get(name)
-        return None if t is None else max(0.0, t[0] + t[1] - now)
+        if t is None:
+            return None
+        left = t[0] + t[1] - now
+        return left if not clip or left > 0.0 else 0.0
 
     def earliest(self) -> Optional[tuple[float, str]]:
         """(deadline, name) of the next timer to expire; ties go by name for determinism."""

@@ -42,7 +42,8 @@ Observation helpers (for emulators and observers; none changes the state): ``eve
 field 7 measures, RH-RD-5), ``control_generation`` (changes whenever the remote-control goal
 may have changed, so a replacing ``$OPK``/``$OMW`` is a new goal), ``opk_counting``,
 ``timer(name)`` and the expectation ``checkpoint`` (:mod:`~helmcheck.model.observe`). Two calls
-let an observer adopt what it saw: ``drop_checkpoint()`` and ``await_on_station()`` (RH-PK-2).
+let an observer adopt what it saw: ``drop_checkpoint()``, ``await_on_station()`` (RH-PK-2) and
+``await_park_station()`` (RH-INT-2).
 
 Decisions (spec open), besides those in :mod:`~helmcheck.model.transitions`:
 
@@ -50,6 +51,10 @@ Decisions (spec open), besides those in :mod:`~helmcheck.model.transitions`:
 * ``$OPK`` accepted while the snapshot position is within ``on_station_m`` of the target counts
   down at once; otherwise when the plant reports :class:`~helmcheck.model.plant.OnStation`.
   Before that, field 10 shows the full park time. A replacing ``$OPK`` (RH-RD-3) starts over.
+* A mission park resumed after remote control (RH-INT-2) counts from the release, wherever the
+  vehicle is. The profile leaves room to count only once back on station at the park's waypoint
+  (the paper: "once control is released the vehicle will park for the remaining time"):
+  ``await_park_station()`` holds the count until :class:`~helmcheck.model.plant.OnStation`.
 * "At the surface" means snapshot depth ≤ ``gps_fix_depth_m`` (the RH-RD-10 threshold).
 * ``$OXFLT`` is honoured only when ``profile.fault_injection == "oxflt"``; otherwise it is an
   unknown ID. The plant event :class:`~helmcheck.model.plant.SafetyViolation` always works.
@@ -125,6 +130,8 @@ class VehicleModel(VehicleStatus, StateEffects):
         self.mission_mode = "N"
         self.mission_wp = 0
         self.park_left: Optional[float] = None  #: mission park seconds left when not counting
+        #: a resumed mission park waits to be back on station to count (:meth:`await_park_station`)
+        self.park_waiting = False
         self.ignore_gps = False
         self.srp_mission: Optional[Mission] = None
         self.srp_active = False
@@ -300,6 +307,12 @@ class VehicleModel(VehicleStatus, StateEffects):
             if self.mode == "mP" and not self.timers.armed("opk") and self.phase == "none":
                 self.timers.arm("opk", now, self.opk_seconds)
                 self._pending.append(ev.ParkStarted(now, "opk", self.opk_seconds))
+            elif self.mode == "P" and self.park_waiting and self.phase == "none":
+                self.park_waiting = False
+                left = self.park_left or 0.0
+                self.timers.arm("park", now, left)
+                self.park_left = None
+                self._pending.append(ev.ParkStarted(now, "mission", left))
             elif self.mode == "W" and not self.queue_parking:
                 self._fire("queue_wp_reached", now)
         elif t is QueueWaypointReached:
@@ -344,6 +357,20 @@ class VehicleModel(VehicleStatus, StateEffects):
         :class:`~helmcheck.model.plant.OnStation` (an observer that cannot see the position
         adopts the countdown only when the vehicle shows it)."""
         self.timers.disarm("opk")
+
+    def await_park_station(self) -> bool:
+        """RH-INT-2, read the other way the profile allows: a mission park resumed after remote
+        control "parks for the remaining time" once back on station at its waypoint, not at once.
+        Undo the resumed count (the time left as at the release) until the next
+        :class:`~helmcheck.model.plant.OnStation` (an emulator that returns to the park waypoint
+        first; an observer adopting what the vehicle shows). False when no park was resumed."""
+        t = self.timers
+        if self.mode != "P" or self.phase != "none" or not t.armed("park"):
+            return False
+        self.park_left = t.duration("park")
+        t.disarm("park")
+        self.park_waiting = True
+        return True
 
     def clone(self) -> "VehicleModel":
         """An independent copy (for shadows and what-if questions)."""

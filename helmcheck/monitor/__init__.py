@@ -11,6 +11,8 @@ at once, and a copy judged). Modules, one concern each:
   judges as written; rotated by size (``wire.log``, ``wire.001.log``, …);
 * :mod:`.live` — check-log's judges (:class:`helmcheck.checklog.checker.SessionJudge`) fed the
   records on a thread of their own; new findings as they are made;
+* :mod:`.gaps` — a side whose device vanished: opened again under its name when it is back (the
+  relay's ``reopen``), the gap recorded for the judges (what one side shows alone is held);
 * :mod:`.view` — a finding as one line, or a live screen on a terminal;
 * :mod:`.session` — :func:`~.session.monitor`: one session from the open ports to a results
   directory that ``check-log`` would give for its log and ``verify`` re-judges.

@@ -7,8 +7,12 @@ judges in a process of their own — follows the log as it grows. New findings g
 ``on_finding`` from the main thread as they arrive (a person watching, or a script, sees a
 violation within a moment of its record); the view (:mod:`.view`) is refreshed from there too.
 
-The session ends at ``duration`` or ``until``, on Ctrl-C, SIGTERM or SIGHUP (raised as
-``KeyboardInterrupt`` by :mod:`helmcheck.signals`), or when both sides are gone. Then the judge
+A side whose device vanishes (an adapter unplugged, a serial server's connection dropped) is
+waited for under its name for ``reconnect_wait`` seconds while the other side is still relayed
+and judged, and read again when it is back; the gap is in the record for the judges
+(:mod:`.gaps`) and in ``results.json`` ``monitor.link_gaps``. The session ends at ``duration`` or
+``until``, on Ctrl-C, SIGTERM or SIGHUP (raised as ``KeyboardInterrupt`` by
+:mod:`helmcheck.signals`), or when both sides are gone for good. Then the judge
 drains, and the results directory is written as ``check-log`` writes it for the same log
 (:mod:`helmcheck.checklog.report`: role ``log``, both roles judged), closed as a certificate
 (:func:`helmcheck.reports.certificate.finish_run`: ``profile.toml``, digests of every segment,
@@ -31,12 +35,14 @@ from .. import __version__
 from ..failures import describe_interrupt
 from ..grammar.wirelog import run_header
 from ..line.link import Link
+from ..line.reopen import DEFAULT_WAIT_S, gap_event
 from ..line.transport import open_link, parse_port_spec
 from ..profile import Profile
 from ..reports.certificate import RunDeclaration, finish_run
 from ..reports.render import render_all
 from ..reports.results import exit_code, write_results_atomic
 from ..reports.segments import read_session
+from .gaps import SideGaps
 from .live import Finding, LiveJudge, helper_process
 from ..line.relay import Relay
 from .sessionlog import ROTATE_BYTES, SessionLog
@@ -68,6 +74,10 @@ class Options:
     links: Optional[tuple[Link, Link]] = None  #: command hook: the two sides, opened by the command
     realtime: bool = True  #: the relay asks for real-time priority (:mod:`helmcheck.line.relay`)
     on_relay: Optional[Callable[[str], None]] = None  #: told the relay's priority once it runs
+    #: seconds a side whose device vanished is waited for under its name (``--reconnect-wait``;
+    #: 0: gone for good at once), :mod:`.gaps`
+    reconnect_wait: float = DEFAULT_WAIT_S
+    on_gap: Optional[Callable[[str], None]] = None  #: told (from the main thread) a side is gone, back
 
 
 @dataclass
@@ -120,10 +130,18 @@ def monitor(opts: Options) -> Result:
     live = LiveJudge(d / slog.name, opts.profile.replace(time_scale=opts.time_scale, baud=opts.baud), role="both",
                      time_scale=opts.time_scale, baud=opts.baud)
     t0 = time.monotonic()
+    roles = dict(zip(("backseat", "vehicle"), side_roles(opts.mode, opts.backseat)))
+    gaps = SideGaps({"backseat": opts.backseat, "vehicle": opts.vehicle}, roles, baud=opts.baud,
+                    wait_s=opts.reconnect_wait, note=slog.note, t0=t0)
+
+    def on_event(t: float, kind: str, side: str) -> None:  # the relay's thread, in order with the bytes
+        slog.note(t - t0, f"monitor: the {side} side: {kind}")
+        gaps.event(t - t0, kind, side)
+
     relay = Relay(b_link, v_link, forward=opts.mode == "between",
                   on_bytes=lambda t, direction, data: slog.bytes(t - t0, direction, data),
-                  on_event=lambda t, kind, side: slog.note(t - t0, f"monitor: the {side} side: {kind}"),
-                  clock=time.monotonic, realtime=opts.realtime)
+                  on_event=on_event, clock=time.monotonic, realtime=opts.realtime,
+                  reopen=gaps.reopen if gaps.any else None)
     slog.note(0.0, f"monitor started ({opts.mode}): backseat {b_link.name}, vehicle {v_link.name}")
     relay.start()
     slog.note(time.monotonic() - t0, f"monitor: relay priority {relay.started()}")
@@ -131,7 +149,7 @@ def monitor(opts: Options) -> Result:
         opts.on_relay(relay.priority)
     ended = "the session ended"
     try:
-        ended = _wait(opts, relay, live, interim, t0)
+        ended = _wait(opts, relay, live, interim, t0, gaps)
     except KeyboardInterrupt as e:  # Ctrl-C, SIGTERM, SIGHUP (helmcheck.signals)
         ended = f"the monitor was {describe_interrupt(e)}"
     except BaseException:
@@ -139,10 +157,11 @@ def monitor(opts: Options) -> Result:
         raise
     finally:
         relay.stop(2.0)
-        for link in links:
+        for link in (*links, *gaps.links):
             link.close()
         if opts.view is not None:
             opts.view.close()
+    gaps.close(time.monotonic() - t0)  # a side still gone: what was held is not confirmed
     slog.note(time.monotonic() - t0, f"monitor ended: {ended}")
     slog.close()
     interim.join()
@@ -153,6 +172,10 @@ def monitor(opts: Options) -> Result:
     out.segments = list(slog.segments[1:])
     out.seconds = time.monotonic() - t0
     results = _results(out, opts, ended, relay, live)
+    if gaps.gaps:
+        results["monitor"]["link_gaps"] = [dict(g) for g in gaps.gaps]
+        results["events"] = sorted([*results.get("events", []), *map(gap_event, gaps.gaps)], key=lambda e: e["t"])
+    results["monitor"]["reconnect_wait_s"] = float(opts.reconnect_wait)
     finish_run(results, d, opts.profile.replace(time_scale=opts.time_scale, baud=opts.baud), opts.certificate)
     if opts.render:
         render_all(d)
@@ -167,11 +190,15 @@ def _found(opts: Options, f: Finding) -> None:
         opts.view.finding(f)
 
 
-def _wait(opts: Options, relay: Relay, live: LiveJudge, interim: "_Interim", t0: float) -> str:
+def _wait(opts: Options, relay: Relay, live: LiveJudge, interim: "_Interim", t0: float, gaps: SideGaps) -> str:
     """Until the session ends (module docstring); returns why it ended."""
     while True:
         for f in live.poll():
             _found(opts, f)
+        while gaps.messages:
+            text = gaps.messages.popleft()
+            if opts.on_gap is not None:
+                opts.on_gap(text)
         interim.tick()
         now = time.monotonic()
         if opts.duration is not None and now - t0 >= opts.duration:

@@ -1,4 +1,5 @@
-"""The HTML report's model coverage (modes, transitions, interrupt pairs; the exploration's own
+"""The HTML report's model coverage (modes, transitions, interrupt pairs; the range edges of §4–8b
+the run reached, ``stats.edges``, with those it did not and why; the exploration's own
 coverage of the model's rows, interrupt pairs, timer boundaries and error codes, with what stayed
 uncovered, listed in natural order: row 2 before row 10) beside the sentence saying what model
 coverage means for the verdict (:func:`~helmcheck.reports.scope.model_coverage_note`), and the
@@ -12,7 +13,7 @@ from typing import Any, Mapping
 
 from .html_markup import _e
 from .rundir import Run
-from .scope import model_coverage_note
+from .scope import edge_coverage, edge_gist, model_coverage_note
 from .timeline import MODE_ORDER, event_counts
 
 _REMOTE_MODES = ("A", "M", "mP", "W")
@@ -50,8 +51,25 @@ def _coverage(run: Run) -> str:
         body.append(f"<tr><th>{_e(active)}</th>{''.join(cells)}</tr>")
     out.append(f'<table class="pairs"><thead><tr><th>active ↓ / interrupted by →</th>{head}</tr></thead>'
                f"<tbody>{''.join(body)}</tbody></table>")
+    out.append(_edge_coverage(run))
     out.append(_exploration_coverage(run))
     return "\n".join(out)
+
+
+def _edge_coverage(run: Run) -> str:
+    """The range edges reached (``stats.edges``): the count, per clause, and the edges not reached."""
+    e = edge_coverage(run.results)
+    if not e:
+        return ""
+    per = " · ".join(f"{_e(c)} {_e(d.get('reached'))}/{_e(d.get('of'))}" for c, d in
+                     sorted((e.get("by_clause") or {}).items(), key=lambda x: natural_key(x[0])))
+    missing = e.get("unreached") or []
+    more = (f'<details><summary>{len(missing)} not reached</summary><ul class="uncovered">'
+            + "".join(f"<li><code>{_e(u.get('edge'))}</code>{' — ' + _e(u['why']) if u.get('why') else ''}</li>"
+                      for u in missing) + "</ul></details>") if missing else ""
+    return (f'<h3 id="range-edges">Range edges reached ({_e(e.get("reached"))} of {_e(e.get("of"))})</h3>'
+            f'<p class="note">{_e(edge_gist(run.results))} A value at a bound, and just past it, sent where the '
+            f'answer turns on that bound alone.</p><p class="muted">{per}</p>{more}')
 
 
 def natural_key(text: object) -> tuple:

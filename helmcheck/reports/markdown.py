@@ -19,7 +19,7 @@ import re
 from .identity import identity_rows
 from .linecounters import counters_summary
 from .rundir import Run
-from .scope import headline, model_coverage_note, scope_of
+from .scope import edge_gist, headline, model_coverage_note, scope_of
 from .text import printable
 from .timeline import event_counts
 from .verdicts import describe_process
@@ -121,6 +121,8 @@ def render_markdown(run: Run, comparison_md: str | None = None) -> str:
     out.append("|" + "---:|" * (len(c) + 1))
     out.append("| " + " | ".join(str(n) for n in c.values()) + f" | {sum(c.values())} |")
     out.append("")
+    if edge_gist(r):
+        out += [md_escape(edge_gist(r)), ""]
     mc = ((r.get("stats") or {}).get("explore") or {}).get("model_coverage")
     if isinstance(mc, dict) and mc:
         out.append("Exploration's model coverage: " + "; ".join(

@@ -21,7 +21,9 @@ A verdict says how the judged clauses went; the scope says how much was judged. 
 **Model coverage is not scope.** What a vehicle run's exploration reached of the reference model
 (``stats.explore.model_coverage``: rows, interrupt pairs, timer boundaries, error codes) measures
 the random search on top of the fixed cases; no verdict and no certificate depends on it. Every
-rendering that shows it says so beside it (:func:`model_coverage_note`).
+rendering that shows it says so beside it (:func:`model_coverage_note`). Nor are the range edges a
+vehicle run reached (``stats.edges``, :func:`edge_gist`): a bound whose edge was not reached is
+still judged by its clause wherever it was met.
 
 Nothing here reads files: the scope is a pure function of the results document (its role, its
 clause verdicts, ``partial``), so ``helmcheck verify`` can recompute it from re-judged verdicts
@@ -40,7 +42,7 @@ from ..judge.verdict import Verdict
 from .view import VERDICT_LABEL
 
 __all__ = ["JUDGED", "Gap", "Scope", "claimed_clauses", "scope_of", "headline", "id_ranges", "model_coverage_note",
-           "what_to_change", "precision_note"]
+           "edge_coverage", "edge_gist", "what_to_change", "precision_note"]
 
 JUDGED = (Verdict.PASS, Verdict.NON_STRICT, Verdict.FAIL)
 _GAPS_SHOWN = 4
@@ -191,6 +193,26 @@ def model_coverage_note(results: Mapping[str, Any]) -> str:
     return ("Model coverage is how much of the reference model the exploration's random sequences "
             "reached within their budget (the fixed test cases are not counted); it is not part of "
             f"the verdict, {rests}.")
+
+
+def edge_coverage(results: Mapping[str, Any]) -> Mapping[str, Any]:
+    """``stats.edges`` of a vehicle run: the range edges of §4–8b it reached (empty when it recorded none)."""
+    e = (results.get("stats") or {}).get("edges")
+    return e if isinstance(e, dict) and "of" in e else {}
+
+
+def edge_gist(results: Mapping[str, Any]) -> str:
+    """One sentence: how many range edges the run reached, and why the others were not."""
+    e = edge_coverage(results)
+    if not e:
+        return ""
+    why: dict[str, int] = {}
+    for u in e.get("unreached") or ():
+        k = (u.get("why") or "not sent") if isinstance(u, dict) else "not sent"
+        why[k] = why.get(k, 0) + 1
+    rest = "; ".join(f"{n} {k}" for k, n in sorted(why.items()))
+    return (f"Range edges reached (§4–8b, both sides of every bound): {e.get('reached')} of {e.get('of')}"
+            + (f" (not reached: {rest})" if rest else "") + ".")
 
 
 def id_ranges(ids: Iterable[str]) -> str:

@@ -25,6 +25,7 @@ from ... import __version__
 from ...failures import OutputLost, describe_interrupt
 from ...grammar.wirelog import run_header
 from ...judge.timing import JITTER_S
+from ...line.reopen import DEFAULT_WAIT_S, reopenable
 from ...line.transport import BAUD_RATES, Link, open_link, parse_port_spec
 from ...profile import Profile
 from ...reports.certificate import RunDeclaration, finish_run
@@ -51,6 +52,9 @@ class Options:
     scenarios: Optional[list[str]] = None  #: default: all of :data:`.scenarios.SCENARIOS`, in order
     strict: bool = False  #: a SHOULD not met fails the run
     connect_timeout: float = 30.0  #: seconds to wait for the backseat's first byte
+    #: seconds helmcheck's own device (a serial adapter) that vanished mid-run is waited for under
+    #: the same name (:mod:`.runner`, link life); 0: not waited for
+    reconnect_wait: float = DEFAULT_WAIT_S
     exec_cmd: Optional[str] = None  #: start the backseat under test on the port (:mod:`.process`)
     exec_grace_s: float = 5.0  #: SIGTERM → SIGKILL when stopping it
     certificate: Optional[RunDeclaration] = None  #: identity and signing key
@@ -80,6 +84,8 @@ def problems(opts: Options, spell: Callable[[str], str] = lambda name: f"--{name
         out.append(f"{spell('duration')} must be a positive number of seconds (got {opts.duration})")
     if not _positive(opts.connect_timeout):
         out.append(f"{spell('connect-timeout')} must be a positive number of seconds (got {opts.connect_timeout})")
+    if not (math.isfinite(opts.reconnect_wait) and opts.reconnect_wait >= 0):
+        out.append(f"{spell('reconnect-wait')} must be 0 or a positive number of seconds (got {opts.reconnect_wait})")
     if opts.exec_cmd is not None:
         from ...line.launcher import check_command
         why = check_command(opts.exec_cmd)
@@ -119,6 +125,7 @@ def certify(opts: Options) -> Outcome:
                                 "duration_s": float(opts.duration), "planned_s": round(plan.total, 3),
                                 "scenarios": list(dict.fromkeys(names)), "baud": baud,
                                 "connect_timeout_s": float(opts.connect_timeout),
+                                "reconnect_wait_s": float(opts.reconnect_wait),
                                 "reaction_s": float(profile.reaction_s), "jitter_s": JITTER_S, **opts.settings}
     link = opts.link if opts.link is not None else _open(opts.port, baud)
     log = opts.log if opts.log is not None else open(report_dir / "wire.log", "w", encoding="utf-8")
@@ -150,7 +157,7 @@ def _run(opts: Options, profile: Profile, plan, report_dir: Path, link: Link, lo
     from .progress import Progress
     from .runner import Runner
 
-    child = process = None  # exec_cmd: the backseat under test (.process)
+    child = process = runner = None  # exec_cmd: the backseat under test (.process)
     progress = Progress(enabled=opts.progress)
     try:
         meta = [f"started {started_dt.strftime('%Y-%m-%dT%H:%M:%S.%fZ')}  port {link.name}  "
@@ -165,9 +172,14 @@ def _run(opts: Options, profile: Profile, plan, report_dir: Path, link: Link, lo
                 print(f"helmcheck certify backseat: {plan.note}", file=sys.stderr)
         if opts.on_port is not None:
             opts.on_port(link.name)
+        spec = parse_port_spec(opts.port)
         runner = Runner(link, profile, plan, time_scale=profile.time_scale,
                         missions=DirectoryCatalog([builtin_dir()]), log=log, meta=meta,
-                        connect_timeout=opts.connect_timeout, progress=progress)
+                        connect_timeout=opts.connect_timeout, progress=progress,
+                        # helmcheck's own device can come back; a pty it made or a client it
+                        # serves that goes away is the backseat leaving (.runner, link life)
+                        port=opts.port if spec.kind != "socket" and reopenable(spec) else None,
+                        reconnect_wait=opts.reconnect_wait)
         if opts.exec_cmd:
             from .process import start_backseat
             try:
@@ -189,6 +201,8 @@ def _run(opts: Options, profile: Profile, plan, report_dir: Path, link: Link, lo
     finally:
         if child is not None and process is None:
             child.stop()  # the run never started (or broke): leave nothing behind
+        if runner is not None and runner.link is not link:
+            runner.link.close()  # the port opened again after a gap
         link.close()
         try:
             log.close()

@@ -80,6 +80,15 @@ class Progress:
         self.bar.update(self.task, completed=elapsed, description=f"{scenario:<11}",
                         extra=bad or "no offence so far")
 
+    def note(self, text: str) -> None:
+        """Something that happened to the run (a port gone, back): shown even between updates."""
+        if not self.enabled:
+            return
+        if self.bar is not None and self.task is not None:
+            self.bar.console.print(f"{_PREFIX} {text}", markup=False, highlight=False)
+        else:
+            self._say(text)
+
     def _say(self, text: str) -> None:
         try:
             print(f"{_PREFIX} {text}", file=self.stream, flush=True)

@@ -23,6 +23,7 @@ from ...clauses import backseat_clauses
 from ...judge.backseat import BS_CLAUSES
 from ...judge.ledger import Ledger
 from ...judge.runfacts import RunFacts
+from ...line.reopen import gap_event
 from ...profile import Profile
 from ...reports import render_all
 from ...reports.assemble import apply, assemble
@@ -61,6 +62,11 @@ def build_results(outcome: Optional[RunRecord], *, profile: Profile, settings: d
                           "bytes_from_backseat": outcome.observer.stats["bytes"],
                           "lines_from_backseat": outcome.observer.stats["lines"],
                           "vehicle": outcome.vehicle_stats}
+        if outcome.gaps:  # helmcheck's port gone and waited for (.runner, link life)
+            results["link_gaps"] = [dict(g) for g in outcome.gaps]
+            for g in outcome.gaps:
+                ev = gap_event(g)
+                add_event(results, ev["t"], ev["kind"], ev["label"])
     apply(results, a, duration_s=round(outcome.ended_at - (outcome.connected_at or 0.0), 3) if outcome else 0.0)
     return results
 

@@ -21,10 +21,19 @@ the bytes that follow it.
 Link life (decisions): the run starts at the backseat's first byte; none within
 ``connect_timeout`` is "never connected". On a pty the loop lets go of its own copy of the
 slave side once the backseat is there, so the backseat closing the port (or dying) is seen as
-a hang-up; on a TCP serial server it is the client's disconnect; on a device, a device that
-disappears. Any of these before the run's end is "disconnected" (the report says when). The
-loop waits in ``select`` at most 50 ms at a time; SIGINT/SIGTERM (or :meth:`Runner.stop`)
-end it early as "interrupted". When helmcheck started the backseat (``child``, a
+a hang-up; on a TCP serial server it is the client's disconnect. Either is the backseat leaving,
+and before the run's end it is "disconnected" (the report says when). On a device (``port``:
+helmcheck's own serial adapter, or any name that can come back, :mod:`helmcheck.line.reopen`)
+a device that disappears is helmcheck's side of the line going away, not the backseat's doing:
+the loop waits for it under the same name for ``reconnect_wait`` seconds (:meth:`Runner._gap_start`),
+keeping the vehicle's clock going (what it says meanwhile is lost, as on a cut line) and the
+scenarios' schedule still. Back in time, the record gets a ``run resumed`` note (the judge does not
+hold the gap against the backseat: the next poll is due from there, what it knew is unknown
+again, :class:`~helmcheck.judge.backseat.BackseatObserver`), any staged window still open is
+closed, and the scenario the gap cut starts again from its start, the rest of the schedule after
+it (``link_gaps`` in ``results.json``). Not back in time, the run is "disconnected", its reason
+naming the port and the wait. The loop waits in ``select`` at most 50 ms at a time;
+SIGINT/SIGTERM (or :meth:`Runner.stop`) end it early as "interrupted". When helmcheck started the backseat (``child``, a
 :class:`~helmcheck.line.launcher.Launcher`), the loop also ends, as "exited", as soon as
 that process has ended (checked every tick).
 
@@ -54,6 +63,7 @@ from ...model.missions import MissionCatalog
 from ...profile import Profile
 from ...emulator.core import EmulatorCore
 from ...line.recorder import Recorder
+from ...line.reopen import DEFAULT_WAIT_S, RETRY_S, wait_for_port
 from ...line.transport import Link, LinkClosed
 from .link import HangupPty
 from .scenarios import LOCKOUT_CODE, Plan
@@ -97,6 +107,9 @@ class RunRecord:
     vehicle_stats: dict = field(default_factory=dict)
     facts: RunFacts = field(default_factory=RunFacts)  #: the run facts, as the record's notes gave them
     process: Optional[dict] = None  #: the backseat's ``process`` object, when helmcheck started it
+    #: helmcheck's port gone and waited for: when (seconds since the certifier started), how long,
+    #: why, the scenario it cut, whether it came back
+    gaps: list[dict] = field(default_factory=list)
 
 
 class Runner:
@@ -105,8 +118,16 @@ class Runner:
     def __init__(self, link: Link, profile: Profile, plan: Plan, *, time_scale: float,
                  missions: Optional[MissionCatalog] = None, log: Optional[IO[str]] = None,
                  meta: Iterable[str] = (), connect_timeout: float = 30.0,
-                 clock: Callable[[], float] = time.monotonic, progress: Any = None, child: Any = None):
+                 clock: Callable[[], float] = time.monotonic, progress: Any = None, child: Any = None,
+                 port: Optional[str] = None, reconnect_wait: float = DEFAULT_WAIT_S):
         self.link = link
+        #: the name to open again when the link's device vanishes (None: not waited for)
+        self.port = port if reconnect_wait > 0 else None
+        self.reconnect_wait = reconnect_wait
+        self._gap: Optional[dict] = None  #: the gap under way (its entry in ``outcome.gaps``)
+        self._gap_slot = None  #: the scenario slot it cut
+        self._retry_at = 0.0
+        self._shift = 0.0  #: seconds the schedule moved on by the gaps (the cut scenarios run again)
         self.profile = profile
         self.plan = plan
         self.time_scale = time_scale
@@ -163,7 +184,16 @@ class Runner:
                     reason = (f"the backseat never connected: no byte arrived on {self.link.name} "
                               f"within {self.connect_timeout:g} s")
                     break
-                if self.connected_at is not None and self.rel(now) >= self.connected_at + self.plan.total:
+                if self._gap is not None:
+                    back = self._gap_tick(now)
+                    if back is False:
+                        gap = self._gap
+                        status = "disconnected"
+                        reason = (f"helmcheck's port {self.port} was gone at {gap['lost_at_s']:.1f} s and did not "
+                                  f"come back within {self.reconnect_wait:g} s (--reconnect-wait; {gap['why']})")
+                        break
+                    continue
+                if self.connected_at is not None and self.rel(now) >= self.connected_at + self._shift + self.plan.total:
                     status, reason = "complete", "the run completed"
                     break
                 if self.connected_at is not None:
@@ -176,6 +206,9 @@ class Runner:
                 if gone:
                     now = self.clock()
                     if self.connected_at is None:
+                        continue
+                    if self.port is not None and not gone.startswith("disconnect"):
+                        self._gap_start(now, gone)  # helmcheck's own device: waited for
                         continue
                     status = "disconnected"
                     reason = (f"the backseat closed the port or crashed after {self._elapsed(now):.1f} s "
@@ -202,8 +235,9 @@ class Runner:
 
             o = self.outcome
             o.process = end_backseat(self.child, epoch=self.launch, link_lost=status in ("disconnected", "exited"))
+            started = None if self.connected_at is None else self.connected_at + self._shift
             for text in process_notes(o.process, clauses=BS_CLAUSES, plan=self.plan,
-                                      connected_at=self.connected_at, ended_at=o.ended_at):
+                                      connected_at=started, ended_at=o.ended_at):
                 self.recorder.note(t, text)
         if status == "never-connected":
             self.recorder.note(t, not_judged_note(BS_CLAUSES, f"not judged: {reason}"))
@@ -211,7 +245,80 @@ class Runner:
             self.recorder.note(t, partial_note(reason))
 
     def _elapsed(self, now: float) -> float:
-        return 0.0 if self.connected_at is None else self.rel(now) - self.connected_at
+        """Seconds of the schedule run so far (a gap's scenario, run again, is counted once)."""
+        return 0.0 if self.connected_at is None else self.rel(now) - self.connected_at - self._shift
+
+    # ------------------------------------------------------------------ helmcheck's port gone and back
+    def _gap_start(self, now: float, why: str) -> None:
+        """The link's device vanished (module docstring): note it, wait for it from the loop."""
+        t = self.rel(now)
+        try:
+            self.link.close()
+        except Exception:  # noqa: BLE001
+            pass
+        self._note(now, f"link lost: {why}")
+        self._note(now, f"link gap: waiting up to {self.reconnect_wait:g} s for {self.port} to come back "
+                        f"(--reconnect-wait)")
+        self._gap_slot = self._scenario_at(self._elapsed(now))
+        self._gap = {"lost_at_s": round(t, 6), "back_at_s": None, "gap_s": None, "port": self.port, "why": why,
+                     "cut": self._gap_slot.name if self._gap_slot is not None else None}
+        self.outcome.gaps.append(self._gap)
+        self._retry_at = now
+        self._framer = Framer(self.profile.max_line_bytes)  # a line the gap cut is nobody's
+        self._out.clear()
+        if self.progress is not None and hasattr(self.progress, "note"):
+            self.progress.note(f"{self.port} is gone ({why}); waiting up to {self.reconnect_wait:g} s for it")
+
+    def _gap_tick(self, now: float) -> Optional[bool]:
+        """One turn of the loop while the port is gone: True back, False given up, None waiting."""
+        gap = self._gap
+        assert gap is not None
+        self._service(now)  # the vehicle goes on; what it says is lost (:meth:`_write`)
+        if now >= self._retry_at:
+            link, _ = wait_for_port(self.port, baud=self.profile.baud, within_s=0.0)  # type: ignore[arg-type]
+            if link is not None:
+                self._gap_end(self.clock(), link)
+                return True
+            self._retry_at = now + RETRY_S
+        if self.rel(now) - gap["lost_at_s"] >= self.reconnect_wait:
+            return False
+        time.sleep(min(_TICK, RETRY_S))
+        return None
+
+    def _gap_end(self, now: float, link: Link) -> None:
+        """The port is back: the record says so, staged windows close, the cut scenario starts again."""
+        gap = self._gap
+        assert gap is not None
+        self.link = link
+        t = self.rel(now)
+        gap.update(back_at_s=round(t, 6), gap_s=round(t - gap["lost_at_s"], 6))
+        cut = self._gap_slot
+        again = f"scenario {cut.name} starts again" if cut is not None else "the run goes on"
+        self._note(now, f"run resumed: helmcheck's port came back after a gap of {t - gap['lost_at_s']:.2f} s "
+                        f"({self.port} was gone from {gap['lost_at_s']:.3f} s to {t:.3f} s: {gap['why']}); what "
+                        f"crossed the line meanwhile was not seen; {again}")
+        self._note(now, f"link reopened: {self.port} is back after {t - gap['lost_at_s']:.2f} s")
+        self._gap = None
+        if self._rejecting:
+            self._rejecting = False
+            self._note(now, "reject: window ends")
+        if self._silent:
+            self._silent = False
+            self._note(now, "silence ends")
+        if cut is not None:  # the schedule goes on from the cut scenario's start
+            self._shift = t - (self.connected_at or 0.0) - cut.start
+            self._actions = deque(a for a in self.plan.actions if a.at >= cut.start)
+        if self.progress is not None and hasattr(self.progress, "note"):
+            self.progress.note(f"{self.port} is back after {t - gap['lost_at_s']:.1f} s; {again}")
+        self._due(now)
+
+    def _scenario_at(self, elapsed: float):
+        """The scenario slot the schedule is in at ``elapsed`` seconds of it (the last one after)."""
+        slots = self.plan.slots
+        for slot in slots:
+            if elapsed < slot.end:
+                return slot
+        return slots[-1] if slots else None
 
     def _wait_and_read(self, now: float) -> str:
         """Wait for input (at most one tick) and handle it; a reason when the peer is gone."""
@@ -298,6 +405,9 @@ class Runner:
         self._write(self.clock())
 
     def _write(self, now: float) -> None:
+        if self._gap is not None:  # nothing crosses a line whose port is gone: lost, not recorded
+            self._out.clear()
+            return
         while self._out:
             try:
                 n = self.link.write_some(bytes(self._out[:65536]))
@@ -325,7 +435,7 @@ class Runner:
 
     # ------------------------------------------------------------------ staging
     def _due(self, now: float) -> None:
-        start = self.launch + (self.connected_at or 0.0)
+        start = self.launch + (self.connected_at or 0.0) + self._shift
         while self._actions and start + self._actions[0].at <= now:
             self._act(self._actions.popleft(), now)
         if self.progress is not None:

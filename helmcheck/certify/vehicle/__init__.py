@@ -23,6 +23,9 @@ entry point is :func:`.runner.certify`. Modules, one concern each:
   in wall and vehicle seconds; :mod:`.generate` — what they draw (every claimed command at its
   range edges and error codes, every mutation of a line); :mod:`.modelcover` — what of the
   model they reached (rows, interrupt pairs, timer boundaries, error codes).
+* :mod:`.edges` — the range edges of §4–8b (both sides of every bound and keyword, generated from
+  the command checks, the grammar and the model's state checks) and which of them the lines sent
+  reached (``stats.edges``).
 * :mod:`.replay` — version-independent replay files: write, read, re-drive from the verified
   reset, naming the step that failed or went another way; :mod:`.relocate` moves the positions
   a replay's lines send to where the vehicle begins it.
@@ -30,6 +33,8 @@ entry point is :func:`.runner.certify`. Modules, one concern each:
   declared time scale (sans-IO); :mod:`.clockprobe` reads the clock at start.
 * :mod:`.restore` — leaving the vehicle as it was found: its settings and its mode.
 * :mod:`.resume` — ``--resume DIR``: an interrupted run goes on from its last completed case.
+* :mod:`.rejoin` — a port that vanished mid-run, waited for under the same name: the gap
+  recorded, the vehicle's state verified again, the case it cut run again (or ``--resume``).
 * :mod:`.plan` — ``--plan``: the run's estimated time, from the cases run in virtual time
   (:mod:`.virtual`: a serial line in virtual time with the reference vehicle at its far end).
 * :mod:`.runner` — one certification run: cases, exploration, results and reports;

@@ -20,8 +20,8 @@ from typing import Optional
 
 from ...grammar import sentences as s
 from ...profile import Profile
-from .steps import (Burst, Case, Fault, MissionEnd, Octd, Poll, Raw, Send, SetRoundTrip, Settle, Start, Until,
-                    Wait, WithSetting)
+from .steps import (Burst, Case, ClearWords, Fault, MissionEnd, Octd, Poll, Raw, Send, SetRoundTrip, Settle, Start,
+                    Until, Wait, WithSetting)
 
 __all__ = ["CASES", "select_cases", "unmet_need", "line_needs"]
 
@@ -29,10 +29,42 @@ __all__ = ["CASES", "select_cases", "unmet_need", "line_needs"]
 # this line at this time scale, ``{to_long}`` one that outlasts several steps, and so on.
 OMS = "OMS,90,2,20,{speed},{to}"
 OMS0 = "OMS,90,2,20,0,{to}"  # speed 0: the vehicle holds its position
-OMS_DIVE = "OMS,90,{dive_depth},20,{speed},120"  # down to a depth an ascent takes a while to leave
+OMS_DIVE = "OMS,90,{dive_depth},20,{speed},{to_hi}"  # down to a depth an ascent takes a while to leave
 OMP_HOLD = "OMP,8080808080,00,{to_long}"  # neutral: holds depth, outlasts what follows (RH-RD-12)
 OMS_RESTART = "OMS,90,2,20,{speed},{to_restart}"  # restarted {gap} into it, both deadlines told apart
 FAR_OMW = "OMW,{near_lat},{lon},2,,15,{speed},0,"
+HOLD_SURFACE = "OMS,90,0,20,0,{to_long}"  # stays where it is, at the surface, for several steps
+#: V-70's controls, each sent again just before its $OPOS so that what follows fits its timeout on a slow line
+_DIVE_HOLD = "OMS,90,1.5,45,{speed},{to_long}"  # down to 1.5 m and held there
+_RISE = "OMS,90,0,45,{speed},{to_long}"  # back up to the surface, under way
+OPOS_FAR = "OPOS,{opos_lat},{lon},0,,"  # far enough that the next report tells applied from not (RH-POS-2)
+ACCEPTED = {"OMS": "$ACK,9,0,0", "OMP": "$ACK,10,0,0", "OPK": "$ACK,11,0,0", "OMW": "$ACK,16,0,0",
+            "OPOS": "$ACK,6,0,0", "ODVL": "$ACK,15,0,0", "OMSTART": "$ACK,3,0,0", "ORWSET": "$ACK,12,0,0",
+            "OLOGL": "$ACK,5,0,0", "OLOGD": "$ACK,4,0,0", "OJW": "$ACK,7,0,0"}
+REFUSED = {"OMS": "$ACK,9,1,20", "OMP": "$ACK,10,1,21", "OPK": "$ACK,11,1,22", "OMW": "$ACK,16,1,36",
+           "OPOS": "$ACK,6,1,18", "ODVL": "$ACK,15,1,35", "OMSTART": "$ACK,3,1,30", "ORWSET": "$ACK,12,1,23",
+           "OLOGL": "$ACK,5,1,24", "OLOGD": "$ACK,4,1,25", "OJW": "$ACK,7,1,19", "OMLOAD": "$ACK,2,1,29"}
+
+
+def _ok(*bodies: str) -> tuple:
+    """Sends a conforming vehicle accepts."""
+    return tuple(Send(b, expect=ACCEPTED[b.split(",")[0]]) for b in bodies)
+
+
+def _off(base: str, *changes: tuple) -> tuple:
+    """Sends of ``base`` with one field at a time (1 = the first after the ID) set to a value just
+    past its bound: each refused with the command's own error (RH-ACK-3)."""
+    out = []
+    for i, value in changes:
+        f = base.split(",")
+        f[i] = value
+        out.append(Send(",".join(f), expect=REFUSED[f[0]]))
+    return tuple(out)
+
+
+def _no(*bodies: str) -> tuple:
+    """Sends a conforming vehicle refuses with the command's own error."""
+    return tuple(Send(b, expect=REFUSED[b.split(",")[0]]) for b in bodies)
 
 
 def _c(id_, clauses, title, expectation, start, *steps, needs=()):
@@ -188,8 +220,8 @@ CASES: tuple[Case, ...] = (
     _c("V-34", "RH-JW-2", "$OJW ends remote control",
        "$OJW from A, M, mP and W gives the mission toward the new next waypoint", "N",
        Send(OMS), Send("OJW,{wp_other}"), Poll(mode_not="A"), Send("OMP,8080808080,00,{to}"),
-       Send("OJW,0"), Poll(mode_not="M"), Send("OPK,{lat},{lon},5,{speed}"), Send("OJW,{wp_other}"),
-       Poll(mode_not="mP"), Send(FAR_OMW), Send("OJW,0"), Poll(mode_not="W")),
+       Send("OJW,{wp_first}"), Poll(mode_not="M"), Send("OPK,{lat},{lon},5,{speed}"), Send("OJW,{wp_other}"),
+       Poll(mode_not="mP"), Send(FAR_OMW), Send("OJW,{wp_first}"), Poll(mode_not="W")),
     _c("V-35", "RH-JW-2", "$OJW ends a mission park",
        "$OJW during the mission park gives the mission toward the new next waypoint", "P",
        Send("OJW,{wp_other}"), Poll()),
@@ -224,10 +256,11 @@ CASES: tuple[Case, ...] = (
        Send(FAR_OMW), Send("OMW,{near_lat},{near_lon},2,3,15,{speed},0,"), Poll(mode="W"), Wait(5.0),
        Poll(mode="W")),
     _c("V-41", "RH-OMW-3", "$OMW,Clr and its synonyms",
-       "Clr, CLEAR and STOP clear the queue and resume the mission; in N the keyword changes nothing",
+       "Clr, CLEAR and STOP (the profile's omw_clear_keywords) clear the queue and resume the mission; in N "
+       "the keyword changes nothing",
        "N",
-       Send(FAR_OMW), Send("OMW,Clr"), Poll(mode="N|P"), Send(FAR_OMW), Send("OMW,CLEAR"), Poll(mode="N|P"),
-       Send(FAR_OMW), Send("OMW,STOP"), Poll(mode="N|P"), Send("OMW,Clr", expect="$ACK,16,0,0"),
+       Send(FAR_OMW), Send("OMW,{kw_a}"), Poll(mode="N|P"), Send(FAR_OMW), Send("OMW,{kw_b}"), Poll(mode="N|P"),
+       Send(FAR_OMW), Send("OMW,{kw_c}"), Poll(mode="N|P"), Send("OMW,{kw_a}", expect="$ACK,16,0,0"),
        Poll(mode="N|P")),
     _c("V-42", "RH-OMW-4", "The mission resumes when the queue is done",
        "a queued waypoint at the vehicle's position is reached at once; the mission resumes", "N",
@@ -336,11 +369,112 @@ CASES: tuple[Case, ...] = (
            Start(srp=True), Fault("Sfp"), Settle("lockout"),
            Until("the SRP after the surface", mode="N", srp_active=True, budget_v=600.0), Poll(mode="N"))),
        needs=("violation", "srp_mission", "srp_field", "cmd:ORWSET")),
+    # --- range edges (§4–8b): both sides of every bound, :mod:`.edges` --------------------------
+    _c("V-65", "RH-SRV-2", "$OMS at each edge of its ranges",
+       "heading 0 and 359.9, depth 0 and max_depth, pitch 0 and 45, speed 0 and max_speed_kn, the timeout "
+       "range's ends are accepted (its lowest with a second $OMS in the same write, which restarts it, "
+       "RH-RD-3); 0.1 (or 1) past each is refused (20), every other field inside", "N",
+       *_ok("OMS,359.9,{depth_max},45,{speed},{to_hi}", "OMS,90,2,20,{speed_max},{to}"),
+       *_off("OMS,90,2,20,{speed},{to}", (1, "-0.1"), (1, "360"), (2, "-0.1"), (2, "{depth_out}"), (3, "-0.1"),
+             (3, "45.1"), (4, "-0.1"), (4, "{speed_out}"), (5, "{to_under}"), (5, "{to_over}")),
+       Burst(("OMS,0,0,0,0,{to_lo}", OMS0), expect=("$ACK,9,0,0", "$ACK,9,0,0")), Poll(mode="A")),
+    _c("V-66", "RH-PRM-2", "$OMP at each edge of its fields",
+       "lower-case hex and the timeout range's ends are accepted (the lowest with a second $OMP in the same "
+       "write); nine and eleven hex digits, reserved 01 and one past each timeout end are refused (21)", "S",
+       *_ok("OMP,7f7f808080,00,{to_hi}"),
+       *_off("OMP,8080808080,00,{to}", (3, "{to_under}"), (3, "{to_over}"), (2, "01"), (1, "808080808"),
+             (1, "80808080800")),
+       Burst(("OMP,8080808080,00,{to_lo}", "OMP,8080808080,00,{to}"), expect=("$ACK,10,0,0", "$ACK,10,0,0")),
+       Poll(mode="M")),
+    _c("V-67", "RH-PK-1 RH-RD-9", "$OPK just inside and just outside 10 miles, and at each edge of its ranges",
+       "after an ignore-GPS start (no fix, RH-RD-10) an $OPOS puts the vehicle where it reported itself; "
+       "an $OPK 0.5 % beyond opk_max_distance_m from there is refused (40), one 0.5 % inside it accepted "
+       "(mP; the park is too far to start counting); minutes 1 and 1440 and speed 0 and max_speed_kn are "
+       "accepted; a latitude ±90 or longitude ±180 is in range (refused for the distance, 40); 0.1 (or 1) "
+       "past each bound is refused (22)", "S",
+       Start(ignore_gps=1), *_ok(HOLD_SURFACE), Poll(mode="A"), *_ok("OPOS,{lat},{lon},0,,"),
+       Send("OPK,{opk_out_lat},{lon},{opk_min},{speed}", expect="$ACK,11,1,40"),
+       *_ok("OPK,{opk_in_lat},{lon},1,0"), Poll(mode="mP"),
+       *_ok("OPK,{opk_in_lat},{lon},1440,{speed}", "OPK,{opk_in_lat},{lon},{opk_min},{speed_max}"),
+       *(Send(b, expect="$ACK,11,1,40") for b in ("OPK,90,{lon},{opk_min},{speed}", "OPK,-90,{lon},{opk_min},{speed}",
+                                                   "OPK,{lat},180,{opk_min},{speed}", "OPK,{lat},-180,{opk_min},{speed}")),
+       *_off("OPK,{opk_in_lat},{lon},{opk_min},{speed}", (1, "90.1"), (1, "-90.1"), (2, "180.1"), (2, "-180.1"),
+             (3, "0"), (3, "1441"), (4, "-0.1"), (4, "{speed_out}")),
+       Poll(mode="mP")),
+    _c("V-68", "RH-ACK-3 RH-RD-9", "$OMW at each edge of its ranges",
+       "waypoints at latitude ±90, longitude ±180, depths ±100, pitch 0 and 45, speed 0 and max_speed_kn, "
+       "park 0 and 86400 s are queued (W); 0.1 (or 1) past each bound is refused (36); Clr ends the queue",
+       "N",
+       *_ok("OMW,90,180,100,100,45,{speed},86400,", "OMW,-90,-180,-100,-100,0,0,0,",
+            "OMW,{near_lat},{lon},2,,15,{speed_max},0,"),
+       *_off("OMW,{near_lat},{lon},2,,15,{speed},0,", (1, "90.1"), (1, "-90.1"), (2, "180.1"), (2, "-180.1"),
+             (3, "100.1"), (3, "-100.1"), (4, "100.1"), (4, "-100.1"), (5, "-0.1"), (5, "45.1"), (6, "-0.1"),
+             (6, "{speed_out}"), (7, "-1"), (7, "86401")),
+       Poll(mode="W"), *_ok("OMW,{kw_a}"), Poll(mode="N|P")),
+    _c("V-69", "RH-OMW-3 RH-RD-4", "$OMW keywords in any case",
+       "each keyword of omw_clear_keywords in lower, upper and title case (clr, Clear, stop …) clears a "
+       "queued waypoint and resumes the mission; a word beside them (CLEARS) is refused (36)", "N",
+       ClearWords(FAR_OMW)),
+    _c("V-70", "RH-POS-2 RH-RD-10", "$OPOS on each side of the GPS fix",
+       "an $OPOS is applied at the surface in a mission started with ignore-GPS; once that mission is "
+       "stopped, at the surface in S, it is not; in a mission started normally it is applied under water "
+       "and not at the surface (each judged by the next report, the depth held steady around it)", "S",
+       Until("the surface in S", mode="S", surface=True, budget_v=300.0),
+       Start(ignore_gps=1), *_ok(HOLD_SURFACE),
+       Until("the surface in A", mode="A", surface=True, budget_v=300.0, refresh=HOLD_SURFACE),
+       *_ok(HOLD_SURFACE), Wait(2.0), *_ok(OPOS_FAR), Poll(mode="A"),
+       Send("OMSTOP,0"), Until("the surface in S", mode="S", surface=True, budget_v=300.0), Wait(2.0),
+       *_ok(OPOS_FAR), Poll(mode="S"),
+       Start(), *_ok(_DIVE_HOLD),
+       Until("under water", mode="A", submerged=True, depth_at_least=1.4, budget_v=300.0, refresh=_DIVE_HOLD),
+       *_ok(_DIVE_HOLD), Wait(2.0), *_ok(OPOS_FAR), Poll(mode="A"),
+       *_ok(_RISE), Until("the surface in A", mode="A", surface=True, budget_v=300.0, refresh=_RISE),
+       *_ok(_RISE), Wait(2.0), *_ok(OPOS_FAR), Poll(mode="A")),
+    _c("V-71", "RH-POS-1 RH-DVL-1 RH-RD-9", "$OPOS and $ODVL at each edge of their ranges",
+       "at the surface in S (a fix: the position is not applied): latitude ±90, longitude ±180, speed 0 and "
+       "max_speed_kn, conductivity 0 and 100, temperature -5 and 50 are accepted, 0.1 past each refused "
+       "(18); $ODVL x and y ±5 and the timeout range's ends accepted, one step past each refused (35)", "S",
+       Until("the surface in S", mode="S", surface=True, budget_v=300.0),
+       *_ok("OPOS,90,180,{speed_max},100,50", "OPOS,-90,-180,0,0,-5"),
+       *_off("OPOS,{lat},{lon},0,35,12", (1, "90.1"), (1, "-90.1"), (2, "180.1"), (2, "-180.1"), (3, "-0.1"),
+             (3, "{speed_out}"), (4, "-0.1"), (4, "100.1"), (5, "-5.1"), (5, "50.1")),
+       *_ok("OPOS,{lat},{lon},0,35,12", "ODVL,5,-5,{to_lo}", "ODVL,-5,5,{to_hi}"),
+       *_off("ODVL,0.5,0,{to}", (1, "5.1"), (1, "-5.1"), (2, "5.1"), (2, "-5.1"), (3, "{to_under}"), (3, "{to_over}")),
+       Poll(mode="S")),
+    _c("V-72", "RH-MSN-2 RH-RD-6", "$OMSTART at each edge of its fields",
+       "each rh5 flag 1 and an SRP inside the mission directory start the mission, each paper-form flag "
+       "1–3 starts the loaded one ($OMSTOP after each); a flag 2, paper flag 4, and a name or SRP name that "
+       "is empty, absolute, with a drive letter or a '..' component are refused (30)", "S",
+       *(st for body in ("OMSTART,0,1,0,0,{mission},", "OMSTART,0,0,1,0,{mission},", "OMSTART,0,0,0,1,{mission},",
+                         "OMSTART,0,0,0,0,{mission},{mission}")
+         for st in (*_ok(body), Send("OMSTOP,0"))),
+       *(st for flag in ("1", "2", "3") for st in (Send("OMLOAD,{mission},0", expect="$ACK,2,0,0"),
+                                                    *_ok(f"OMSTART,{flag}"), Send("OMSTOP,0"))),
+       *_off("OMSTART,0,0,0,0,{mission},", (1, "2"), (2, "2"), (3, "2"), (4, "2"), (5, ""), (5, "/{mission}"),
+             (5, "C:{mission}"), (5, "sub/../../{mission}")),
+       *_off("OMSTART,0,0,0,0,{mission},{mission}", (6, "/{mission}"), (6, "C:{mission}"),
+             (6, "sub/../../{mission}")),
+       *_no("OMSTART,4", "OMLOAD,,0"), Poll(mode="S")),
+    _c("V-73", "RH-SET-2 RH-RD-8", "$ORWSET writes at each edge",
+       "a write of state 0 with no value and of state 1 with three values is accepted, four values or "
+       "state 2 refused (23); SafetyAction takes srp and park, not Park or dive (23); each setting is "
+       "written back as it was found", "S",
+       WithSetting("Sle", "1", (*_ok("ORWSET,Sle,W,0", "ORWSET,Sle,W,1,1,2,3"),
+                                *_no("ORWSET,Sle,W,1,1,2,3,4", "ORWSET,Sle,W,2,1"))),
+       WithSetting("SafetyAction", "srp", (*_ok("ORWSET,SafetyAction,W,1,park"),
+                                           *_no("ORWSET,SafetyAction,W,1,Park", "ORWSET,SafetyAction,W,1,dive"))),
+       needs=("cmd:ORWSET",)),
+    _c("V-74", "RH-LOG-1 RH-LOG-2 RH-JW-1", "$OLOGL, $OLOGD and $OJW at each edge of their counts",
+       "1 and 12 labels are accepted in S, none refused (24); in the mission 1 and 12 values are accepted, "
+       "none and 13 refused (25); $OJW to the first waypoint is accepted, one below refused (19)", "S",
+       *_no("OLOGL"), *_ok("OLOGL,a", "OLOGL,1,2,3,4,5,6,7,8,9,10,11,12"), Start(),
+       *_no("OLOGD", "OLOGD,1,2,3,4,5,6,7,8,9,10,11,12,13"), *_ok("OLOGD,1", "OLOGD,1,2,3,4,5,6,7,8,9,10,11,12"),
+       *_ok("OJW,{wp_first}"), *_no("OJW,{wp_under}"), Poll(mode="N")),
     # --- §8 time ---------------------------------------------------------------------------------
     _c("V-62", "RH-TIM-1 RH-TIM-2", "Durations hold at the declared time scale",
        "a servo timeout of 30 s or more and a primitive timeout end within max(0.5 s, 5 %) plus the "
-       "measured slack, at the declared time scale k (30 s: a clock 30 % off is told apart from the "
-       "slack at k = 25)", "N",
+       "measured slack, at the declared time scale k (the servo timeout is the shortest whose end a "
+       "clock 30 % fast moves by more than the precision the line allows, else the longest allowed)", "N",
        Send("OMS,90,2,20,{speed},{to_tim}"), Settle("remote"), Poll(mode="N|P"),
        Send("OMP,8080808080,00,{to}"), Settle("remote"), Poll(mode="N|P")),
 )
@@ -415,6 +549,10 @@ def _sends(steps) -> list:
     for st in steps:
         if isinstance(st, Send):
             out.append(st)
+        elif isinstance(st, ClearWords):
+            out.append(Send(st.queue))
+        elif isinstance(st, Burst):
+            out += [Send(b) for b in st.bodies]
         elif isinstance(st, WithSetting):
             out += _sends(st.steps)
     return out

@@ -15,7 +15,9 @@ The keys :meth:`Durations.context` adds to a case's templates (:mod:`.interprete
 ==============  ==============================================================================
 ``to``          a servo / primitive timeout the observer times (RH-SRV-4, RH-PRM-4)
 ``to_long``     a control that must outlast several steps (at least 60 s and three ``to``)
-``to_tim``      RH-TIM-2's long timeout (at least 30 s: a clock 30 % off is told apart)
+``to_tim``      RH-TIM-2's long timeout: the shortest of at least 30 s that tells a clock 30 % off
+                (:data:`CLOCK_OFF`) from RH-TIM-1's tolerance widened by this line; where none
+                does, the longest the profile allows (the verdict states its precision)
 ``to_restart``  a timeout restarted ``gap`` into it, both deadlines told apart (RH-SRV-3)
 ``gap``         vehicle seconds between the two ``$OMS`` of ``to_restart``
 ``opk_min``     ``$OPK`` minutes whose countdown is timed (RH-PK-3); ``opk_s`` the seconds
@@ -174,6 +176,26 @@ def _opos_m(profile: Profile, b: LineBudget) -> float:
     return max(110.0, 4 * way)
 
 
+#: The clock error V-62 (RH-TIM-2) is to tell apart: a vehicle clock this fraction fast or slow.
+CLOCK_OFF = 0.3
+
+
+def _to_tim(b: LineBudget, lo: int, hi: int) -> Optional[int]:
+    """RH-TIM-2's timeout: the shortest timeable one of at least 30 s that a clock
+    :data:`CLOCK_OFF` fast ends early by more than the line's precision (a fast clock is the
+    smaller error: ``d·(1 − 1/1.3)``); where none does, the longest timeable one."""
+    early = 1.0 - 1.0 / (1.0 + CLOCK_OFF)
+    d = b.shortest(lo, hi, at_least=30.0)
+    best = d
+    while d is not None and d <= hi:
+        if early * d >= MARGIN * b.precision_v(d):
+            return d
+        if b.timeable(d):
+            best = d
+        d += 1
+    return best
+
+
 def derive(profile: Profile, budget: LineBudget) -> Durations:
     """The durations for ``profile`` on the line ``budget`` describes."""
     lo, hi = int(profile.timeout_range[0]), int(profile.timeout_range[1])
@@ -182,7 +204,7 @@ def derive(profile: Profile, budget: LineBudget) -> Durations:
     to_long = b.shortest(lo, hi, at_least=max(60.0, 3 * (to or hi))) if to is not None else None
     if to_long is None and to is not None:
         to_long = hi
-    to_tim = b.shortest(lo, hi, at_least=30.0)
+    to_tim = _to_tim(b, lo, hi)
     to_restart = None
     gap = 0.0
     if to is not None:

@@ -22,11 +22,12 @@ from ...grammar import checksum_hex
 from ...grammar import sentences as s
 from ...profile import Profile
 from .catalogue import unmet_need
+from .edges import edge_list, edge_values, north_of, opk_edge_m
 from .flow import CaseStop
 from .safety import BenchSafetyRefused
 from .session import Session, frame
-from .steps import (Burst, Case, Fault, MissionEnd, Octd, Poll, Raw, Send, SetRoundTrip, Settle, Start, Until,
-                    Wait, WithSetting)
+from .steps import (Burst, Case, ClearWords, Fault, MissionEnd, Octd, Poll, Raw, Send, SetRoundTrip, Settle, Start,
+                    Until, Wait, WithSetting)
 
 __all__ = ["run_case", "run_step", "raw_line", "context", "fill"]
 
@@ -48,6 +49,9 @@ def context(session: Session) -> dict:
            # deep enough that an ascent after a lockout takes a while, within any depth range
            "dive_depth": f"{min(p.max_depth / 2, 10.0 if p.depth_unit == 'm' else 33.0):g}"}
     ctx.update(session.durations().context())
+    ctx.update(edge_values(p), opk_in_m=opk_edge_m(p, "in"), opk_out_m=opk_edge_m(p, "out"))
+    kws = (list(p.omw_clear_keywords) or ["Clr"]) * 3  # the profile's $OMW keywords, first three (RH-OMW-3)
+    ctx.update(kw_a=kws[0], kw_b=kws[1], kw_c=kws[2])
     _position(ctx, lat, lon)
     _other(session, ctx)
     return ctx
@@ -59,6 +63,8 @@ def _position(ctx: dict, lat: str, lon: str) -> None:
                opos_lat=f"{float(lat) + opos:.6f}",
                far_lat=f"{float(lat) + 1.0:.6f}", km_lat=f"{float(lat) + 0.01:.6f}",  # 1.1 km north
                stn_lat=f"{float(lat) + 15.0 / 111320.0:.6f}")  # 15 m north
+    if "opk_in_m" in ctx:  # the $OPK 10-mile edge, from where the vehicle last reported (.edges)
+        ctx.update(opk_in_lat=north_of(float(lat), ctx["opk_in_m"]), opk_out_lat=north_of(float(lat), ctx["opk_out_m"]))
 
 
 def _other(session: Session, ctx: dict) -> None:
@@ -246,7 +252,11 @@ def run_step(session: Session, st, ctx: dict) -> None:
     elif isinstance(st, WithSetting):
         _with_setting(session, st, ctx)
     elif isinstance(st, Burst):
-        session.burst([frame(fill(b, ctx)) for b in st.bodies])
+        sents = session.burst([frame(fill(b, ctx)) for b in st.bodies])
+        for sent, text in zip(sents, st.expect):
+            _check_expect(session, sent, text)
+    elif isinstance(st, ClearWords):
+        _clear_words(session, st, ctx)
     elif isinstance(st, SetRoundTrip):
         _set_round_trip(session, st)
     elif isinstance(st, Octd):
@@ -254,6 +264,20 @@ def run_step(session: Session, st, ctx: dict) -> None:
             session.exchange(frame("OSD,T"))
     else:  # pragma: no cover
         raise TypeError(st)
+
+
+def _clear_words(session: Session, st: ClearWords, ctx: dict) -> None:
+    """Each keyword edge of :func:`.edges.edge_list`: the accepted spellings in ``W``, each followed
+    by a report (the queue cleared, the mission resumed: RH-OMW-3, RH-RD-4), then the refused ones."""
+    words = [e for e in edge_list(session.profile) if e.command == "OMW" and e.field == "keyword"]
+    for e in words:
+        if e.side == "in":
+            run_step(session, Send(st.queue, expect="$ACK,16,0,0"), ctx)
+            run_step(session, Send(f"OMW,{e.probe}", expect="$ACK,16,0,0"), ctx)
+            run_step(session, Poll(mode="N|P"), ctx)
+    for e in words:
+        if e.side == "out":
+            run_step(session, Send(f"OMW,{e.probe}", expect="$ACK,16,1,36"), ctx)
 
 
 def _until(session: Session, st: Until, ctx: dict) -> None:

@@ -60,6 +60,7 @@ class TesterLink:
         self.bytes_out = 0
         self.lines_in = 0
         self.lost: Optional[str] = None
+        self.lost_t: Optional[float] = None  #: the record's time of the ``link lost`` note
         self.per_byte = transmit_time(1, profile.baud)
 
     # ------------------------------------------------------------------ time
@@ -107,7 +108,7 @@ class TesterLink:
             self.lost = why
             for ev in self.framer.close():
                 self._add(self.now(), ev.raw, False)
-            self.note(f"link lost: {why}")
+            self.lost_t = self.note(f"link lost: {why}")
         raise LinkLost(self.lost)
 
     # ------------------------------------------------------------------ receive
@@ -177,7 +178,7 @@ class TesterLink:
         except Exception:  # noqa: BLE001
             pass
         self.link = link
-        self.lost = None
+        self.lost = self.lost_t = None
         self.framer = Framer(max(4096, 4 * self.profile.max_line_bytes))
         self.inbox.clear()
         self.note(why)

@@ -105,6 +105,10 @@ class Plan:
     line: dict = field(default_factory=dict)  #: the line budget (``LineBudget.as_dict``)
     durations: dict = field(default_factory=dict)  #: the durations chosen from it (``Durations.context``)
     verdicts: dict = field(default_factory=dict)  #: clause → the judge's verdict on the planned vehicle
+    #: the range edges the planned cases reach on the reference vehicle (:meth:`.edges.EdgeTally.summary`)
+    edges: dict = field(default_factory=dict)
+    #: edge id → the case that reached it first on the reference vehicle
+    edge_cases: dict = field(default_factory=dict)
 
     @property
     def total_wall_s(self) -> float:
@@ -229,6 +233,8 @@ def estimate(profile: Profile, time_scale: float, *, select: Optional[list] = No
         recorder.close()
         observer.close()
     plan.verdicts = {v.id: v.verdict for v in ledger.verdicts()}
+    plan.edges = session.edges.summary()
+    plan.edge_cases = dict(session.edges.reached)
     plan.missions = {"directories": [str(d) for d in catalog.dirs], "given": missions_dir is not None,
                      "stand_ins": dict(catalog.stand_ins)}
     plan.assumptions = _assumptions(plan, profile, catalog, missions_dir, n, budget, hypothesis_profile)

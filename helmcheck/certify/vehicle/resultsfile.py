@@ -4,7 +4,7 @@
 the profile, the settings); :func:`save` writes them after every case and at the end —
 atomically, marked ``partial`` until the final save — assembled from the run's one ledger and
 its run facts by :func:`helmcheck.reports.assemble.assemble`, with the timeline, coverage,
-restore record and stats beside; :func:`keep_traceback` puts a tester error's traceback beside
+restore record and stats beside (and each link gap as an event, :mod:`.rejoin`); :func:`keep_traceback` puts a tester error's traceback beside
 them (``tester-error.txt``).
 """
 
@@ -13,6 +13,7 @@ from __future__ import annotations
 import time
 
 from ... import __version__
+from ...line.reopen import gap_event
 from ...reports import results as R
 from ...reports.assemble import apply, assemble
 
@@ -53,7 +54,7 @@ def save(run, final: bool = False) -> None:
     assembly = assemble("vehicle", run.ledger, run.facts, strict=run.o.strict, partial=partial,
                         lead=lead if final else "")
     r["timeline"] = [{"t": t, "mode": m} for t, m in obs.timeline]
-    r["events"] = list(obs.events)
+    r["events"] = list(obs.events) + [gap_event(g) for g in r.get("link_gaps") or ()]
     modes = sorted({m for _, m in obs.timeline})
     pairs = [list(p) for p in sorted(obs.interrupt_pairs)]
     steps = [[a, b, "observed"] for (_, a), (_, b) in zip(obs.timeline, obs.timeline[1:]) if a != b]
@@ -67,6 +68,7 @@ def save(run, final: bool = False) -> None:
         r["restore"] = run.custodian.record()
     if run.session is not None:
         run.stats["forced_wait_s"] = round(run.session.forced_wait, 3)
+        run.stats["edges"] = run.session.edges.summary()  # the range edges reached (:mod:`.edges`)
         if run.session.meter.measured:  # the line the verdicts were reached on (:mod:`.linemeter`)
             r["settings"]["line_budget"] = run.session.meter.budget().as_dict()
     run.stats["wall_s"] = round(time.monotonic() - run.t_start

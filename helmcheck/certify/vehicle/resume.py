@@ -14,7 +14,8 @@ flat battery) should not send it back to the start. :func:`resume_into` prepares
 * the cases already completed are not run again; a case the interruption (or a lost link) cut
   off runs again from its start; exploration runs if the first part had not finished it;
 * what the vehicle was found in (the settings' original values, :mod:`.restore`) is taken from
-  the first part, whose own restore may already have put them back.
+  the first part, whose own restore may already have put them back; a setting it wrote and could
+  not put back (its port vanished, :mod:`.rejoin`) is put back at the end of this part.
 
 The run's profile, selection, time scale, seed and the like are the first part's (the command
 line checks that nothing contradicts them, :mod:`.cli`).
@@ -57,6 +58,7 @@ def resume_into(run: Any) -> Resumed:
     r = prior
     r["cases"] = cases
     r["partial"] = True
+    r.pop("resume_command", None)  # this is that command
     settings = r.setdefault("settings", {})
     settings.setdefault("resumed", []).append(
         {"at": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()), "completed_cases": len(cases),
@@ -75,6 +77,9 @@ def resume_into(run: Any) -> Resumed:
         rec = run.custodian.records.get(st.get("name"))
         if rec is not None and st.get("before") is not None:
             rec.before = list(st["before"])
+            # written and not verified as put back (a port that vanished before the restore):
+            # this part puts it back at its end, whether it writes it again or not
+            rec.written = bool(st.get("written")) and not st.get("verified")
     found = restore.get("found") or {}
     if found.get("mode"):
         run.custodian.found_mode, run.custodian.found_mission = found["mode"], found.get("mission")

@@ -18,8 +18,13 @@ partial:``). ``results.json`` is assembled from that ledger and those facts by
 :func:`helmcheck.reports.assemble.assemble` — the function ``check-log`` and ``helmcheck verify``
 use on ``wire.log`` — and nothing changes a verdict after it.
 
-A vanished device stops the run: a ``run aborted`` note makes the clauses not yet judged
-INCONCLUSIVE with that reason, and the report is still written.
+A vanished device (EIO, the pty closed, the socket dropped) is waited for under the same name
+for ``Options.reconnect_wait_s`` (``--reconnect-wait``): back in time, the gap is recorded as a
+``run resumed`` note, the vehicle's state verified again and the case the gap cut run again from
+its start (:mod:`.rejoin`); not back, the run stops partial, naming the ``--resume`` command that
+goes on from that case (``Outcome.resume_command``). A link fault that is not a vanished device
+(a vehicle that stops answering, garbage) stops the run: a ``run aborted`` note makes the clauses
+not yet judged INCONCLUSIVE with that reason, and the report is still written.
 
 With ``Options.exec_cmd`` (``--exec``) helmcheck starts the vehicle under test itself on the
 port (:mod:`.exec_child`; :mod:`helmcheck.line.exec_port`, :mod:`helmcheck.line.launcher`),
@@ -50,6 +55,7 @@ from ...judge.linebudget import NOMINAL_WIDENING_S
 from ...judge.vehicle import VehicleObserver
 from ...judge.wire import tester_note
 from ...line.recorder import Recorder
+from ...line.reopen import DEFAULT_WAIT_S, reopenable
 from ...line.transport import open_link
 from ...profile import Profile
 from ...reports import results as R
@@ -65,6 +71,7 @@ from .interpreter import run_case
 from .link import TesterLink
 from .progress import Progress
 from .generate import EXPLORE_WRITES
+from .rejoin import rejoin
 from .restore import Custodian, written_settings
 from .resume import Resumed, resume_into
 from .safety import BenchSafetyRefused
@@ -112,6 +119,12 @@ class Options:
     #: timing coarser than nominal (:data:`~helmcheck.judge.linebudget.NOMINAL_WIDENING_S`), naming
     #: the time scale that would not (:class:`CoarseTiming`); ``"any"``: judge with what the line gives
     precision: str = "any"
+    #: wall seconds a vanished port is waited for under the same name before the run stops
+    #: (``--reconnect-wait``; 0: not waited for), :mod:`.rejoin`
+    reconnect_wait_s: float = DEFAULT_WAIT_S
+    #: the command that goes on after a port that did not come back (the command line's own;
+    #: default: ``helmcheck certify vehicle --port PORT --resume DIR``)
+    resume_command: str = ""
 
 
 #: ``$OSD,S`` requests the link check sends more when the first two get only garbage, and the
@@ -172,6 +185,8 @@ class Run(ExecChild):
         self.aborted: Optional[str] = None
         self.stopped: Optional[str] = None  #: a start-up check stopped the run: leads the verdict reason
         self.coarse: Optional[CoarseTiming] = None  #: ``--precision nominal`` stopped it
+        self.gone: Optional[str] = None  #: the port vanished and did not come back (:mod:`.rejoin`)
+        self.resume_command: Optional[str] = None  #: what goes on from there
         self.partial = False
         self.t_start = time.monotonic()
         self.results = resultsfile.new_results(opts)
@@ -188,6 +203,7 @@ class Run(ExecChild):
         if opts.resume:
             self.resumed = resume_into(self)
             self.facts = RunFacts.from_wire_log(self.dir / R.WIRE_LOG_NAME)  # the first part's facts
+        self.results["settings"]["reconnect_wait_s"] = float(opts.reconnect_wait_s)
 
     # ------------------------------------------------------------------ results
     def save(self, final: bool = False) -> None:
@@ -220,8 +236,10 @@ class Run(ExecChild):
             lines, last_t = self.resumed.lines, self.resumed.last_t
             self.recorder = Recorder(wire, observers=[self.observer, self.facts], after=(lines, last_t))
             self.link = TesterLink(raw, self.p, self.recorder, start_at=last_t + 1.0)
-            self.link.note(f"run resumed: {time.strftime('%Y-%m-%dT%H:%M:%SZ', time.gmtime())}, "
-                           f"{self.resumed.done} case(s) already run")
+            # stamped where the first part's record ends: the judge lets no time pass over a
+            # command the interruption cut off before it knows (as after a link gap, :mod:`.rejoin`)
+            self.recorder.note(last_t, f"run resumed: {time.strftime('%Y-%m-%dT%H:%M:%SZ', time.gmtime())}, "
+                                       f"{self.resumed.done} case(s) already run")
         else:
             self._record(wire, meta)
             assert self.recorder is not None
@@ -313,8 +331,9 @@ class Run(ExecChild):
 
     def _reopen(self) -> bool:
         """A link lost during the run: open the port again for the restore (a vehicle that came
-        back). ``--exec`` and a link the caller gave are not reopened here."""
-        if self.o.exec_cmd or self.o.link is not None or self.link is None:
+        back after the run stopped waiting for it). ``--exec`` and a port that names nothing that
+        can come back (:func:`~helmcheck.line.reopen.reopenable`) are not reopened."""
+        if self.o.exec_cmd or self.link is None or not reopenable(self.o.port):
             return False
         try:
             raw = open_link(self.o.port, role="client", baud=self.p.baud)
@@ -337,27 +356,34 @@ class Run(ExecChild):
                 self.results["cases"].append(entry)
                 self.progress.step(f"{case.id} {case.subject}", "skipped (already failed)")
                 continue
-            t0 = time.monotonic()
-            counters.start()
-            try:
+            cuts = 0
+            while True:
+                t0 = time.monotonic()
+                counters.start()
                 try:
-                    outcome, reason = run_case(ses, case)
-                finally:
-                    entry["line_counters"] = counters.end(case.id, case.clauses)
-            except LinkLost as e:
-                gone = self.child_gone(settle_s=1.0)
-                if gone:  # the vehicle under test died: not a link fault
-                    self.aborted = gone
-                    entry.update(verdict="not-tested", reason=gone, wall_s=round(time.monotonic() - t0, 3),
-                                 cut=True)
-                    self.results["cases"].append(entry)
-                    self.progress.step(case.id, "not finished (the vehicle under test ended)")
+                    try:
+                        outcome, reason = run_case(ses, case)
+                    finally:
+                        entry["line_counters"] = counters.end(case.id, case.clauses)
+                    break
+                except LinkLost as e:
+                    gone = self.child_gone(settle_s=1.0)
+                    if gone:  # the vehicle under test died: not a link fault
+                        self.aborted = gone
+                        entry.update(verdict="not-tested", reason=gone, wall_s=round(time.monotonic() - t0, 3),
+                                     cut=True)
+                        self.results["cases"].append(entry)
+                        self.progress.step(case.id, "not finished (the vehicle under test ended)")
+                        raise
+                    cut = dict(entry, verdict="inconclusive", reason=str(e), wall_s=round(time.monotonic() - t0, 3),
+                               cut=True)
+                    self.results["cases"].append(cut)
+                    cuts += 1
+                    if rejoin(self, e, f"case {case.id}", cuts):  # the port is back: the case again
+                        cut["reason"] = f"cut by a link gap ({e}); run again from its start"
+                        continue
+                    self.progress.step(case.id, "inconclusive (link)")
                     raise
-                entry.update(verdict="inconclusive", reason=str(e), wall_s=round(time.monotonic() - t0, 3),
-                             cut=True)
-                self.results["cases"].append(entry)
-                self.progress.step(case.id, "inconclusive (link)")
-                raise
             entry.update(verdict="pass" if outcome == "done" else outcome, reason=reason,
                          wall_s=round(time.monotonic() - t0, 3))
             self.results["cases"].append(entry)
@@ -369,7 +395,8 @@ class Run(ExecChild):
         """Close the record: a ``run aborted`` note when it ended early (a ``not tested`` note for
         what a dead vehicle under test never reached), then the observer."""
         if self.recorder is not None:
-            t = self.link.now() if self.link is not None else self.recorder.last_t
+            # a link still lost: at its loss (time the judge did not see, :mod:`.rejoin`)
+            t = self.link.now() if self.link is not None and not self.link.lost else self.recorder.last_t
             gone = self.child_gone()
             if gone:
                 left = [c for c in self.ids if not self.ledger.judged(c)]
@@ -392,6 +419,26 @@ def _precision(run: "Run", precision: str) -> None:
         raise CoarseTiming(budget)
 
 
+def _again(run: "Run", what: str, step: Callable[[], None]) -> None:
+    """``step()``, run again from its start after each link gap it is cut by (:mod:`.rejoin`)."""
+    cuts = 0
+    while True:
+        try:
+            step()
+            return
+        except LinkLost as e:
+            cuts += 1
+            if not rejoin(run, e, what, cuts):
+                raise
+
+
+def _link_check(run: "Run", opts: Options) -> None:
+    run.probe()
+    run.session.measure_line()  # what the line costs: the durations the cases choose
+    _precision(run, opts.precision)
+    check_clock(run, opts.clock_check)
+
+
 def certify(opts: Options) -> Outcome:
     """Run a whole certification (module docstring); never raises for vehicle or link faults."""
     run = Run(opts)
@@ -405,14 +452,11 @@ def certify(opts: Options) -> Outcome:
         run.save()
         try:
             run.open()
-            run.probe()
-            run.session.measure_line()  # what the line costs: the durations the cases choose
-            _precision(run, opts.precision)
-            check_clock(run, opts.clock_check)
+            _again(run, "the link check", lambda: _link_check(run, opts))
             run.run_cases(cases)
             if explore_now and run.aborted is None:
                 from .explore import explore
-                explore(run)
+                _again(run, "the exploration", lambda: explore(run))
                 run.progress.step("exploration", "done")
         except (ClockMismatch, CoarseTiming) as e:  # the declared time scale is clearly wrong, or too
             run.aborted = run.stopped = str(e)          # coarse for --precision nominal: INCONCLUSIVE
@@ -471,5 +515,8 @@ def certify(opts: Options) -> Outcome:
         reason = f"{reason.rstrip('.')}; {unverified_text(restore)}"
         if code != 1:  # the vehicle may have left with a setting changed: never a green run; a
             code = 2   # FAIL stays non-conformant (1), the restore named beside it
+    if run.gone is not None and code == 0:
+        code = 2
     return Outcome(r["verdict"], reason, code, run.dir, r,
-                   nominal_time_scale=run.coarse.scale if run.coarse is not None else None)
+                   nominal_time_scale=run.coarse.scale if run.coarse is not None else None,
+                   resume_command=run.resume_command)

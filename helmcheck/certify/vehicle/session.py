@@ -50,6 +50,8 @@ from ...judge.vehicle import Sent, VehicleObserver
 from ...judge.wire import case_end_note, case_note, tester_note
 from ...profile import Profile
 from .durations import Durations, derive
+from .edges import EdgeTally
+from .safety import BenchSafetyRefused
 from .flow import CaseStop, LinkSilent
 from .link import TesterLink
 from .linemeter import LINK_PROBES, LineMeter
@@ -103,6 +105,8 @@ class Session:
         self.meter = LineMeter(self.k, profile.baud, profile.ack_window_s)
         self._durations: Optional[Durations] = None
         self.reruns = 0  #: re-runs the last :meth:`exchange` took (a faulty line spoilt what came before)
+        #: the range edges of §4–8b the lines sent reached (:mod:`.edges`; ``stats.edges``)
+        self.edges = EdgeTally(profile)
 
     # ================================================================ the line budget
     def measure_line(self, host: bool = True) -> None:
@@ -187,11 +191,17 @@ class Session:
         seq = self.obs.seq
         if self.custodian is not None:
             self.custodian.check_write(raw)  # no setting is written unless its restore is known
-        t = self.link.send(raw)
+        at = self.edges.before(raw, self.obs.state())
+        try:
+            t = self.link.send(raw)
+        except BenchSafetyRefused:
+            self.edges.refused(at, "bench safety")
+            raise
         self._trace({"send": _esc(raw), "t": round(t, 6)})
         for sent in reversed(self.obs.sent):
             if sent.seq <= seq:
                 break
+            self.edges.track(sent, at)
             return sent
         return None
 
@@ -350,9 +360,19 @@ class Session:
         if self.custodian is not None:
             for raw in raws:
                 self.custodian.check_write(raw)
-        t = self.link.send(b"".join(raws))
+        state = self.obs.state()  # each line's edges as met in the state before the burst (:mod:`.edges`)
+        ats = [self.edges.before(raw, state) for raw in raws]
+        try:
+            t = self.link.send(b"".join(raws))
+        except BenchSafetyRefused:
+            for at in ats:
+                self.edges.refused(at, "bench safety")
+            raise
         self._trace({"send": _esc(b"".join(raws)), "t": round(t, 6)})
         sents = [x for x in self.obs.sent if x.seq > seq]
+        if len(sents) == len(raws):
+            for sent, at in zip(sents, ats):
+                self.edges.track(sent, at)
         while any(not x.done for x in sents):  # until each is answered or the observer gave up on it
             hard = max(self.obs.give_up_at(x) for x in sents if not x.done) + 0.05
             if self.link.next(hard) is None and self.now() >= hard:

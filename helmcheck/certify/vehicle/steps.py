@@ -15,7 +15,13 @@ reported position, ``{near_lat}``/``{near_lon}`` a point ~110 m north/east of it
 ~111 km north, ``{km_lat}`` one ~1.1 km north, ``{wp_last}``/``{wp_bad}`` the last and one-past-the-last waypoint number,
 ``{wp_other}`` a waypoint of the test mission other than its learnt park waypoint,
 ``{depth_over}`` a depth just over ``max_depth``, ``{speed_over}`` a speed just over
-``max_speed_kn``.
+``max_speed_kn``. The profile's own bounds at their edges (:func:`.edges.edge_values`): ``{to_lo}``/``{to_hi}``
+the ends of ``timeout_range`` and ``{to_under}``/``{to_over}`` one past them, ``{depth_max}``/``{depth_out}``
+and ``{speed_max}``/``{speed_out}`` the ceiling and 0.1 past it, ``{wp_first}``/``{wp_under}`` the first
+waypoint and one below; ``{opk_in_lat}``/``{opk_out_lat}`` a point due north of the vehicle's last
+reported position just inside and just outside the ``$OPK`` limit (``opk_max_distance_m``, :data:`.edges.OPK_EDGE`);
+``{kw_a}``, ``{kw_b}``, ``{kw_c}`` the profile's ``$OMW`` keywords (``omw_clear_keywords``), the first three, repeated
+when there are fewer.
 """
 
 from __future__ import annotations
@@ -24,7 +30,7 @@ from dataclasses import dataclass
 from typing import Optional
 
 __all__ = ["Send", "Raw", "Poll", "Wait", "Settle", "Until", "Fault", "Start", "MissionEnd", "WithSetting",
-           "Burst", "SetRoundTrip", "Octd", "Case", "RAW_KINDS"]
+           "Burst", "SetRoundTrip", "Octd", "ClearWords", "Case", "RAW_KINDS"]
 
 #: Mutations of a valid sentence (:func:`.interpreter.raw_line`), each tied to its clause.
 RAW_KINDS = {
@@ -144,9 +150,11 @@ class WithSetting:
 
 @dataclass(frozen=True)
 class Burst:
-    """Several commands written back to back before any reply is read (RH-ACK-6)."""
+    """Several commands written back to back before any reply is read (RH-ACK-6); ``expect``: the
+    answer to each, in words (as :class:`Send`'s)."""
 
     bodies: tuple
+    expect: tuple = ()
 
 
 @dataclass(frozen=True)
@@ -154,6 +162,16 @@ class SetRoundTrip:
     """Read a setting, write a changed state and value, read it back, restore it (RH-SET-2)."""
 
     setting: str
+
+
+@dataclass(frozen=True)
+class ClearWords:
+    """RH-RD-4: every ``$OMW`` keyword the profile names (``omw_clear_keywords``) in lower, upper and
+    title case, each sent with ``queue`` queued before it (a waypoint: mode ``W``), where it must
+    clear the queue and resume the mission (a report after each); then each word beside them that
+    must be refused — the keyword edges of :func:`.edges.edge_list`."""
+
+    queue: str
 
 
 @dataclass(frozen=True)

@@ -24,8 +24,9 @@ Dispatch:
 * notes (``!``, :func:`~helmcheck.judge.wire.parse_note`) — ``scenario X starts`` (findings
   then carry ``X`` as their case), ``lockout starts (<code>)`` / ``lockout ends``, ``silence
   starts`` / ``silence ends`` (no answer is expected meanwhile, and servo control is not
-  judged across it), ``link: <baud> baud 8N1`` (the line's baud from then on). Other notes are
-  not needed: a staged rejection is an ``$ACK`` like any other.
+  judged across it), ``link: <baud> baud 8N1`` (the line's baud from then on), ``run resumed:
+  …`` (the record goes on after a gap it did not see, :meth:`BackseatObserver._resume`). Other
+  notes are not needed: a staged rejection is an ``$ACK`` like any other.
 
 The observer imports no ``serial``, ``time``, ``threading`` or ``asyncio``.
 """
@@ -333,3 +334,33 @@ class BackseatObserver:
         elif n.kind == "link" and n.value:
             st.baud = int(n.value)
             self.arrivals.baud = st.baud
+        elif n.kind == "resumed":
+            self._resume(ev)
+
+    def _resume(self, ev: WireEvent) -> None:
+        """``run resumed``: the record goes on after a gap in what it saw (an interrupted run,
+        a port that vanished and came back, a side of a monitored line gone). What the gap cut
+        is not judged, and what the backseat may have learnt in it is not known: a line it cut
+        is nobody's (the framers start afresh), no answer is awaited, servo control is not held
+        (RH-BS-6), the next poll is due :data:`~.polling.POLL_INTERVAL_S` from here (RH-BS-8),
+        and the state reports, the lockout and the rejections as the backseat knew them start
+        unknown again (RH-BS-3, RH-BS-5): only what it is seen to learn from here is held
+        against it. Decision: an interval that spans the gap is never judged, whichever way."""
+        t = ev.t
+        st = self.settings
+        self._framer = Framer(self.profile.max_line_bytes)
+        self._vframer = Framer(max(self.profile.max_line_bytes, 1024))
+        self._records.clear()
+        self._offset = self._consumed = self._voffset = 0
+        self.pending.clear()
+        self.servo.end(t)
+        self.polling.resume(t, Evidence(t, NOTE, ev.note[:200], ev.lineno))
+        self.reports = self.preconditions.reports = StateReports()
+        ep = self.lockout.episode
+        if ep is not None:
+            ep.end = t if ep.end is None else min(ep.end, t)
+            self.reaction.episode_over(ep)
+        old = self.lockout
+        self.lockout = self.reaction.lockout = Lockout(st)
+        self.lockout.noted, self.lockout.count = old.noted, old.count
+        self.reaction.forget()

@@ -6,7 +6,8 @@ clause is about. *A poll* is a well-formed ``$OSD`` whose letters include ``S`` 
 not). The gaps judged: first byte → first poll, poll → poll, and last poll → end of the run,
 each by :func:`~.common.gap` against 5 s plus the observer's
 :data:`~helmcheck.judge.timing.JITTER_S` (a poll may have been seen late). A gap is judged once,
-when it closes. Polling is wall time and never scales (RH-TIM-2).
+when it closes. After a ``run resumed`` note (a gap in what the record saw) the interval starts
+again at the note: one that spans what nobody saw is not judged. Polling is wall time and never scales (RH-TIM-2).
 """
 
 from __future__ import annotations
@@ -32,6 +33,7 @@ class Polling:
         self._last_ev: Optional[Evidence] = None
         self.polls = 0
         self._passed = False
+        self._resumed = False  #: the interval open now began at a ``run resumed`` note
 
     @property
     def active(self) -> bool:
@@ -49,9 +51,18 @@ class Polling:
             return
         self.polls += 1
         ev = line.evidence()
-        self._judge(line.t, ev, "state poll {:.2f} s after the previous one" if self.polls > 1
+        self._judge(line.t, ev, "first state poll {:.2f} s after the record resumed" if self._resumed
+                    else "state poll {:.2f} s after the previous one" if self.polls > 1
                     else "first state poll {:.2f} s after the backseat's first byte")
         self._last, self._last_ev = line.t, ev
+        self._resumed = False
+
+    def resume(self, t: float, ev: Evidence) -> None:
+        """The record goes on at ``t`` after a gap it did not see (``run resumed``): the interval
+        that spans the gap is not judged; the next poll is due 5 s from ``t``."""
+        if self._last is not None:
+            self._last, self._last_ev = t, ev
+            self._resumed = True
 
     def close(self, t: float) -> None:
         """The run (or the log) ended at ``t``."""

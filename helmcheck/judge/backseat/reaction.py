@@ -152,6 +152,14 @@ class Reaction:
             return  # over before the backseat could know
         self._met(ep.case, None, f"only $OSD during the lockout ({ep.code}, {ep.osd} poll(s))")
 
+    def forget(self) -> None:
+        """After a gap in the record (``run resumed``): the rejections the backseat knew of may
+        have been answered since, unseen; a resend is judged only after a rejection seen anew."""
+        for ser in self._rejected.values():
+            self._end(ser)
+        self._rejected.clear()
+        self._recent.clear()
+
     def close(self) -> None:
         for ser in self._rejected.values():
             self._end(ser)

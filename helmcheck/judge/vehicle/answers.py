@@ -12,6 +12,10 @@ judges replies, split out to keep one concern per module; it works on the observ
 * **The ACK window** (RH-ACK-2, :func:`~helmcheck.judge.timing.ack_allowance`; an ACK later
   than the window, transmit time and the observer's own uncertainty is a FAIL), the answer
   against the mirror (:mod:`.belief`), and ``$OSD``'s data before its ACK (RH-ACK-5, RH-OSD-1).
+  Decision (the profile is silent): a line a tester sent after opening the link (its ``link:``
+  note) and before the vehicle had answered anything — the link check's probe of a vehicle still
+  starting up — is not timed, nor missed (:attr:`~.sent.Sent.first_contact`): the link check waits
+  for the vehicle to answer at all. A capture's first lines are judged like any other.
 * **A faulty line** (module :mod:`.observer`, "a faulty line"): an answer whose replies the line
   may have spoilt (a broken run came while it waited), or that came later than its window (a
   stall of the line can hold it), is *held*: what it would book goes to the repetition rule
@@ -252,7 +256,9 @@ class Answers:
         allowance = ack_allowance(window, len(p.raw), replies, self.baud, self.res, self.jitter)
         dt = t - p.t
         verdict = "fail" if late else ack_verdict(dt, allowance, window, self.res, self.jitter)
-        if late and p.late_booked:
+        if p.first_contact and not late:
+            pass  # the first answer of a vehicle not heard from yet (still starting): not timed
+        elif late and p.late_booked:
             pass  # RH-ACK-2 was booked when the give-up deadline passed
         elif verdict == "fail":
             why = self._late_text(p, dt)
@@ -279,6 +285,8 @@ class Answers:
         if p.branched:  # already in the mirror, unanswered: judge the late answer's content only
             self._late_answer(p, a, observed, ev)
             return verdict == "pass" and not late
+        if self.held is not None and not isinstance(p.kind.item, s.OSD):
+            self._settle(None, False, [])  # another command before any report: both stay named
         # RH-RD-15: the command took effect the instant its ACK went out, which its arrival bounds
         # (less the replies' transmit time), however long the vehicle took to answer
         took = min(dt, transmit_time(replies, self.baud))
@@ -317,6 +325,8 @@ class Answers:
             if res.desync:
                 self.book("inconclusive", cands, f"{what} — not judged: the observer lost track of the "
                                                  f"vehicle's state before ({res.desync})", ev, at=p, stated=stated)
+            elif res.ignored:  # or the command before it was not carried out: the next report says
+                self._hold(p, cands, res.ignored, what, ev)
             else:
                 self.book("fail", cands, what, ev, at=p, stated=stated)
         for tt, verdict, reason in res.timings:
@@ -416,6 +426,8 @@ class Answers:
         t_from = max(p.t, t - transmit_time(len(evd.text) + 2, self.baud))
         self._bound_oxflt(p, t_from)
         res = self.beliefs.osi(osi, self.v(t_from), self.v(t), self.slack_v())
+        if self.held is not None:
+            self._settle(res.ignored, not res.findings, ev)
         if res.findings:
             named = tuple(dict.fromkeys(c for c, _ in res.findings if c != "RH-OUT-4"))  # a field's own clause
             cands = (("RH-OUT-4",) + named + tuple(c for c in res.causes if c != "RH-OUT-4" and c not in named)

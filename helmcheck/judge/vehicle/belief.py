@@ -14,7 +14,8 @@ what was adopted to explain the wire), most plausible first (fewest unseen event
   got there (:func:`~.closure.reachable`); an ``$OSD`` that every candidate can only have met
   in one state is answered in place, not on copies (it changes no state; ``_poll``). The
   candidates whose answer is the vehicle's survive.
-  When none does, unseen events that change the answer are tried (:func:`~.closure.explain_reply`);
+  When none does, unseen events that change the answer are tried (:func:`~.closure.explain_reply`,
+  for every candidate);
   when that fails too, the answer is a finding, and the observer follows the nominal state marked
   *desynchronised* until a state that is known again (an accepted ``$OMSTOP`` or ``$OMSTART``).
 * :meth:`Beliefs.osi` — an ``$OSI`` produced between ``v_sent`` and ``v_recv``. The candidates
@@ -26,6 +27,14 @@ what was adopted to explain the wire), most plausible first (fewest unseen event
   (:class:`~.candidate.Timed`, :mod:`.brackets`), and the ``$OSI``'s position, speed and depth
   become the plant snapshot (GPS fix and surface rules, ``$OPK`` distance) — not the depth during
   the ascent, where reaching the surface is an event to be adopted.
+
+An accepted command that changes the mode is *unconfirmed* until the next ``$OSI``: nothing on the
+wire shows yet that the vehicle carried it out. When the next command's answer is one no candidate
+gives but the state before that command gives (``$OMSTOP,0`` accepted, then an ``$OLOGL`` refused
+as a running vehicle refuses it), the evidence names two faults, either of which explains it: the
+answer, or the command before it not carried out. :attr:`CommandResult.ignored` says so, and the
+next report tells them apart (:attr:`OsiResult.ignored`: whether the state of a vehicle that did
+not carry it out explains that report).
 
 Decision (spec open): at most :data:`CAP` candidates are kept; beyond, the least plausible go.
 """
@@ -52,6 +61,9 @@ from .sent import brief
 __all__ = ["Beliefs", "CommandResult", "OsiResult", "CAP"]
 
 CAP = 6
+#: Commands that may set a timer going when accepted (their ACK instant's uncertainty is the
+#: timer's, :attr:`Beliefs.arm_v`); a refused one, or any other, sets none going.
+_ARMING = frozenset({s.OMS, s.OMP, s.OPK, s.OMW, s.ODVL, s.OJW, s.OMSTART, s.OMSTARTPaper, s.OXFLT})
 #: Command events the lockout refuses (err 26) and the ascent does not: their answer tells them apart.
 _LOCK_ONLY = LOCKOUT_REFUSED - ASCENT_REFUSED
 
@@ -68,6 +80,9 @@ class CommandResult:
     mission_dependent: bool = False  #: the answer depends on mission files the observer lacks
     desync: str = ""  #: why the state was already unknown (findings are then INCONCLUSIVE)
     timings: list = field(default_factory=list)  #: (Timed, verdict, reason): the lockout's end
+    #: (command, row, ACK) of the accepted command before this one, with no report between, whose
+    #: not being carried out explains this answer too (module docstring); () when none does
+    ignored: tuple = ()
 
 
 @dataclass(slots=True)
@@ -81,6 +96,9 @@ class OsiResult:
     desync: str = ""
     causes: tuple = ()  #: clauses of what changed since the last confirmed report (for blame)
     own: set = field(default_factory=set)  #: clauses this report passes by their own evidence
+    #: after a :attr:`CommandResult.ignored` answer: whether the state of a vehicle that did not
+    #: carry out the command before it explains this report (None: no such question)
+    ignored: Optional[bool] = None
 
 
 class Beliefs:
@@ -93,13 +111,18 @@ class Beliefs:
         self.cands: list[Candidate] = [Candidate(VehicleModel(profile, catalog))]
         #: why the vehicle's state is not known (findings are INCONCLUSIVE until it is again)
         self.desync = "the record begins with the vehicle's state unknown"
-        #: vehicle seconds: the widest window in which a command that may arm a timer went into
-        #: effect since the state was last known (RH-RD-15: its ACK going out, which the ACK's
-        #: arrival less the replies' transmit time bounds). An ``$OSD`` arms nothing, so its data's
-        #: transmit time does not widen the timing of anything.
+        #: vehicle seconds: the widest window in which an accepted command that may arm a timer
+        #: (:data:`_ARMING`) went into effect since the state was last known (RH-RD-15: its ACK
+        #: going out, which the ACK's arrival less the replies' transmit time bounds). A refused
+        #: command, an ``$OSD`` or any other arms nothing: their answers' timing widens nothing.
         self.arm_v = 0.0
         #: the last ``$OSI`` and the vehicle second it arrived (its depth is read only when needed)
         self.last_osi: Optional[tuple[s.OSI, float]] = None
+        #: (the primary candidate before it, command, row, ACK) of the last accepted command that
+        #: changed the mode, while no report has come since (module docstring)
+        self.unconfirmed: Optional[tuple] = None
+        #: the state of a vehicle that did not carry that command out, after the answer it explains
+        self.ignoring: Optional[Candidate] = None
 
     @property
     def primary(self) -> Candidate:
@@ -109,12 +132,21 @@ class Beliefs:
     def command(self, item, v: float, slack_v: float, observed: list) -> CommandResult:
         """Feed an answered command (module docstring); ``observed`` is the vehicle's replies."""
         desync = self.desync
-        if type(item) is not s.OSD:
-            self.arm_v = max(self.arm_v, slack_v)
+        ack = observed[-1] if observed and isinstance(observed[-1], s.ACK) else None
+        if type(item) in _ARMING and (ack is None or ack.status == 0):
+            self.arm_v = max(self.arm_v, slack_v)  # it may have set a timer going (RH-RD-15)
         if type(item) is s.OSD:
             result = self._poll(item, v, slack_v, observed, desync)
             if result is not None:
                 return result
+            prev = self.unconfirmed
+        else:
+            prev, self.unconfirmed, self.ignoring = self.unconfirmed, None, None
+        before = None
+        if type(item) is not s.OSD and not isinstance(item, SentenceError):
+            r = self.cands[0].model.row_for(item)
+            if r is not None and r.error is None and (r.target != STAY or r.phase_to is not None):
+                before = self.cands[0].clone()  # the state it leaves, until a report confirms it
         options = []
         for c in self.cands:
             options += branches(c, item, v, slack_v, self.catalog)
@@ -127,20 +159,22 @@ class Beliefs:
             chosen = match[0]
             result = CommandResult(chosen[1], True, chosen[2], chosen[3], chosen[0].story[base:], False, desync)
         else:
-            found = None
+            explanations = []  # each candidate's own (they may differ in what no report shows yet)
             for c in self.cands:
                 tp = c.seen_v if c.seen_v is not None else (c.model.now or v)
-                found = explain_reply(c, item, v, observed, tp, self.catalog, self.profile.gps_fix_depth_m)
-                if found is not None:
-                    break
-            if found is not None:
-                cand, replies, mission_dep = found
+                got = explain_reply(c, item, v, observed, tp, self.catalog, self.profile.gps_fix_depth_m)
+                if got is not None:
+                    explanations.append(got)
+            if explanations:
+                cand, replies, mission_dep = explanations[0]
                 base = len(self.cands[0].story)
-                self._keep([cand])
+                self._keep([e[0] for e in explanations])
                 result = CommandResult(replies, True, nominal[2], nominal[3], cand.story[base:], mission_dep,
                                        desync)
             else:
                 result = CommandResult(nominal[1], False, nominal[2], nominal[3], (), False, desync)
+                if prev is not None:
+                    result.ignored = self._ignored(prev, item, v, observed)
                 want = nominal[1][-1] if nominal[1] and isinstance(nominal[1][-1], s.ACK) else None
                 got = observed[-1] if observed and isinstance(observed[-1], s.ACK) else None
                 if got is not None and got.status == 1:
@@ -162,7 +196,25 @@ class Beliefs:
                         self.desync = (f"the vehicle answered {brief(observed)} where a conforming "
                                        f"vehicle answers {brief(nominal[1])}")
         self._after_command(item, observed, v, slack_v, result)
+        ack = observed[-1] if observed and isinstance(observed[-1], s.ACK) else None
+        row = result.row
+        if (before is not None and result.matched and ack is not None and ack.status == 0 and row is not None
+                and (row.target != STAY or row.phase_to is not None)):
+            self.unconfirmed = (before, item, row, ack)
         return result
+
+    def _ignored(self, prev: tuple, item, v: float, observed: list) -> tuple:
+        """(command, row, ACK) of ``prev`` (:attr:`unconfirmed`) when the state before it answers
+        ``item`` as the vehicle did (the vehicle may not have carried it out); else ()."""
+        before, cmd, row, ack = prev
+        c = before.clone()
+        c.model.advance(v)
+        replies = c.model.receive(item, v)
+        c.drain()
+        if reply_keys(replies) != reply_keys(observed):
+            return ()
+        self.ignoring = c
+        return (cmd, row, ack)
 
     def _poll(self, item: s.OSD, v: float, slack_v: float, observed: list, desync: str
               ) -> Optional[CommandResult]:
@@ -274,6 +326,9 @@ class Beliefs:
         v = (v_sent + v_recv) / 2
         slack = (v_recv - v_sent) / 2 + slack_v + self.arm_v
         self.last_osi = (osi, v_recv)
+        self.unconfirmed = None
+        ignoring, self.ignoring = self.ignoring, None
+        ignored = None if ignoring is None else not ignoring.check(osi, v, slack)
         for c in self.cands:
             if c.code_unknown and osi.error_state != "N" and c.model.phase != "none":
                 c.model.error_state = osi.error_state
@@ -281,16 +336,15 @@ class Beliefs:
         if self.desync and self._adopt(osi, v_sent):
             self.desync = ""
         explained = [c for c in self.cands if not c.check(osi, v, slack)]
-        result = OsiResult(desync=self.desync)
+        result = OsiResult(desync=self.desync, ignored=ignored)
         if not explained:
             fix = self.profile.gps_fix_depth_m
             for c in self.cands:
                 tp = c.seen_v if c.seen_v is not None else (c.model.now or v_sent)
                 got = explain_osi(c, osi, v, slack, tp, self.catalog, fix, self.profile.depth_unit)
-                if got is not None:
-                    explained.append(got)
-                    result.adopted = got.story[len(c.story):]
-                    break
+                if got is not None:  # each candidate's own explanation: they differ in what no
+                    explained.append(got)  # report shows (a mission frozen in N or in P)
+                    result.adopted = result.adopted or got.story[len(c.story):]
         if not explained:
             p = self.primary
             result.findings = p.check(osi, v, slack)
@@ -366,6 +420,9 @@ class Beliefs:
                 causes.insert(0, "RH-SAF-2")
             if osi.mode == p.model.mode:  # the mode is right: a countdown is what differs
                 causes += {"mP": ["RH-PK-2"], "W": ["RH-OMW-4"]}.get(osi.mode, [])
+            if (p.resumed and osi.mode == p.model.mode == "P"
+                    and all(f.field == "park_time" for f in result.findings)):
+                causes.insert(0, "RH-INT-2")  # a park resumed after remote control: its time left
             if p.timed or any(tt for tt in (p.model.timer(),) if tt is not None and abs(tt[0] - v) <= 2 * tt[1]):
                 causes += ["RH-TIM-1", "RH-TIM-2"]  # a duration was being timed around this report
             result.causes = tuple(dict.fromkeys(c for c in causes if c != "RH-OUT-4"))

@@ -11,6 +11,19 @@ never their values) and keeps, besides the model, what judging needs and the mod
   started inside the window is left — nor one that did and was frozen and resumed since (a mission
   park frozen by remote control resumes with what was left of it, which the window's uncertainty
   still has: ``carried``, RH-INT-2, RH-RD-5);
+* ``left_v`` / ``release`` — a mission park resumed after remote control (RH-INT-2) counts from
+  the release with the time that was left when control took over (RH-RD-5), and the observer
+  knows neither exactly: the time left was as uncertain as the park's count was when it froze
+  (``left_v``), and a timer's release (the ``$OPK`` time up, a timeout, the queue's last park)
+  comes anywhere within RH-TIM-1's tolerance of the timer, itself as uncertain as its start. So
+  a release that resumes a park opens a window on the park's start that wide (:meth:`_resumed`;
+  ``release``: the release's model time and the time left's part of the window); the first
+  report that shows the park resumed narrows it, before it is judged, to the moment the reports
+  bracket (:meth:`_bracket_release`), and the park time the reports show narrows it further
+  (:func:`~.brackets.retime`), as for a countdown an adopted event began; ``resumed`` — the
+  mission park counting is one resumed so: a park time no conforming state explains is its time
+  left's (RH-INT-2, for blame), and it may be one that counts only once back on station
+  (``left_known``: how well its time left is known, :func:`~.closure.explain_osi`);
 * ``pending`` — table rows applied since the last confirming ``$OSI``: their clauses pass when an
   ``$OSI`` confirms the state they led to (rows that change nothing visible pass at their ACK);
 * ``timed`` — timer-driven transitions awaiting their RH-TIM-1 bracket (:class:`Timed`);
@@ -28,6 +41,10 @@ never their values) and keeps, besides the model, what judging needs and the mod
   report of the after-state a little before the model's own deadline, within the tolerance,
   leaves the last report of the before-state as the bracket's start), and the last err 26 to a
   command only the lockout refuses;
+* ``noted`` — the moment a plant note (the emulator's own log) says the next mission waypoint was
+  reached, where the observer left that event to the reports because it does not know yet what
+  the waypoint holds: the closure adopts it at that moment, not in a window (until the next
+  confirmed report);
 * ``nav_seen`` / ``fix_seen`` — the latest report of the running mission's distance to its next
   waypoint (``$OSI`` field 7 in ``N`` or ``P`` at that waypoint: mission name, waypoint, metres,
   vehicle time, position, speed) and the latest reported position (earliest and latest vehicle
@@ -43,7 +60,8 @@ from dataclasses import dataclass
 from typing import Optional
 
 from ...model.observe import Finding, quick_check
-from ...model.transitions import STAY, Row
+from ...model.timers import tolerance
+from ...model.transitions import REMOTE_MODES, STAY, Row
 from ...model.vehicle import VehicleModel
 
 __all__ = ["Candidate", "Timed", "sig"]
@@ -91,7 +109,8 @@ class Candidate:
 
     __slots__ = ("model", "events", "story", "extra_v", "window", "pending", "timed", "abandoned",
                  "s_cause", "refused_locked", "seen_v", "seen_mode", "seen_at", "locked_v", "code_unknown",
-                 "refresh", "nav_seen", "fix_seen", "_mode", "_phase", "carried")
+                 "refresh", "nav_seen", "fix_seen", "left_v", "release", "resumed", "left_known", "noted",
+                 "_mode", "_phase", "carried")
 
     def __init__(self, model: VehicleModel):
         if model.trace is None:
@@ -118,6 +137,15 @@ class Candidate:
         self.code_unknown = False
         self.nav_seen: Optional[tuple] = None
         self.fix_seen: Optional[tuple] = None
+        self.left_v = 0.0
+        #: (model time, the time left's part of the window, the window, the last report before
+        #: it) of a timed release
+        self.release: Optional[tuple] = None
+        self.resumed = False  #: the mission park counting is one resumed after remote control
+        self.left_known = 0.0  #: vehicle seconds: how well the time left of a resumed park is known
+        #: vehicle time of a plant note of the next mission waypoint reached that the observer left
+        #: to the reports (what the waypoint holds is not known yet): the closure places it then
+        self.noted: Optional[float] = None
         self._mode = model.mode
         self._phase = model.phase
 
@@ -138,6 +166,8 @@ class Candidate:
         c.seen_at = dict(self.seen_at)
         c.code_unknown = self.code_unknown
         c.nav_seen, c.fix_seen = self.nav_seen, self.fix_seen
+        c.left_v, c.release, c.resumed, c.noted = self.left_v, self.release, self.resumed, self.noted
+        c.left_known = self.left_known
         c._mode, c._phase = self._mode, self._phase
         return c
 
@@ -163,7 +193,7 @@ class Candidate:
         steps, self.model.trace = list(trace), []
         fired = []
         if any(st.row.event == "violation" for st in steps):
-            self._depth_unknown()
+            self._depth_unknown(self._mode)
         for st in steps:
             row = st.row
             before_mode, before_phase = self._mode, self._phase
@@ -183,18 +213,80 @@ class Candidate:
                     t_old = self.seen_at[before_mode]
                 self.timed.append(Timed(st.timer, row, st.at, st.duration, before_mode, t_old, self.extra_v))
             self._book(row, before_mode, before_phase)
+            if row.error is None:
+                self._resumed(st, before_mode)
         return fired
 
-    def _depth_unknown(self) -> None:
-        """A violation came: the depth the mirror has is the last report's, from before it, and the
-        vehicle may have gone down since (a mission's dive). During the lockout it holds that unseen
-        depth (RH-RD-11), so whether it is at the surface when the lockout ends (RH-SAF-4 at once, or
-        the ascent first) is for a report to show: the surface is then adopted (:mod:`.closure`),
-        never assumed from a depth read before the violation."""
+    def _depth_unknown(self, before: str) -> None:
+        """A violation came: the depth the mirror has is the last report's, from before it, and a
+        vehicle that was heading down (a remote control, or a mission whose next waypoint is under
+        water) may have gone down since. During the lockout it holds that unseen depth (RH-RD-11), so
+        whether it is at the surface when the lockout ends (RH-SAF-4 at once, or the ascent first) is
+        then for a report to show: the surface is adopted (:mod:`.closure`), never assumed from a
+        depth read before the violation. A vehicle stopped, or on a surface leg, stays where it was."""
         m = self.model
         fix = m.profile.gps_fix_depth_m
-        if m.phase == "lockout" and m.snapshot.depth_m <= fix:
+        if m.phase != "lockout" or m.snapshot.depth_m > fix:
+            return
+        diving = before in ("A", "M", "W", "mP")
+        if before in ("N", "P") and m.mission is not None:
+            # without the vehicle's mission files (a catalogue that learns, :mod:`.catalog`) the
+            # waypoint's depth is not known: it may be diving too
+            diving = (getattr(m.missions, "learns", True) or m.mission.is_open
+                      or not 0 <= m.mission_wp < len(m.mission.waypoints)
+                      or m.mission.waypoints[m.mission_wp].depth > fix)
+        if diving:
             m.update_plant(m.snapshot.with_(depth_m=fix + 1e-3))
+
+    def _resumed(self, st, before_mode: str) -> None:
+        """A mission park frozen by remote control, or resumed by its release (module docstring)."""
+        row = st.row
+        if before_mode == "P" and row.target in REMOTE_MODES:
+            self.left_v = self.extra_v if self.window is not None else 0.0
+            self.release, self.resumed = None, False
+            return
+        if row.target != "P" or before_mode not in REMOTE_MODES:
+            if row.target not in (STAY, "P"):
+                self.resumed = False
+            return
+        t = self.model.timers
+        start = (t.deadline("park") or 0.0) - (t.duration("park") or 0.0)
+        if not t.armed("park") or abs(start - st.at) > 1e-6:
+            return
+        self.resumed = True
+        left, self.left_v = self.left_v, 0.0
+        self.left_known = left
+        half = left + (tolerance(st.duration) + self.extra_v if st.timer else 0.0)
+        if half > 0:
+            self.window = (st.at - half, st.at + half)
+            self.extra_v = half
+            timed = self.timed[-1] if self.timed and self.timed[-1].deadline == st.at else None
+            self.release = (st.at, left, self.window, timed.t_old if timed else None) if st.timer else None
+
+    def _bracket_release(self, v: float, slack_v: float) -> None:
+        """A report made by ``v`` (± ``slack_v``) shows the park resumed by the timed release
+        :attr:`release`: the release came after the last report of the state before it and
+        before this one, and the resumed park's start is that moment less or more the
+        uncertainty of the time left (module docstring). Where the start was already narrowed
+        by the park time shown (:func:`~.brackets.retime`, when this is not the first report
+        after the release) outside of that, it goes back inside: the count shown does not fit
+        any release the reports allow, and is judged so."""
+        at, left, (lo0, hi0), t_old = self.release  # type: ignore[misc]
+        self.release = None
+        t = self.model.timers
+        if self.window is None or not t.armed("park"):
+            return
+        t_old = next((tt.t_old for tt in self.timed if abs(tt.deadline - at) <= 1e-6), t_old)
+        lo = max(lo0, (t_old if t_old is not None else lo0) - slack_v - left)
+        hi = min(hi0, v + slack_v + left)
+        if lo > hi:
+            return  # the reports contradict the window (judged as they are)
+        lo_w, hi_w = self.window
+        if max(lo, lo_w) <= min(hi, hi_w):
+            lo, hi = max(lo, lo_w), min(hi, hi_w)
+        t.arm("park", (lo + hi) / 2, t.duration("park") or 0.0)
+        self.window = (lo, hi)
+        self.extra_v = (hi - lo) / 2
 
     def _book(self, row: Row, before_mode: str, before_phase: str) -> None:
         if row.error is not None:
@@ -221,12 +313,15 @@ class Candidate:
 
     # ------------------------------------------------------------------ questions
     def check(self, osi, v: float, slack_v: float) -> list[Finding]:
-        """``[]`` when this candidate explains ``osi`` at ``v`` (RH-OUT-4, RH-TIM-1)."""
+        """``[]`` when this candidate explains ``osi`` at ``v`` (RH-OUT-4, RH-TIM-1); a report
+        that shows a resumed park first narrows when its count began (:meth:`_bracket_release`)."""
+        if self.release is not None and osi.mode == "P" and self.model.mode == "P":
+            self._bracket_release(v, slack_v)
         return quick_check(self.model, osi, v, slack_v + self.extra_v)
 
     def saw(self, v: float, mode: str) -> None:
         """A confirmed ``$OSI`` showed ``mode``, sent at vehicle time ``v``."""
-        self.seen_v, self.seen_mode = v, mode
+        self.seen_v, self.seen_mode, self.noted = v, mode, None
         self.seen_at[mode] = v
 
     def lapse_uncertainty(self) -> None:

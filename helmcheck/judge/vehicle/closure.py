@@ -5,9 +5,11 @@ an ``$OPK`` position or a queued ``$OMW`` waypoint, the surface after a lockout,
 tripping by itself (RH-SAF-5), the end of a mission of unknown length. The observer adopts such
 an event for a candidate state only when a report cannot be explained without it, and places it
 in an explicit **time window**: it happened after ``tp`` (the last observation that showed it had
-not, or the model's last input) and before the report that reveals it. The event is applied at
-the window's start and the window's width is carried as extra slack on every timer it started
-(:class:`~.candidate.Candidate`), so any moment in the window is accepted.
+not, or the model's last input) and before the report that reveals it — or at ``tp`` exactly,
+where the emulator's own log has a plant note of that waypoint reached
+(:attr:`~.candidate.Candidate.noted`). The event is applied at the window's start and the
+window's width is carried as extra slack on every timer it started (:class:`~.candidate.Candidate`),
+so any moment in the window is accepted.
 
 :func:`explain_osi` tries, in order of plausibility (fewest events first), the events that fit
 the candidate's mode, and keeps the first that explains the ``$OSI``:
@@ -24,7 +26,10 @@ the candidate's mode, and keeps the first that explains the ``$OSI``:
                        after waypoints passed (learnt when none passed)
 ``mission end``        ``S`` where only the end of a mission of unknown length explains it
 ``on station``         ``mP``: the ``$OPK`` countdown starts; ``W``: the queued waypoint is
-                       reached (×n for the queue)
+                       reached (×n for the queue); ``P``: a mission park resumed after remote
+                       control, held until back on station (RH-INT-2), counts from then
+``resumed park held``  ``P``: a mission park resumed after remote control counts only once
+                       back on station at its waypoint (RH-INT-2's other reading)
 =====================  ===================================================================
 
 :func:`explain_reply` does the same for an ``$ACK`` the candidate cannot explain, with the events
@@ -54,6 +59,9 @@ __all__ = ["explain_osi", "explain_reply", "same_replies", "reply_keys", "MAX_WA
 
 #: The most mission (or queue) waypoints the observer assumes passed between two reports.
 MAX_WAYPOINTS = 8
+#: The trials of one mission waypoint reached, what it holds learnt: the event a plant note gives
+#: the moment of when the observer left it to the reports (:attr:`~.candidate.Candidate.noted`).
+_NOTED = ("mission waypoint reached", "a mission park", "the mission's end")
 _FT = 0.3048
 _SAFETY = frozenset(SAFETY_CODES)
 
@@ -135,6 +143,9 @@ def explain_osi(c: Candidate, osi: s.OSI, v: float, slack_v: float, tp: float, c
         if ok(trial, early):
             if learn is not None:
                 learn()
+            if n == 1 and c.noted == tp and name.startswith(_NOTED):
+                # the emulator's own note says when: the waypoint was reached then, at the window's start
+                return trial.adopted(f"{name} at v={tp:.1f} (the plant's note)", tp, tp, n)  # type: ignore[union-attr]
             return trial.adopted(f"{name} between v={seen - early:.1f} and v={v:.1f}", seen - early, v, n)  # type: ignore[union-attr]
         return None
 
@@ -262,6 +273,8 @@ def _motion_trials(c: Candidate, osi: s.OSI, tp: float, gap: float, catalog, v: 
             out = [(name, not_past(build), n, learn) for name, build, n, learn in out]
     elif m.mode == "P" and m.mission is not None and osi.mode == "S":
         out += _park_and_end(c, osi, tp, gap, catalog)
+    elif m.mode == "P" and osi.mode == "P" and m.mission is not None and c.resumed:
+        out += _resumed_park(c, osi, tp)
     elif m.mode == "mP":
         from ...model.timers import tolerance
         prof = m.profile
@@ -302,6 +315,41 @@ def _motion_trials(c: Candidate, osi: s.OSI, tp: float, gap: float, catalog, v: 
             for j in (1, 2):
                 out.append((f"the queue done, then {j} mission waypoint(s) reached", then_mission(j), whole + j,
                             None))
+    return out
+
+
+def _resumed_park(c: Candidate, osi: s.OSI, tp: float) -> list:
+    """A mission park resumed after remote control (RH-INT-2) that counts only once back on
+    station at its waypoint — the reading the profile leaves beside counting at once
+    (:meth:`~helmcheck.model.vehicle.VehicleModel.await_park_station`): the count held at the time
+    left (where the report shows it, within what the observer knows of that time:
+    :attr:`~.candidate.Candidate.left_known`); then on station there, as for the ``$OPK`` park
+    (field 7 at most ``on_station_m`` plus the way it can have drifted while its count ran)."""
+    from ...model.timers import tolerance
+    m = c.model
+    out: list = []
+    shown = float(osi.park_time)
+    if not m.park_waiting and m.timers.armed("park"):
+        def hold(t: Candidate) -> Optional[Candidate]:
+            if not t.model.await_park_station():
+                return None
+            left, u = t.model.park_left or 0.0, c.left_known
+            if left < shown - 1.0 - u or left > shown + u:
+                return None  # not the time that was left (RH-INT-2)
+            t.model.park_left = min(max(left, shown - 1.0 + 1e-6), shown)  # field 10 rounded up
+            t.left_known = 0.0
+            return t
+        out.append(("the resumed mission park waiting to be back on station", hold, 1, None))
+    elif m.park_waiting:
+        prof = m.profile
+        left = m.park_left or 0.0
+        knots = max([prof.max_speed_kn, float(osi.speed)] + [x[-1] for x in (c.nav_seen, c.fix_seen) if x is not None])
+        counted = max(0.0, left - shown) + 1.0 + tolerance(left)
+        if float(osi.distance) <= prof.on_station_m + knots * KNOT_MPS * counted:
+            def on_station(t: Candidate) -> Candidate:
+                t.model.plant(OnStation(), tp)
+                return t
+            out.append(("on station at the mission park's waypoint", on_station, 1, None))
     return out
 
 

@@ -84,6 +84,8 @@ class Deadlines:
         never to a later command."""
         p.state = "missing"
         p.waited = ack_give_up_after(allowance)
+        if p.first_contact:
+            return  # a vehicle not heard from yet (still starting up): not judged (answers.py)
         self.gave_up.append(p)
         if not p.branched:
             # it may have been acted on, its answer lost: both stay candidates (as for a command a

@@ -32,7 +32,10 @@
 
 Notes it acts on (:mod:`helmcheck.judge.wire`): ``case``/``case … end`` (attribution; a case's
 end concludes what it held), ``not tested``/``inconclusive`` (tester facts), ``link:``
-(RH-FRM-9), ``plant:`` and ``fault injected`` (exact plant events from an emulator's own log),
+(RH-FRM-9), ``plant:`` and ``fault injected`` (exact plant events from an emulator's own log: applied after a report asked
+for before them and still on its way, which shows the state before them; a mission waypoint
+reached whose park or end the observer has not learnt is left to the reports, from the note's
+moment on),
 ``line fault …`` and ``relay started:`` (a line-fault relay's record).
 
 A driver reads, besides the ledger: :attr:`sent` (every classified backseat line, with its
@@ -60,7 +63,7 @@ from ..wire import FROM_VEHICLE, LINE_CACHE, NOTE, TO_VEHICLE, Decodings, WireEv
 from . import osichecks
 from .belief import Beliefs
 from .answers import Answers
-from .blame import targets
+from .blame import command_clauses, targets
 from .catalog import GivenMissions, KnownMissions
 from .deadlines import Deadlines
 from .lines import PREFIX_REPEAT, Kind, OutputJudge, classify
@@ -152,6 +155,10 @@ class VehicleObserver(Answers, Deadlines):
         self.aborted = ""
         #: (mode before, command ID) of every accepted control command in a remote mode (coverage)
         self.interrupt_pairs: set = set()
+        #: an answer that names two faults, held until a report tells them apart (:meth:`_hold`)
+        self.held: Optional[tuple] = None
+        #: plant notes waiting for a report on its way to be judged first (:meth:`_note`)
+        self.notes_held: list = []
 
     # ------------------------------------------------------------------ helpers
     def v(self, t: float) -> float:
@@ -206,6 +213,37 @@ class VehicleObserver(Answers, Deadlines):
         due, dur, nm = got
         return due / self.k, dur, nm
 
+    # ------------------------------------------------------------------ an answer naming two faults
+    def _hold(self, p: Sent, cands: tuple, ignored: tuple, what: str, ev: list) -> None:
+        """An answer no conforming state gives, which the state before the accepted command just
+        before it gives (:attr:`~.belief.CommandResult.ignored`): either the answer is wrong, or
+        that command was not carried out. Held until the next report tells them apart
+        (:meth:`_settle`)."""
+        cmd, row, ack = ignored
+        q = next((q for q in reversed(self.sent) if q.kind.item is cmd and q is not p), None)
+        self.held = (p, cands, command_clauses(cmd, ack, row), what, ev,
+                     text_of(q) if q is not None else f"${cmd.ID}", [q.ev] if q is not None else [])
+
+    def _settle(self, ignored: Optional[bool], explained: bool, report: list) -> None:
+        """Book the held answer: on its own clauses when the next report shows the command before
+        it carried out (the mirror explains the report, a vehicle that did not carry it out does
+        not); on that command's clauses when the report shows it not carried out; on both when
+        the report tells nothing apart, or none comes before another command or the record's end."""
+        p, cands, other, what, ev, text, before_ev = self.held  # type: ignore[misc]
+        self.held = None
+        if ignored and not explained:
+            self.book("fail", other, f"{text} was accepted but not carried out: the next report shows the state "
+                                     f"before it, and {what} — as that state answers", before_ev + ev + report, at=p)
+        elif explained and ignored is False:
+            self.book("fail", cands, what, ev, at=p)
+        else:
+            self.book("fail", cands, f"{what}; or else {text} before it, accepted with no report between, was not "
+                                     f"carried out (the state before it answers so): no report tells which",
+                      before_ev + ev, at=p)
+            self.book("fail", other, f"{text}, accepted, may not have been carried out: {what}, as the state before "
+                                     f"it answers; or else that answer is wrong: no report tells which",
+                      before_ev + ev, at=p)
+
     # ------------------------------------------------------------------ input
     def feed(self, ev: WireEvent) -> None:
         self._advance(ev.t)
@@ -216,6 +254,8 @@ class VehicleObserver(Answers, Deadlines):
             self.vbytes += len(ev.data)
             for fe in self._frame(FROM_VEHICLE, ev.data):
                 self._vehicle(fe, ev)
+            if self.notes_held:
+                self._release_notes()
         elif ev.dir == NOTE:
             self._note(ev)
 
@@ -296,10 +336,50 @@ class VehicleObserver(Answers, Deadlines):
                     event = cls(**kwargs)
                 except TypeError:
                     return
-            for c in self.beliefs.cands:
+            # a report asked for before the event, still on its way, shows the state before it (the
+            # vehicle answers an $OSD when it processes it): the event waits until it is judged
+            asked = next((q for q in self.pending if q.kind.ack_type == 8 and q.osi is None
+                          and "S" in getattr(q.kind.item, "requested", ())), None)
+            if asked is not None:
+                self.notes_held.append((event, v, ev, asked))
+            else:
+                self._plant_note(event, v, ev)
+
+    def _plant_note(self, event, v: float, ev: WireEvent) -> None:
+        """A plant event from a note, at vehicle time ``v``, to every candidate."""
+        for c in self.beliefs.cands:
+            if isinstance(event, P.WaypointReached) and self._unknown_waypoint(c.model, event.index):
+                # what the waypoint holds is learnt from the reports (the closure), in a window
+                # that begins when the note says it was reached: the model is brought to then
+                c.model.advance(max(v, c.model.now or 0.0))
+                c.noted = c.model.now
+            else:
                 c.model.plant(event, max(v, c.model.now or 0.0))
-                c.drain()
-            self.event(ev.t, "lockout" if isinstance(event, P.SafetyViolation) else "note", ev.note[:80])
+            c.drain()
+        self.event(ev.t, "lockout" if isinstance(event, P.SafetyViolation) else "note", ev.note[:80])
+
+    def _release_notes(self, all_: bool = False) -> None:
+        """Plant notes held for a report on its way (:meth:`_note`), once it has come (or gone)."""
+        while self.notes_held:
+            event, v, ev, asked = self.notes_held[0]
+            if not all_ and asked.osi is None and any(q is asked for q in self.pending):
+                return
+            self.notes_held.pop(0)
+            self._plant_note(event, v, ev)
+
+    def _unknown_waypoint(self, m, index: Optional[int]) -> bool:
+        """Whether reaching mission waypoint ``index`` (the next one when None) does what the
+        observer does not know yet: a mission learnt from the reports (no mission files given)
+        whose park at that waypoint, or whose length, has not been seen. A plant note of such a
+        waypoint reached is left to the reports, which the closure learns it from (as in a log
+        without notes); applied, it would take the waypoint as holding nothing."""
+        run = m.mission
+        if run is None or m.mode != "N":
+            return False
+        entry = self.missions.entry(run.name)
+        if entry is None:
+            return False  # the mission files were given (or the name is unknown: nothing to learn)
+        return run.is_open or not entry.park_known(m.mission_wp if index is None else index)
 
     # ------------------------------------------------------------------ backseat lines
     def _backseat(self, fe, ev: WireEvent) -> None:
@@ -323,6 +403,9 @@ class VehicleObserver(Answers, Deadlines):
         sent = Sent(self.seq, ev.t, raw, self._evidence(ev, raw, ">"), k, self.case, self.case_clauses,
                     self.vbytes)
         sent.mark = self.streaks.mark()
+        # a tester that opened the link (its ``link:`` note) probes a vehicle that may still be
+        # starting: its lines before the first answer are not timed (answers.py); a capture's are
+        sent.first_contact = self.alive_t is None and self.link_baud is not None
         self.sent.append(sent)
         if k.kind in ("command", "error"):
             if self.first_command_t is None:
@@ -494,6 +577,9 @@ class VehicleObserver(Answers, Deadlines):
         state is unknown again (taken from the next report that shows it whole, as at the start of
         a record), and the run is no longer ended early."""
         t = ev.t
+        if self.held is not None:
+            self._settle(None, False, [])
+        self.notes_held = []
         self.framers = {TO_VEHICLE: Framer(self.profile.max_line_bytes),  # a line cut by the
                         FROM_VEHICLE: Framer(max(4096, 4 * self.profile.max_line_bytes))}  # stop is nobody's
         for p in list(self.pending) + self.dead:
@@ -548,6 +634,9 @@ class VehicleObserver(Answers, Deadlines):
         self._junk_settle(False)
         self.streaks.conclude("the record ended before it was made again")
         self._mission_unshown("the record ended")
+        self._release_notes(all_=True)
+        if self.held is not None:
+            self._settle(None, False, [])
         self.checks.close()
         if self.ledger.holding:
             self.ledger.release(False, "not confirmed: the record ended before the re-runs")

@@ -21,7 +21,8 @@ A report carries more, and these checks use it:
   reports itself within ``on_station_m`` of its target for longer than
   :data:`~helmcheck.judge.timing.PLANT_REACT_S` (+ RH-TIM-1 tolerance and slack) without acting
   fails the clause of the act it owes: the queued waypoint (RH-OMW-4), the mission's end at its
-  last waypoint (RH-MSN-4; a waypoint of a mission of unknown length: RH-OUT-4);
+  last waypoint (RH-MSN-4; a waypoint of a mission of unknown length: RH-OUT-4), a mission park
+  resumed after remote control that counts only once back on station (RH-INT-2);
 * **the ``$OMW`` queue's order** (field 7 in ``W``, RH-OMW-2): :mod:`.queuetarget`;
 * **the way made** (fields 4, 5, 6 and 7): every report's position, and field 7 in ``N``/``P`` at
   the mission's next waypoint, are kept on the mirror's candidates (``fix_seen``, ``nav_seen``)
@@ -32,7 +33,9 @@ A report carries more, and these checks use it:
   longer than the same allowance without taking it fails RH-SAF-4;
 * **``$OPOS``** (RH-POS-2): a candidate that applied an accepted ``$OPOS`` position keeps it as
   its latest position (``fix_seen``) and forgets the distance it last reported (``nav_seen``): it
-  moved there at once. After an accepted ``$OPOS`` the next report's position is where the
+  moved there at once (and the ``$OMW`` queue's heads forget where they were last seen,
+  :meth:`~.queuetarget.QueueTarget.moved`, as the ``$OPK`` park forgets the reports that showed
+  the vehicle away from its position). After an accepted ``$OPOS`` the next report's position is where the
   mirror says (moved to the given position without a GPS fix, not moved with one) — judged only
   when the two readings are far enough apart to tell; every later ``$OCTD`` shows the
   conductivity and temperature it gave;
@@ -45,6 +48,7 @@ A report carries more, and these checks use it:
 
 from __future__ import annotations
 
+import math
 from decimal import Decimal, InvalidOperation
 from typing import Optional
 
@@ -69,9 +73,10 @@ _ENDS_PARK = (s.OMS, s.OMP, s.OMW, s.OMWClear, s.OJW, s.OMSTOP, s.OMSTART, s.OMS
 class _OpkPark:
     """An accepted ``$OPK`` (RH-PK-2): its park seconds, when it was sent (vehicle seconds), the
     reports that showed the vehicle away from its position ``(earliest, latest, metres)``, the
-    fastest the vehicle can go (knots), when it was first reported on station."""
+    ``$OPOS`` positions applied since (RH-POS-2: each moved it at once), the fastest the vehicle
+    can go (knots), when it was first reported on station."""
 
-    __slots__ = ("seconds", "v0", "away", "knots", "on", "passed", "failed")
+    __slots__ = ("seconds", "v0", "away", "knots", "on", "passed", "failed", "jumps")
 
     def __init__(self, seconds: int, v0: float):
         self.seconds, self.v0 = seconds, v0
@@ -79,6 +84,30 @@ class _OpkPark:
         self.knots = 0.0
         self.on: Optional[float] = None
         self.passed = self.failed = False
+        #: (earliest, latest) vehicle seconds of each ``$OPOS`` position applied since (RH-POS-2):
+        #: the vehicle was moved at once, so a report on one side says nothing of the other
+        self.jumps: list[tuple[float, float]] = []
+
+    def moved(self, early: float, late: float) -> None:
+        self.jumps.append((early, late))
+
+    def possible(self, begin: tuple[float, float], radius: float) -> bool:
+        """:func:`_possible` for each stretch between the moves (:attr:`jumps`), with the reports
+        of that stretch: whether the vehicle can have been on station at some moment of ``begin``."""
+        mps = self.knots * KNOT_MPS
+        cuts = [-math.inf] + [j for jump in self.jumps for j in jump] + [math.inf]
+        for i in range(0, len(cuts), 2):
+            a, b = cuts[i], cuts[i + 1]  # a stretch with no move inside it
+            part = (max(begin[0], a), min(begin[1], b))
+            if part[0] > part[1] + 1e-9:
+                continue
+            away = [x for x in self.away if a <= x[0] and x[1] <= b]
+            if _possible(part, away, mps, radius):
+                return True
+        for early, late in self.jumps:  # at the move itself: anywhere
+            if early <= begin[1] and late >= begin[0]:
+                return True
+        return False
 
 
 def _possible(begin: tuple[float, float], away: list, mps: float, radius: float) -> bool:
@@ -184,12 +213,18 @@ class OsiChecks:
         # until now no longer bounds where it is, so an unseen waypoint reached is bounded from
         # the fix on (:func:`.closure.reachable`), not from the reports before it.
         v, late = o.v(p.t) - 2 * o.slack_v(), o.v(p.t_ack) + o.slack_v()
+        moved = False
         for c in o.beliefs.cands:
             done = c.model.opos_records
             if done and done[-1].position_applied:
                 speed = c.fix_seen[-1] if c.fix_seen is not None else 0.0
                 c.fix_seen = (v, late, float(item.lat), float(item.lon), speed)
                 c.nav_seen = None
+                moved = True
+        if moved:  # so is a queued waypoint reached (RH-OMW-2), or the $OPK position (RH-PK-2): the
+            self.queue.moved()  # way it made bounds them no longer
+            if self.park is not None:
+                self.park.moved(v, late)
         last = o.last_osi
         rec = o.beliefs.primary.model.opos_records
         if last is None or not rec or last.lat is None or last.lon is None:
@@ -385,7 +420,7 @@ class OsiChecks:
                 return
             if not near and park.on is None and not park.failed:
                 begin = (max(park.v0, lo - most), hi - least)
-                if not _possible(begin, park.away, park.knots * KNOT_MPS, prof.on_station_m):
+                if not park.possible(begin, prof.on_station_m):
                     park.failed = True
                     far = max(park.away, key=lambda a: a[2])
                     o.book("fail", ("RH-PK-2",), f"{what} {d:g} m from its position, not on station "
@@ -437,6 +472,10 @@ class OsiChecks:
         elif osi.mode == "W" and not m.queue_parking:
             key = ("W", m.control_generation)
             clause, what = ("RH-OMW-4",), f"on its queued waypoint ({d:g} m) without going on"
+        elif osi.mode == "P" and m.mode == "P" and m.park_waiting:
+            key = ("P", m.mission_wp)
+            clause, what = ("RH-INT-2",), (f"back on station at its park's waypoint ({d:g} m) without its "
+                                           f"mission park counting down the time left (P{osi.park_time})")
         elif osi.mode == "N" and m.mission is not None:
             key = ("N", osi.next_waypoint)
             last = not m.mission.is_open and m.mission_wp == m.mission.last

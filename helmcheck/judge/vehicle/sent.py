@@ -43,6 +43,9 @@ class Sent:
     branched: bool = False  #: a later command was answered first: taken into the mirror unanswered
     late_booked: bool = False  #: RH-ACK-2 booked: no ACK by the give-up deadline
     missing_booked: bool = False  #: RH-ACK-1 booked: no ACK at all
+    #: sent before the vehicle had answered anything in this record (the link check's first probe
+    #: of a vehicle still starting up): its ACK's delay is not judged (RH-ACK-2)
+    first_contact: bool = False
     #: a faulty line may have spoilt what answered it (:mod:`helmcheck.judge.streaks`): what it may
     #: have done, for the tester to make the observation again ("" when nothing was spoilt)
     spoil: str = ""
