@@ -186,3 +186,108 @@ def test_the_example_backseat_behind_flipped_bits_is_never_failed(tmp_path):
     failed, unnamed = _problems(results)
     assert not failed and not unnamed, (failed, unnamed)
     _relay_judged_exactly(tmp_path / "relay.log", "backseat", 10.0, emulator_profile())
+
+
+# ============================================================ the grid (make matrix)
+
+GRID_VEHICLES = ("emulator", "uvc_sim")
+
+
+@pytest.mark.skipif(not MATRIX, reason="the whole grid is make matrix's (HELMCHECK_MATRIX=1)")
+@pytest.mark.parametrize("fault", sorted(FAULTS))
+@pytest.mark.parametrize("vehicle", GRID_VEHICLES)
+def test_grid_a_conforming_vehicle_behind_each_fault_is_never_failed(vehicle, fault, tmp_path):
+    """{the emulator, uvc_sim} × {flips 1e-5 and 1e-4, drops 1e-4, noise bursts, a 2 s stall} at
+    x20 on the framing, acknowledgement and ``$OSD`` clauses: no FAIL, every INCONCLUSIVE naming
+    the line. (A 5 s cut and return: ``tests/test_unplugged.py``.)"""
+    if vehicle == "uvc_sim" and not SIM.is_file():
+        pytest.skip(f"the independent simulator is not there: {SIM}")
+    if vehicle == "emulator":
+        out, line = run_emulator(tmp_path, fault, k=20.0)
+    else:
+        out, line = run_sim(tmp_path, f"{FAULTS[fault]},seed=3", k=20.0)
+    _assert_no_fail_and_named(tmp_path / "r", out.results, line, stall=fault.startswith("stall"))
+    assert out.exit_code in (0, 2), out.reason
+
+
+@pytest.mark.skipif(not MATRIX, reason="the whole grid is make matrix's (HELMCHECK_MATRIX=1)")
+@pytest.mark.parametrize("fault", sorted(FAULTS))
+def test_grid_the_example_backseat_behind_each_fault_is_never_failed(fault, tmp_path):
+    results, line = run_backseat(tmp_path, f"{FAULTS[fault]},seed=4", 10.0, 18.0,
+                                 [str(EXAMPLE_BACKSEAT), "--port", "{port}", "--time-scale", "10"])
+    failed, unnamed = _problems(results)
+    assert not failed and not unnamed, (failed, unnamed)
+
+
+# ============================================================ real faults through light damage
+
+#: The faulty vehicles ``make test`` certifies behind the light settings (``make matrix``: all)
+LIGHT_MUTANTS = ("lowercase-checksum-out", "unpadded-checksum-out", "ack-before-data")
+
+
+def _mutant_params():
+    from tests.faulty_vehicles import MUTANTS
+    chosen = [m for m in MUTANTS if MATRIX or m.name in LIGHT_MUTANTS]
+    return [pytest.param(m, id=m.name) for m in chosen]
+
+
+@pytest.mark.parametrize("mutant", _mutant_params())
+def test_a_faulty_vehicle_behind_light_damage_still_fails_on_its_own_clause(mutant, tmp_path):
+    """Flips 1e-5 a bit and drops 1e-4 a byte, paced at 19200 baud: the faulty vehicle still FAILs
+    on the clause its fault breaks (the repetition rule finds an error a line does not repeat)."""
+    from tests.faulty_vehicles import EMU_PROFILE, make_core, serve
+    k = min(mutant.time_scales)
+    profile = EMU_PROFILE.replace(baud=19200, time_scale=k)
+    with serve(lambda start: make_core(mutant, k, start)) as port, \
+            impaired_line(port, f"{LIGHT},seed=1", link=tmp_path / "vehicle", process=True,
+                          wire_log=tmp_path / "relay.log") as line:
+        out = certify(Options(port=str(line.port), profile=profile, time_scale=k, report_dir=tmp_path / "r",
+                              select=list(mutant.select), examples=0, progress=False, render=False, seed=1))
+    failed = {c["id"]: c["reason"] for c in out.results["clauses"] if c["verdict"] == "fail"}
+    assert mutant.clause in failed, (failed, out.reason)
+    assert out.exit_code == 1
+
+
+def test_a_faulty_backseat_behind_light_damage_still_fails_on_its_own_clause(tmp_path):
+    """A backseat whose every fifth state poll carries a wrong checksum (RH-BS-1), behind flips
+    1e-5 and drops 1e-4: the same broken bytes again are the backseat's, FAIL RH-BS-1."""
+    results, line = run_backseat(tmp_path, f"{LIGHT},seed=2", 10.0, 15.0,
+                                 [str(FAULTY_BACKSEAT), "{port}", "--fault", "bad-checksum", "--time-scale", "10"])
+    verdicts = {c["id"]: c["verdict"] for c in results["clauses"]}
+    assert verdicts.get("RH-BS-1") == "fail", {c["id"]: c["reason"] for c in results["clauses"]
+                                               if c["id"] == "RH-BS-1"}
+
+
+# ============================================================ a baud mismatch, the counters
+
+def test_a_vehicle_behind_a_baud_mismatch_is_named_in_one_line_exit_2(tmp_path):
+    """The emulator at 115200 baud, its bytes as a 19200 receiver reads them (the relay's
+    ``rx-baud``): ``certify vehicle`` says in one line that they read as sentences at 115200, exit 2."""
+    with EmulatorProcess([], time_scale=20.0, baud=115200) as emu, \
+            impaired_line(emu.port, "baud=115200,<rx-baud=19200,seed=1", link=tmp_path / "vehicle",
+                          process=True) as line:
+        run = subprocess.run([sys.executable, "-m", "helmcheck", "certify", "vehicle", "--port", str(line.port),
+                              "--time-scale", "20", "--report-dir", str(tmp_path / "r"), "--no-progress"],
+                             capture_output=True, text=True, timeout=120, cwd=ROOT)
+    assert run.returncode == 2, (run.returncode, run.stderr)
+    says = [ln for ln in (run.stdout + run.stderr).splitlines() if "115200" in ln]
+    assert len(says) == 1 and "read as sentences at 115200 baud, not 19200: run with --baud 115200" in says[0], \
+        (run.stdout, run.stderr)
+    assert says[0].startswith("INCONCLUSIVE") and "Traceback" not in run.stderr
+
+
+def test_every_case_carries_its_line_counters_and_the_report_says_so(tmp_path):
+    """``results.json`` ``cases[].line_counters`` for every case ("not available" on a pty, with
+    why), and the Markdown and HTML reports say it in one line."""
+    profile = emulator_profile()
+    with EmulatorProcess([], time_scale=40.0, baud=115200) as emu:
+        out = certify(Options(port=emu.port, profile=profile.replace(baud=115200, time_scale=40.0), time_scale=40.0,
+                              report_dir=tmp_path / "r", select=["RH-FRM-1", "RH-ACK-1"], examples=0,
+                              progress=False, render=True, seed=1))
+    cases = out.results["cases"]
+    assert cases and all("line_counters" in c for c in cases), [c["id"] for c in cases if "line_counters" not in c]
+    ran = [c["line_counters"] for c in cases if c.get("verdict") != "not-run"]
+    assert ran and all(e["available"] is False and "pseudo-terminal" in e["reason"] for e in ran), ran
+    for name in ("report.md", "report.html"):
+        text = (tmp_path / "r" / name).read_text()
+        assert "not available" in text and "pseudo-terminal" in text, name

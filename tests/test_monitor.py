@@ -161,7 +161,7 @@ def _first_fail(mon: Monitor, clause: str) -> float:
 @pytest.mark.parametrize("mode", ["between", "tap"])
 def test_a_faulty_backseat_is_reported_within_a_second(tmp_path, mode):
     with EmulatorProcess(time_scale=K) as emu:
-        mon, code = RUN[mode](tmp_path, 8.0, emu.port, faulty="bad-checksum")
+        mon, code = RUN[mode](tmp_path, 14.0, emu.port, faulty="bad-checksum")
     assert code == 1
     lag = _first_fail(mon, "RH-BS-1")
     assert lag < 1.0, lag

@@ -110,15 +110,24 @@ def test_rh_bs_8_a_poll_interval_across_a_run_resumed_note_is_not_judged_one_aft
 
 def test_rh_bs_1_a_line_the_gap_cut_is_nobody_s():
     """The first half of a line before the gap and a whole line after the ``run resumed`` note:
-    the torn half is not judged as noise against the backseat (RH-BS-1), the whole line is."""
+    the torn half is not judged against the backseat (RH-BS-1), nor counted as a faulty line's;
+    without the note a faulty line's (INCONCLUSIVE); the same torn bytes three times,
+    the backseat's."""
     r = Run()
     r.bs(0.0, POLL).bs(1.0, POLL[:7])  # cut in the middle
     r.note(6.0, "run resumed: helmcheck's port came back after a gap of 5.00 s")
     r.bs(6.2, POLL).close(7.0)
     assert r.fails("RH-BS-1") == 0 and r.verdict("RH-BS-1") == "pass"
+    assert "spoilt" not in r.ledger.verdict("RH-BS-1").reason  # the gap's: not even a faulty line's
     torn = Run()
     torn.bs(0.0, POLL).bs(1.0, POLL[:7]).bs(6.2, POLL).close(7.0)  # the same bytes, no note
-    assert torn.fails("RH-BS-1") == 1
+    assert torn.fails("RH-BS-1") == 0  # a torn line a faulty line may have made: not judged
+    assert torn.verdict("RH-BS-1") == "inconclusive"
+    assert "the line, not the implementation, may have done it" in torn.ledger.verdict("RH-BS-1").reason
+    again = Run()
+    for t in (1.0, 2.0, 3.0):  # the same torn bytes three times, no gap: the backseat's
+        again.bs(t - 0.5, POLL).bs(t, POLL[:7])
+    assert again.bs(4.0, POLL).close(5.0).fails("RH-BS-1") >= 1
 
 
 def test_a_port_is_opened_as_soon_as_its_name_is_back_and_not_waited_for_past_the_wait(tmp_path):
@@ -151,7 +160,7 @@ def test_a_vehicle_port_gone_for_5_s_mid_run_is_waited_for_and_the_run_finishes(
     """The vehicle's port (a symbolic link, as /dev/serial/by-id) is unplugged 5 s into the run
     and plugged back 5 s later: the run waits, records the gap, verifies the vehicle stopped
     and runs the cut case again; it ends a certificate of what it selected or INCONCLUSIVE for
-    the gap alone (RH-ACK-1 of a poll the cut left unanswered), and ``helmcheck verify`` gets the
+    the gap alone (a poll the cut left unanswered is a remark, not a verdict), and ``helmcheck verify`` gets the
     same verdicts from the record. Before this, the run stopped at the cut: INCONCLUSIVE (link),
     the vehicle left unrestored."""
     from helmcheck.emulator.process import EmulatorProcess

@@ -129,13 +129,15 @@ def check_clock(run, enabled: bool = True) -> ClockCheck:
     if enabled:
         check = measure_clock(run.link, run.p, run.k)
         run.link.drain()  # an answer the check stopped waiting for is not left to the first case
-        ses = run.session
-        if ses is not None and any(not x.done or x.spoil for x in ses.obs.sent):
-            with ses.not_stopping():  # a request the line spoilt: settled, and made again (session.finish)
-                ses.finish()
     else:
         check = not_measured(run.k, "the check was turned off (--no-clock-check)")
     run.link.note(check.note())
+    ses = run.session
+    if enabled and ses is not None and any(not x.done or x.spoil for x in ses.obs.sent):
+        # a request the line may have spoilt (or a vehicle that does not answer it): settled, and
+        # made again (session.finish) — the judge's business, after the check's own budget
+        with ses.not_stopping():
+            ses.finish()
     run.results["settings"]["clock_check"] = check.as_settings()
     if check.stops:
         run.link.note(tester_note("inconclusive", run.ids, check.message()))

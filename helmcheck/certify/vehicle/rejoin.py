@@ -10,7 +10,7 @@ server's connection dropped: the link's ``link lost`` note (:mod:`.link`) — :f
 * records the gap as the judges know it: a ``run resumed:`` note (:mod:`helmcheck.judge.wire`),
   the note ``--resume`` writes after an interruption. The vehicle observer then takes the
   vehicle's state as unknown (from the next report that shows it whole), and does not judge a
-  command the gap cut off (RH-ACK-1 INCONCLUSIVE, naming the gap); ``check-log`` and ``helmcheck
+  command the gap cut off (a remark on RH-ACK-1 naming the gap, never a verdict); ``check-log`` and ``helmcheck
   verify`` read the same note, so the record alone gives the same verdicts. Then ``link
   reopened: …`` at the time the port was back: the gap's time is in the record as time nobody
   saw;

@@ -573,7 +573,7 @@ class VehicleObserver(Answers, Deadlines):
     # ------------------------------------------------------------------ resume and end
     def _resume(self, ev: WireEvent, what: str) -> None:
         """An interrupted run goes on (``run resumed`` note): what the interruption cut off is not
-        judged (RH-ACK-1 INCONCLUSIVE for a command still inside its ACK window), the vehicle's
+        judged (a command still inside its ACK window: a remark on RH-ACK-1, never a verdict), the vehicle's
         state is unknown again (taken from the next report that shows it whole, as at the start of
         a record), and the run is no longer ended early."""
         t = ev.t
@@ -582,9 +582,10 @@ class VehicleObserver(Answers, Deadlines):
         self.notes_held = []
         self.framers = {TO_VEHICLE: Framer(self.profile.max_line_bytes),  # a line cut by the
                         FROM_VEHICLE: Framer(max(4096, 4 * self.profile.max_line_bytes))}  # stop is nobody's
-        for p in list(self.pending) + self.dead:
-            self.ledger.inconclusive("RH-ACK-1", f"{text_of(p)}: the run was interrupted before its $ACK could "
-                                                 f"be read ({what})", [p.ev], p.case)
+        cut = list(self.pending) + self.dead
+        if cut:  # decision: what the cut left unanswered was never observed, so it is not judged
+            self.ledger.remark("RH-ACK-1", f"{len(cut)} command(s) left unanswered when the run was cut were not "
+                                           f"judged (first: {text_of(cut[0])}; {what})")
         for q in self.silent:
             q.state = "silent"
         self._junk_settle(False)
