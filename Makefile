@@ -41,15 +41,18 @@ fuzz: $(STAMP)
 explore-reach: $(STAMP)
 	HELMCHECK_REACH=1 $(PY) -m pytest -q tests/test_explore_reach.py
 
-# Not run by CI (about an hour on two cores): the slow-line grid — every case on the reference and
+# Not run by CI (about 90 minutes on two cores): the slow-line grid — every case on the reference and
 # every faulty vehicle over lines in virtual time (time scales 1-40, replies 3 ms-0.9 s, 9600-115200
 # baud, the timing freedoms at their bounds), and whole certifications on real ptys of the emulator
 # at each line-timing freedom's bound at x5, x20 and x40 and of the independent simulator behind a
 # slow line (tests/test_line_budget.py, tests/test_slow_line.py); and ports unplugged mid-run: the
 # independent simulator certified whole behind a 5 s cut, cuts in a case and in the exploration, a
-# backseat device and a monitored side that never come back (tests/test_unplugged.py).
+# backseat device and a monitored side that never come back (tests/test_unplugged.py); the
+# emulator, the independent simulator and the example backseat behind every line fault, and every
+# faulty vehicle behind light damage (tests/test_bad_line.py); the independent simulator's own
+# missions at x5 and the lockout finding's replay (make test's budget keeps x20 and one replay).
 matrix: $(STAMP)
-	HELMCHECK_MATRIX=1 $(PY) -m pytest -n 2 tests/test_line_budget.py tests/test_slow_line.py tests/test_unplugged.py
+	HELMCHECK_MATRIX=1 $(PY) -m pytest -n 2 tests/test_line_budget.py tests/test_slow_line.py tests/test_unplugged.py tests/test_bad_line.py tests/test_third_party_vehicle.py::test_its_own_missions_with_oxflt_certify tests/test_explore_replays.py
 
 # Not run by CI (several minutes): every --help example, the slow ones and those that need a
 # vehicle too (run against the emulator on their port); make test runs the others.
