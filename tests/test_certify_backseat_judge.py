@@ -510,3 +510,21 @@ def test_backseat_observer_does_no_io_and_reads_no_clock():
             elif isinstance(node, ast.ImportFrom) and node.level == 0 and node.module:
                 names = [node.module.split(".")[0]]
             assert not forbidden & set(names), (path.name, names)
+
+
+def test_rh_bs_3_a_vehicle_line_broken_after_the_last_whole_report_leaves_a_violation_inconclusive():
+    """A stopped vehicle (``S``), then vehicle lines that reached the backseat broken (the line
+    flipped an LF: an accepted ``$OMSTART``'s ``$ACK`` run into the next report, itself one bit
+    off) and an ``$OMS``:
+    the backseat may have read the start in it — INCONCLUSIVE naming the broken line, never a FAIL
+    (``docs/contracts.md``, a faulty line). A whole ``S`` report after it: the ``$OMS`` is a FAIL."""
+    spoilt = bytearray(osi("N"))
+    spoilt[-4] ^= 0x01  # a checksum digit one bit off: the report does not read either
+    broken = frame("ACK,3,0,0")[:-1] + b"*" + bytes(spoilt)
+    r = Run().veh(0.0, osi("S")).veh(1.0, osi("S")).veh(2.0, broken).bs(2.5, OMS).close(3.0)
+    assert r.fails("RH-BS-3") == 0 and r.verdict("RH-BS-3") == "inconclusive"
+    assert "the line broke" in r.ledger.verdict("RH-BS-3").reason
+    again = Run().veh(0.0, osi("S")).veh(2.0, broken).veh(3.0, osi("S")).bs(3.5, OMS).close(4.0)
+    assert again.fails("RH-BS-3") == 1
+    clean = Run().veh(0.0, osi("S")).veh(1.0, osi("S")).bs(2.5, OMS).close(3.0)
+    assert clean.fails("RH-BS-3") == 1

@@ -64,8 +64,11 @@ class StateReports:
         self._arr: list[float] = []
         self._rec: list[float] = []
         self._v: list[bool] = []
+        self._seen: deque[tuple[float, bool]] = deque(maxlen=64)  #: every report's (arrival, running)
+        self._broken: deque[float] = deque(maxlen=64)  #: arrivals of vehicle lines a faulty line broke
 
     def report(self, recorded: float, arrived: float, running: bool) -> None:
+        self._seen.append((arrived, running))
         if self._v and self._v[-1] == running:
             return
         if self._arr and arrived < self._arr[-1]:
@@ -88,6 +91,24 @@ class StateReports:
         if self._v[i - 1] == need:
             return False
         return not (i < len(self._v) and self._rec[i] <= at)  # the next change says ``need``
+
+    def broken(self, arrived: float) -> None:
+        """A vehicle line that reached the backseat broken (bytes that frame into nothing, a
+        checksum that does not match): what it said, the backseat may or may not have read."""
+        self._broken.append(arrived)
+
+    def uncertain(self, t: float, at: float) -> Optional[float]:
+        """A contradiction found at ``t`` for a command sent at ``at`` rests on a report the
+        backseat may no longer have believed: a vehicle line broken on its way arrived by ``at``
+        after the last whole report of that state that had arrived by ``t`` (it may have been
+        the change, read in part). The broken line's arrival, or None."""
+        i = bisect_right(self._arr, t)
+        if not i:
+            return None
+        v = self._v[i - 1]
+        last = max((a for a, r in self._seen if r == v and a <= t), default=self._arr[i - 1])
+        late = [b for b in self._broken if last < b <= at]
+        return late[-1] if late else None
 
 class Pending:
     """Commands waiting for their ``$ACK`` (module docstring)."""

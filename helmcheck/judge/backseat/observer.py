@@ -250,6 +250,9 @@ class BackseatObserver:
             self._taken()
             if isinstance(e, Line):
                 self._report(e.raw, ev.t, self.arrivals.arrival(e.offset + len(e.raw) - base))
+            else:  # bytes that frame into nothing: a line broken on its way (RH-BS-3's uncertainty),
+                # readable in part from when its first bytes had arrived
+                self.reports.broken(self.arrivals.arrival(max(0, e.offset - base) + min(e.length, 16)))
 
     def _taken(self) -> None:
         """A relay's note on a vehicle run is used up by it (it touched that run and no other). A
@@ -259,9 +262,12 @@ class BackseatObserver:
             self.faults.take(FROM_VEHICLE)
 
     def _report(self, raw: bytes, t: float, arrived: float) -> None:
+        r = self._decode(raw).sentence
+        if r is None:  # a line of the vehicle's that does not read (a faulty line, maybe)
+            self.reports.broken(arrived)
+            return
         if raw[:5] not in _READ:  # nothing else tells the backseat what it could know
             return
-        r = self._decode(raw).sentence
         if isinstance(r, s.OSI):
             self._osi(r, t, arrived)
         elif isinstance(r, s.ACK):
