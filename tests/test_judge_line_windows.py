@@ -22,10 +22,11 @@ import pytest
 
 from helmcheck.checklog.checker import check_log
 from helmcheck.grammar import sentences as s
+from helmcheck.grammar.checksum import checksum
 from helmcheck.judge.vehicle.belief import Beliefs
 from helmcheck.judge.vehicle.catalog import KnownMissions
 from helmcheck.model.testing import omp, oms, omstart
-from helmcheck.profile import DEFAULT, emulator_profile
+from helmcheck.profile import DEFAULT, emulator_profile, load_profile
 
 LOG = Path(__file__).parent / "fixtures" / "logs" / "violation_while_diving_x40.log"
 
@@ -56,3 +57,39 @@ def test_rh_saf_4_a_violation_while_diving_leaves_the_depth_to_the_reports():
     assert verdicts["RH-OUT-4"] == "pass" and verdicts["RH-SAF-2"] == "pass", verdicts
     bad = {c["id"]: c["reason"] for c in out.clauses if c["verdict"] in ("fail", "inconclusive")}
     assert not bad, bad
+
+
+SURFACE_LOG = Path(__file__).parent / "fixtures" / "logs" / "surface_while_omp_holds_x40.log"
+
+
+def _deeper(text: str, after: float, depth: str) -> str:
+    """The record with every ``$OSI`` after ``after`` s reporting ``depth`` (field 15), checksums
+    made again: the same vehicle, under water."""
+    out = []
+    for ln in text.splitlines(keepends=True):
+        parts = ln.split(" ", 2)
+        if len(parts) == 3 and parts[1] == "<" and parts[2].startswith("$OSI,") and float(parts[0]) > after:
+            body = parts[2][1:parts[2].index("*")].split(",")
+            body[15] = depth
+            body = ",".join(body)
+            ln = f"{parts[0]} < ${body}*{checksum(body.encode()):02X}\n"
+        out.append(ln)
+    return "".join(out)
+
+
+def test_rh_saf_3_a_vehicle_at_the_surface_while_omp_holds_depth_may_end_the_refusals(tmp_path):
+    """A recorded x40 exploration (the emulator): a violation while the stopped vehicle floats up
+    at 0.27 m, ``$OMP`` accepted after the lockout, the next report at 0.21 m (the surface: 0.25 m),
+    then ``$OPK`` refused with its own err 22, not 26. RH-SAF-3 ends the refusals "until the
+    vehicle is at the surface"; the model defers that while ``$OMP`` holds depth (RH-RD-12 is
+    silent): both are conforming. Before: FAIL RH-SAF-3. The same record with the vehicle 5 m
+    down in those reports: not a pass."""
+    profile = load_profile(str(Path(__file__).parent.parent / "examples" / "emulator.toml"))
+    out = check_log(SURFACE_LOG, profile=profile, role="vehicle", time_scale=40.0)
+    verdicts = {c["id"]: (c["verdict"], c["reason"]) for c in out.clauses}
+    assert verdicts["RH-SAF-3"][0] == "pass", verdicts["RH-SAF-3"]
+    assert not {c: v for c, v in verdicts.items() if v[0] == "fail"}
+    deep = tmp_path / "deep.log"
+    deep.write_text(_deeper(SURFACE_LOG.read_text(), 103.26, "5.21"))
+    out = check_log(deep, profile=profile, role="vehicle", time_scale=40.0)
+    assert {c["id"]: c["verdict"] for c in out.clauses}["RH-SAF-3"] != "pass"

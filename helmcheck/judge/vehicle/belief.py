@@ -128,6 +128,12 @@ class Beliefs:
     def primary(self) -> Candidate:
         return self.cands[0]
 
+    def _reported_depth(self) -> Optional[float]:
+        """The depth the last ``$OSI`` showed, metres (None: none, or no depth in it)."""
+        if self.last_osi is None:
+            return None
+        return osi_depth_m(self.last_osi[0], self.profile.depth_unit)
+
     # ------------------------------------------------------------------ commands
     def command(self, item, v: float, slack_v: float, observed: list) -> CommandResult:
         """Feed an answered command (module docstring); ``observed`` is the vehicle's replies."""
@@ -162,7 +168,8 @@ class Beliefs:
             explanations = []  # each candidate's own (they may differ in what no report shows yet)
             for c in self.cands:
                 tp = c.seen_v if c.seen_v is not None else (c.model.now or v)
-                got = explain_reply(c, item, v, observed, tp, self.catalog, self.profile.gps_fix_depth_m)
+                got = explain_reply(c, item, v, observed, tp, self.catalog, self.profile.gps_fix_depth_m,
+                                    reported_depth=self._reported_depth())
                 if got is not None:
                     explanations.append(got)
             if explanations:

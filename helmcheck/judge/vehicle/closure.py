@@ -488,7 +488,7 @@ def _with_park(run, wp: int, seconds: float):
 # =============================================================================== $ACK
 
 def explain_reply(c: Candidate, item, v: float, observed: list, tp: float, catalog,
-                  fix_depth: float) -> Optional[tuple[Candidate, list, bool]]:
+                  fix_depth: float, reported_depth: Optional[float] = None) -> Optional[tuple[Candidate, list, bool]]:
     """``(candidate, replies, mission_dependent)`` with unseen events (or a mission name learnt
     from the vehicle's answer) that explain ``observed`` for ``item`` at ``v``; else None."""
     m = c.model
@@ -519,6 +519,18 @@ def explain_reply(c: Candidate, item, v: float, observed: list, tp: float, catal
             t.model.update_plant(t.model.snapshot.with_(depth_m=0.0))
             return t
         trials.append(("the surface", surfaced))
+        if m.mode == "M" and reported_depth is not None and reported_depth <= fix_depth:
+            # Decision (RH-SAF-3 ends the refusals "until the vehicle is at the surface"; RH-RD-12
+            # is silent on a surface reached while $OMP holds depth, which the model defers to the
+            # primitive's end): a vehicle the last report showed at the surface that ends the
+            # episode there, mode M kept, conforms too
+            def surfaced_holding(t: Candidate) -> Candidate:
+                t.model.advance(tp)
+                t.model.update_plant(t.model.snapshot.with_(depth_m=0.0))
+                if t.model.phase == "ascent" and t.model.mode == "M":
+                    t.model.phase = "none"
+                return t
+            trials.append(("the surface while $OMP held depth", surfaced_holding))
     if m.mission is not None and m.mode in ("N", "P") and m.phase == "none":
         def ended(t: Candidate) -> Optional[Candidate]:
             tm = t.model
