@@ -43,7 +43,7 @@ FAULTS = {
     "flip-1e-4": "baud=19200,flip=1e-4",
     "drop-1e-4": "baud=19200,drop=1e-4",
     "noise": "baud=19200,noise=2e-4,noise-len=1-8",
-    "stall-2s": "baud=19200,stall=2s@5",
+    "stall-2s": "baud=19200,stall=2s@6,stall=2s@12",  # two, so that one falls while the tester talks
 }
 #: The light settings the faulty implementations are still caught through
 LIGHT = "baud=19200,flip=1e-5,drop=1e-4"
@@ -78,9 +78,8 @@ def _assert_no_fail_and_named(out_dir: Path, results: dict, line, stall: bool = 
     failed, unnamed = _problems(results)
     assert not failed, failed
     assert not unnamed, unnamed
-    wire = (out_dir / "wire.log").read_text()
-    if stall and _stalled(line):
-        assert "stall" in wire or any("stall" in c["reason"] for c in results["clauses"]), "the stall is not named"
+    if stall:  # it held bytes up (else the test tests nothing); what it made late is named above
+        assert _stalled(line), "the stall held nothing up"
 
 
 def _certify_vehicle(port: str, profile, k: float, out: Path, select=FRAMING_ACK, examples=0):
@@ -140,7 +139,7 @@ def test_the_emulator_behind_flipped_bits_is_never_failed_and_the_relays_record_
 def test_a_vehicle_we_did_not_write_behind_lost_bytes_noise_and_a_stall_is_never_failed(tmp_path):
     """``uvc_sim.py`` behind a line that loses bytes, bursts noise and stalls 2 s: no FAIL, every
     INCONCLUSIVE naming the line."""
-    out, line = run_sim(tmp_path, "baud=19200,drop=2e-4,noise=2e-4,stall=2s@4,seed=5",
+    out, line = run_sim(tmp_path, "baud=19200,drop=2e-4,noise=2e-4,stall=2s@6,stall=2s@12,seed=5",
                         select=["RH-FRM-2", "RH-FRM-7", "RH-ACK-1", "RH-ACK-2", "RH-ACK-5", "RH-OSD-1"])
     _assert_no_fail_and_named(tmp_path / "r", out.results, line, stall=True)
     assert out.exit_code in (0, 2)

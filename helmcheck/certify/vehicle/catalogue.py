@@ -34,7 +34,8 @@ OMP_HOLD = "OMP,8080808080,00,{to_long}"  # neutral: holds depth, outlasts what 
 OMS_RESTART = "OMS,90,2,20,{speed},{to_restart}"  # restarted {gap} into it, both deadlines told apart
 FAR_OMW = "OMW,{near_lat},{lon},2,,15,{speed},0,"
 HOLD_SURFACE = "OMS,90,0,20,0,{to_long}"  # stays where it is, at the surface, for several steps
-#: V-70's controls, each sent again just before its $OPOS so that what follows fits its timeout on a slow line
+#: V-70's controls, each sent again just before its $OPOS so that what follows fits its timeout on a slow line;
+#: the state each $OPOS needs is confirmed again right before it (a re-run on a faulty line can outlast the control)
 _DIVE_HOLD = "OMS,90,1.5,45,{speed},{to_long}"  # down to 1.5 m and held there
 _RISE = "OMS,90,0,45,{speed},{to_long}"  # back up to the surface, under way
 OPOS_FAR = "OPOS,{opos_lat},{lon},0,,"  # far enough that the next report tells applied from not (RH-POS-2)
@@ -422,14 +423,20 @@ CASES: tuple[Case, ...] = (
        Until("the surface in S", mode="S", surface=True, budget_v=300.0),
        Start(ignore_gps=1), *_ok(HOLD_SURFACE),
        Until("the surface in A", mode="A", surface=True, budget_v=300.0, refresh=HOLD_SURFACE),
-       *_ok(HOLD_SURFACE), Wait(2.0), *_ok(OPOS_FAR), Poll(mode="A"),
+       *_ok(HOLD_SURFACE), Wait(2.0),
+       Until("the surface in A", mode="A", surface=True, budget_v=300.0, refresh=HOLD_SURFACE),
+       *_ok(OPOS_FAR), Poll(mode="A"),
        Send("OMSTOP,0"), Until("the surface in S", mode="S", surface=True, budget_v=300.0), Wait(2.0),
        *_ok(OPOS_FAR), Poll(mode="S"),
        Start(), *_ok(_DIVE_HOLD),
        Until("under water", mode="A", submerged=True, depth_at_least=1.4, budget_v=300.0, refresh=_DIVE_HOLD),
-       *_ok(_DIVE_HOLD), Wait(2.0), *_ok(OPOS_FAR), Poll(mode="A"),
+       *_ok(_DIVE_HOLD), Wait(2.0),
+       Until("under water", mode="A", submerged=True, depth_at_least=1.4, budget_v=300.0, refresh=_DIVE_HOLD),
+       *_ok(OPOS_FAR), Poll(mode="A"),
        *_ok(_RISE), Until("the surface in A", mode="A", surface=True, budget_v=300.0, refresh=_RISE),
-       *_ok(_RISE), Wait(2.0), *_ok(OPOS_FAR), Poll(mode="A")),
+       *_ok(_RISE), Wait(2.0),
+       Until("the surface in A", mode="A", surface=True, budget_v=300.0, refresh=_RISE),
+       *_ok(OPOS_FAR), Poll(mode="A")),
     _c("V-71", "RH-POS-1 RH-DVL-1 RH-RD-9", "$OPOS and $ODVL at each edge of their ranges",
        "at the surface in S (a fix: the position is not applied): latitude ±90, longitude ±180, speed 0 and "
        "max_speed_kn, conductivity 0 and 100, temperature -5 and 50 are accepted, 0.1 past each refused "
