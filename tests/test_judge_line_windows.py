@@ -93,3 +93,18 @@ def test_rh_saf_3_a_vehicle_at_the_surface_while_omp_holds_depth_may_end_the_ref
     deep.write_text(_deeper(SURFACE_LOG.read_text(), 103.26, "5.21"))
     out = check_log(deep, profile=profile, role="vehicle", time_scale=40.0)
     assert {c["id"]: c["verdict"] for c in out.clauses}["RH-SAF-3"] != "pass"
+
+
+LOST_LOG = Path(__file__).parent / "fixtures" / "logs" / "lost_command_clock_check_x40.log"
+
+
+def test_rh_ack_2_an_ack_that_may_answer_a_later_command_is_not_late_for_a_lost_one():
+    """A recorded x40 certification of the independent simulator behind a faulty line (bytes
+    dropped, noise, stalls): the clock check sends ``$OSD,G`` without waiting; the line lost one,
+    and the next one's ``$ACK`` came 0.05 s after it was sent — 1.55 s after the lost one. Taken
+    for the lost one's, it was late (RH-ACK-2), and with a stall's late ``$ACK`` after it, a run of
+    late answers: FAIL. It may answer the later command: held, and made again clean, the line's."""
+    out = check_log(LOST_LOG, role="vehicle")
+    verdicts = {c["id"]: (c["verdict"], c["reason"]) for c in out.clauses}
+    assert verdicts["RH-ACK-2"][0] == "pass", verdicts["RH-ACK-2"]
+    assert "may have lost $OSD,G*33" in verdicts["RH-ACK-2"][1]

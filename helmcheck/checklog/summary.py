@@ -61,7 +61,11 @@ def build_summary(archive: Archive, entries: Sequence[dict[str, Any]], *, report
     for u in archive.unreadable:
         files[u.rel] = {"path": u.rel, "status": "unreadable", "message": u.reason}
     for rel in planned:
-        files.setdefault(rel, {"path": rel, "status": "not-judged", "message": "the run was interrupted first"})
+        if rel not in files:
+            late = (Path(report_dir) / rel / "check-key.json").is_file()  # a worker finished it as the run stopped
+            files[rel] = {"path": rel, "status": "not-judged",
+                          "message": "finished as the run was interrupted: the next run takes it from the cache"
+                          if late else "the run was interrupted first"}
     rows = []
     for rel in sorted(files):
         f = files[rel]

@@ -235,6 +235,16 @@ class Answers:
         if p.held_item is not None:
             p.spoil = p.spoil or text
 
+    def _may_answer_later(self, p: Sent, t: float) -> Optional[Sent]:
+        """A later command of ``p``'s ``$ACK`` type, still waiting, that an ``$ACK`` at ``t`` came
+        within the window of: the line may have lost ``p`` (its own never came) and this one
+        answers that (a tester that sends without waiting, as the clock check does)."""
+        for q in self.pending:
+            if (q.seq > p.seq and q.kind.ack_type == p.kind.ack_type and q.t <= t
+                    and t - q.t <= self.profile.ack_window_s):
+                return q
+        return None
+
     def _late_text(self, p: Sent, dt: float) -> Optional[str]:
         """Why an ``$ACK`` ``dt`` s late may be the line's (a stall held it), or None when it cannot
         be (a later command's ``$ACK`` came first: a stall delays everything, in order; or a relay's
@@ -262,10 +272,14 @@ class Answers:
             pass  # RH-ACK-2 was booked when the give-up deadline passed
         elif verdict == "fail":
             why = self._late_text(p, dt)
+            later = None if why is not None and why.startswith("the line held") else self._may_answer_later(p, t)
+            if later is not None:
+                why = (f"the $ACK came {t - later.t:.2f} s after a later {text_of(later)}: the line may have lost "
+                       f"{text_of(p)}, and the $ACK answers that one")
             if why is not None and not p.holding:
                 p.holding, p.late_text = True, why
-                if why.startswith("the line held"):
-                    p.spoils.append((why, REPEAT, True, ("late",)))
+                if why.startswith("the line held") or later is not None:
+                    p.spoils.append((why, REPEAT, later is None, ("late",) if later is None else ("lost",)))
             self.book("fail", ("RH-ACK-2",), f"$ACK,{a.type} came {dt:.2f} s after {text_of(p)}; allowed "
                                              f"{allowance:.2f} s: the {window:g} s window, "
                                              f"{transmit_time(len(p.raw) + replies, self.baud):.3f} s of transmit "
