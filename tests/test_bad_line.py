@@ -247,14 +247,25 @@ def test_a_faulty_vehicle_behind_light_damage_still_fails_on_its_own_clause(muta
     assert out.exit_code == 1
 
 
-def test_a_faulty_backseat_behind_light_damage_still_fails_on_its_own_clause(tmp_path):
-    """A backseat whose every fifth state poll carries a wrong checksum (RH-BS-1), behind flips
-    1e-5 and drops 1e-4: the same broken bytes again are the backseat's, FAIL RH-BS-1."""
-    results, line = run_backseat(tmp_path, f"{LIGHT},seed=2", 10.0, 15.0,
-                                 [str(FAULTY_BACKSEAT), "{port}", "--fault", "bad-checksum", "--time-scale", "10"])
+def _backseat_faults():
+    """``make test``: the one whose error a faulty line could have made (a wrong checksum now and
+    then); ``make matrix``: every faulty backseat of the suite."""
+    from tests.test_certify_backseat import FAULTS as BACKSEAT_FAULTS
+    chosen = sorted(BACKSEAT_FAULTS) if MATRIX else ["bad-checksum"]
+    return [pytest.param(f, BACKSEAT_FAULTS[f], id=f) for f in chosen]
+
+
+@pytest.mark.parametrize("fault,expected", _backseat_faults())
+def test_a_faulty_backseat_behind_light_damage_still_fails_on_its_own_clause(tmp_path, fault, expected):
+    """A faulty backseat (e.g. every fifth state poll with a wrong checksum, RH-BS-1) behind flips
+    1e-5 and drops 1e-4: still caught on its own clause (the same broken bytes again are the
+    backseat's)."""
+    clause, verdict = expected
+    results, line = run_backseat(tmp_path, f"{LIGHT},seed=2", 10.0, 18.0,
+                                 [str(FAULTY_BACKSEAT), "{port}", "--fault", fault, "--time-scale", "10"])
     verdicts = {c["id"]: c["verdict"] for c in results["clauses"]}
-    assert verdicts.get("RH-BS-1") == "fail", {c["id"]: c["reason"] for c in results["clauses"]
-                                               if c["id"] == "RH-BS-1"}
+    assert verdicts.get(clause) == verdict, {c["id"]: (c["verdict"], c["reason"]) for c in results["clauses"]
+                                             if c["id"] == clause}
 
 
 # ============================================================ a baud mismatch, the counters
