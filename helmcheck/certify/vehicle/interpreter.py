@@ -235,7 +235,10 @@ def run_step(session: Session, st, ctx: dict) -> None:
         session.settle(st.timer, frame(fill(probe, ctx)) if probe else None, session.case_clauses[0])
         _here(session, ctx)
     elif isinstance(st, Until):
+        if st.after_reruns and session.reruns_total == ctx.get("_reruns_confirmed"):
+            return  # nothing was made again since the last Until confirmed the state
         _until(session, st, ctx)
+        ctx["_reruns_confirmed"] = session.reruns_total
         _here(session, ctx)
     elif isinstance(st, Fault):
         _violation(session, st, ctx)

@@ -105,6 +105,7 @@ class Session:
         self.meter = LineMeter(self.k, profile.baud, profile.ack_window_s)
         self._durations: Optional[Durations] = None
         self.reruns = 0  #: re-runs the last :meth:`exchange` took (a faulty line spoilt what came before)
+        self.reruns_total = 0  #: every observation made again so far (a case step's state may be stale)
         #: the range edges of §4–8b the lines sent reached (:mod:`.edges`; ``stats.edges``)
         self.edges = EdgeTally(profile)
 
@@ -218,6 +219,7 @@ class Session:
         while (sent is not None and sent.spoil and self.reruns < RERUNS and _rerunnable(sent)
                and self.obs.awaits(sent)):
             self.reruns += 1
+            self.reruns_total += 1
             self.note(f"re-run {self.reruns} of {RERUNS}: {_line_text(raw)}: {sent.spoil}")
             sent = self._exchange_once(raw)
         return sent
@@ -327,6 +329,7 @@ class Session:
             if x.spoil and x.ident not in done and _rerunnable(x) and self.obs.awaits(x):
                 done.add(x.ident)
                 self.note(f"re-run of {_line_text(x.raw)}: {x.spoil}")
+                self.reruns_total += 1
                 self.exchange(x.raw)
 
     def _probe(self, after: float) -> None:

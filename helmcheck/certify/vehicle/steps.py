@@ -108,6 +108,9 @@ class Until:
     submerged: Optional[bool] = None  #: True: until the depth is below the GPS-fix depth
     depth_at_least: Optional[float | str] = None  #: until ``$OSI`` field 15 shows at least this depth
     refresh: Optional[str] = None  #: a control sent again at half its timeout while waiting (a slow dive)
+    #: only when something was made again since the last ``Until`` confirmed the state (a faulty
+    #: line): that re-run may have outlasted the control; else skipped (a poll costs time)
+    after_reruns: bool = False
 
 
 @dataclass(frozen=True)
