@@ -237,8 +237,8 @@ class Answers:
 
     def _may_answer_later(self, p: Sent, t: float) -> Optional[Sent]:
         """A later command of ``p``'s ``$ACK`` type, still waiting, that an ``$ACK`` at ``t`` came
-        within the window of: the line may have lost ``p`` (its own never came) and this one
-        answers that (a tester that sends without waiting, as the clock check does)."""
+        within the window of (RH-ACK-2): the line may have lost ``p`` (its own never came, RH-ACK-1)
+        and this one answers that (a tester that sends without waiting, as the clock check does)."""
         for q in self.pending:
             if (q.seq > p.seq and q.kind.ack_type == p.kind.ack_type and q.t <= t
                     and t - q.t <= self.profile.ack_window_s):

@@ -514,9 +514,11 @@ def explain_reply(c: Candidate, item, v: float, observed: list, tp: float, catal
             return t
         trials.append(("a safety violation (code not yet shown)", violated))
     if m.phase in ("ascent", "lockout") and ack.err != 26:
-        def surfaced(t: Candidate) -> Candidate:
+        def surfaced(t: Candidate, holding: bool = False) -> Candidate:
             t.model.advance(tp)
             t.model.update_plant(t.model.snapshot.with_(depth_m=0.0))
+            if holding and t.model.phase == "ascent" and t.model.mode == "M":
+                t.model.phase = "none"
             return t
         trials.append(("the surface", surfaced))
         if m.mode == "M" and reported_depth is not None and reported_depth <= fix_depth:
@@ -524,13 +526,7 @@ def explain_reply(c: Candidate, item, v: float, observed: list, tp: float, catal
             # is silent on a surface reached while $OMP holds depth, which the model defers to the
             # primitive's end): a vehicle the last report showed at the surface that ends the
             # episode there, mode M kept, conforms too
-            def surfaced_holding(t: Candidate) -> Candidate:
-                t.model.advance(tp)
-                t.model.update_plant(t.model.snapshot.with_(depth_m=0.0))
-                if t.model.phase == "ascent" and t.model.mode == "M":
-                    t.model.phase = "none"
-                return t
-            trials.append(("the surface while $OMP held depth", surfaced_holding))
+            trials.append(("the surface while $OMP held depth", lambda t: surfaced(t, holding=True)))
     if m.mission is not None and m.mode in ("N", "P") and m.phase == "none":
         def ended(t: Candidate) -> Optional[Candidate]:
             tm = t.model
