@@ -34,6 +34,7 @@ from typing import Callable, Optional
 
 from ..certify.backseat.scenarios import SCENARIOS
 from ..failures import UsageError
+from .lineopt import add_line_argument
 
 __all__ = ["add_arguments", "run", "EPILOG"]
 
@@ -110,6 +111,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="start the backseat under test on the port ({port} is replaced, or the port appended)")
     p.add_argument("--exec-grace", type=float, default=5.0, metavar="S",
                    help="seconds between SIGTERM and SIGKILL when stopping it (default 5)")
+    add_line_argument(p, "guessed from the port: clean for helmcheck's pty and TCP served on loopback")
     p.add_argument("--no-progress", action="store_true",
                    help="no progress on standard error (by default: a bar on a terminal, else a line per "
                         "scenario and at least every 10 s)")
@@ -137,7 +139,8 @@ def run(args: argparse.Namespace, *, on_port: Optional[Callable[[str], None]] = 
                    connect_timeout=args.connect_timeout, exec_cmd=getattr(args, "exec_cmd", None),
                    reconnect_wait=(DEFAULT_WAIT_S if getattr(args, "reconnect_wait", None) is None
                                    else args.reconnect_wait),
-                   exec_grace_s=args.exec_grace, progress=not getattr(args, "no_progress", False))
+                   exec_grace_s=args.exec_grace, progress=not getattr(args, "no_progress", False),
+                   line=getattr(args, "line", None))
     wrong = problems(opts)
     if wrong:
         raise UsageError(wrong[0])

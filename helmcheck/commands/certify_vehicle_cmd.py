@@ -22,6 +22,7 @@ from pathlib import Path
 
 from .. import exitcodes
 from ..failures import UsageError
+from .lineopt import add_line_argument
 
 __all__ = ["add_arguments", "run", "EPILOG"]
 
@@ -150,6 +151,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                         "is measured first, and a vehicle started with --exec is run at the time scale that "
                         "gives it, else the run stops (exit 2) naming that time scale. any (default): judge "
                         "with what the line gives; timing clauses judged coarser say how coarse")
+    add_line_argument(p)
     p.add_argument("--no-clock-check", dest="clock_check", action="store_false",
                    help="do not measure the vehicle's clock rate ($GPRMC times) against --time-scale at start "
                         "(for a vehicle whose $GPRMC time is not its own clock)")
@@ -246,7 +248,7 @@ def run(args: argparse.Namespace) -> int:  # noqa: C901 - argument checks, then 
                        link=link, log_opener=open_wire_log, exec_cmd=args.exec_cmd,
                        exec_grace_s=args.exec_grace, exec_ready_s=args.exec_ready, certificate=cert,
                        operator=_at_a_terminal(), resume=resume, clock_check=args.clock_check,
-                       precision=args.precision, reconnect_wait_s=wait,
+                       precision=args.precision, reconnect_wait_s=wait, line=args.line,
                        resume_command=resume_command(args, report_dir))
         out = certify(opts)
         if out.nominal_time_scale is not None and args.exec_cmd is not None:
@@ -334,7 +336,7 @@ def _reconnect_wait(args: argparse.Namespace) -> float:
 
 
 #: Options of this invocation a resumed run is given again (each: attribute, flag, takes a value).
-_RESUME_AGAIN = (("reconnect_wait", "--reconnect-wait", True), ("precision", "--precision", True),
+_RESUME_AGAIN = (("reconnect_wait", "--reconnect-wait", True), ("precision", "--precision", True), ("line", "--line", True),
                  ("clock_check", "--no-clock-check", False), ("no_progress", "--no-progress", False),
                  ("sign_key", "--sign-key", True), ("operator", "--operator", True),
                  ("site", "--site", True), ("implementation", "--implementation", True))

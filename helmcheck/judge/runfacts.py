@@ -23,6 +23,9 @@ are part of the wire-log format, ``docs/contracts.md``):
                                             certify a pass
 ``run resumed: <what>``                     an interrupted run goes on: the ``run partial`` and
                                             ``process`` facts before it no longer hold
+``line model: clean|noisy — <why>``         whether the link could damage bytes
+                                            (:mod:`.linemodel`); the last one holds; none:
+                                            noisy, "the record does not say"
 ==========================================  ===================================================
 
 (Bench safety refusing a step is a ``not tested RH-X: …`` note of :mod:`.wire`, booked by the
@@ -44,6 +47,7 @@ from pathlib import Path
 from typing import Any, Iterable, Mapping, Optional
 
 from ..grammar.wirelog import NOTE, read_wire_log
+from .linemodel import UNKNOWN, LineModel, read_line_note
 
 __all__ = ["RunFacts", "selection_note", "not_judged_note", "process_note", "partial_note",
            "NOT_SELECTED", "NOT_SELECTED_OBSERVED"]
@@ -83,6 +87,7 @@ class RunFacts:
     process: Optional[dict] = None  #: the ``process`` object, when helmcheck started the implementation
     partial: Optional[str] = None  #: why the run was cut short, or None
     unreadable: list[str] = field(default_factory=list)  #: fact notes that could not be read
+    line_model: LineModel = UNKNOWN  #: whether the link could damage bytes (:mod:`.linemodel`)
 
     # ------------------------------------------------------------------ reading
     def feed(self, ev: Any) -> None:
@@ -107,6 +112,10 @@ class RunFacts:
             return True
         if text.startswith(_PARTIAL):
             self.partial = text[len(_PARTIAL):]
+            return True
+        model = read_line_note(text)
+        if model is not None:
+            self.line_model = model
             return True
         if text.startswith(_RESUMED):
             self.partial = None

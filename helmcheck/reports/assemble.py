@@ -10,11 +10,12 @@
   entries of one (``check-log`` returns entries);
 * the run facts read from the wire log's notes (:class:`helmcheck.judge.runfacts.RunFacts`):
   the selection, the clauses not judged, the implementation under test's end (``process``),
-  whether the run was cut short (``run partial``).
+  whether the run was cut short (``run partial``), the line model (``line model:``).
 
 Its outputs (:class:`Assembly`): the clause entries of ``results.json`` (the facts booked into
 the ledger first: a clause not selected or not judged is NOT-TESTED unless a violation was
-observed), ``partial``, the ``process`` object, the run verdict
+observed), ``partial``, the ``process`` object, ``line_model`` (whether the link could damage
+bytes, and why: :mod:`helmcheck.judge.linemodel`), the run verdict
 (:func:`~.verdicts.run_verdict`: an implementation that ended early is FAIL), its reason
 (:func:`~.verdicts.describe_verdict`) and the scope (:func:`~.scope.scope_of`: the certificate
 flag). :func:`apply` writes an assembly into a results document; nothing changes a verdict after
@@ -42,6 +43,7 @@ class Assembly:
     clauses: list
     partial: bool
     process: Optional[dict]
+    line_model: dict
     verdict: str
     verdict_reason: str
     scope: Scope
@@ -80,7 +82,7 @@ def assemble(role: str, judged: Any, facts: Optional[RunFacts] = None, *, strict
     if lead and not facts.ended_early:  # an implementation that ended early: its end is the reason
         reason = f"{lead[:1].upper()}{lead[1:]}. {reason}"
     scope = scope_of({"role": role, "clauses": clauses, "partial": cut})
-    return Assembly(role, clauses, cut, process, verdict, reason, scope)
+    return Assembly(role, clauses, cut, process, facts.line_model.as_dict(), verdict, reason, scope)
 
 
 def apply(results: dict[str, Any], a: Assembly, *, final: bool = True, finished: Optional[str] = None,
@@ -94,6 +96,7 @@ def apply(results: dict[str, Any], a: Assembly, *, final: bool = True, finished:
         results["process"] = a.process
     else:
         results.pop("process", None)
+    results["line_model"] = a.line_model
     results["verdict"] = a.verdict
     results["verdict_reason"] = a.verdict_reason
     if final:

@@ -24,7 +24,9 @@ from typing import IO, Any, Callable, Optional
 from ... import __version__
 from ...failures import OutputLost, describe_interrupt
 from ...grammar.wirelog import run_header
+from ...judge.linemodel import line_note
 from ...judge.timing import JITTER_S
+from ...line.linekind import line_for
 from ...line.reopen import DEFAULT_WAIT_S, reopenable
 from ...line.transport import BAUD_RATES, Link, open_link, parse_port_spec
 from ...profile import Profile
@@ -67,6 +69,8 @@ class Options:
     link: Optional[Link] = None
     log: Optional[IO[str]] = None
     settings: dict[str, Any] = field(default_factory=dict)  #: recorded too (``settings`` in results.json)
+    #: ``--line clean|noisy`` (None: guessed from the port, :func:`helmcheck.line.linekind.line_for`)
+    line: Optional[str] = None
 
 
 def _positive(x: Optional[float]) -> bool:
@@ -180,6 +184,7 @@ def _run(opts: Options, profile: Profile, plan, report_dir: Path, link: Link, lo
                         # serves that goes away is the backseat leaving (.runner, link life)
                         port=opts.port if spec.kind != "socket" and reopenable(spec) else None,
                         reconnect_wait=opts.reconnect_wait)
+        runner.recorder.note(0.0, line_note(line_for(opts.port, opts.line, serving=True)))
         if opts.exec_cmd:
             from .process import start_backseat
             try:

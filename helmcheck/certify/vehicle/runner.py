@@ -52,8 +52,10 @@ from ...grammar.wirelog import run_header
 from ...judge import Ledger
 from ...judge.runfacts import RunFacts, partial_note, selection_note
 from ...judge.linebudget import NOMINAL_WIDENING_S
+from ...judge.linemodel import line_note
 from ...judge.vehicle import VehicleObserver
 from ...judge.wire import tester_note
+from ...line.linekind import line_for
 from ...line.recorder import Recorder
 from ...line.reopen import DEFAULT_WAIT_S, reopenable
 from ...line.transport import open_link
@@ -119,6 +121,9 @@ class Options:
     #: timing coarser than nominal (:data:`~helmcheck.judge.linebudget.NOMINAL_WIDENING_S`), naming
     #: the time scale that would not (:class:`CoarseTiming`); ``"any"``: judge with what the line gives
     precision: str = "any"
+    #: ``--line clean|noisy``: the line model the run states (None: guessed from the port,
+    #: :func:`helmcheck.line.linekind.line_for`)
+    line: Optional[str] = None
     #: wall seconds a vanished port is waited for under the same name before the run stops
     #: (``--reconnect-wait``; 0: not waited for), :mod:`.rejoin`
     reconnect_wait_s: float = DEFAULT_WAIT_S
@@ -251,6 +256,7 @@ class Run(ExecChild):
         except Exception:  # noqa: BLE001
             pass
         self.link.note(f"link: {self.p.baud} baud 8N1 {self.o.port}")
+        self.link.note(line_note(line_for(self.o.port, self.o.line)))
         self.session = Session(self.link, self.p, self.k, self.observer, max_wait=self.o.max_wait)
         self.session.custodian = self.custodian
         if self.o.operator:

@@ -19,7 +19,8 @@ Dispatch:
   (:mod:`.knowledge`) from the time it had fully arrived; an ``$ACK`` answers a waiting command;
 * a faulty line: the backseat's broken lines are held until it sends the sentence again
   (:mod:`.lines`; a line-fault relay's notes, :mod:`helmcheck.judge.linefaults`, say exactly which
-  the line broke). A report the line broke on its way to the backseat is still taken as known
+  the line broke; a ``line model: clean`` note, :mod:`helmcheck.judge.linemodel`, says the line
+  broke none). A report the line broke on its way to the backseat is still taken as known
   (decision: a backseat may read a damaged line; the live certification cannot tell either);
 * notes (``!``, :func:`~helmcheck.judge.wire.parse_note`) — ``scenario X starts`` (findings
   then carry ``X`` as their case), ``lockout starts (<code>)`` / ``lockout ends``, ``silence
@@ -43,6 +44,7 @@ from ...profile import Profile
 from ..facts import LOCKOUT_REFUSED, NEEDS_MISSION, NEEDS_RUNNING, NEEDS_STOPPED
 from ..ledger import Evidence, Ledger
 from ..linefaults import LineFaults
+from ..linemodel import UNKNOWN
 from ..timing import ack_allowance, ack_give_up_after
 from ..wire import FROM_VEHICLE, NOTE, TO_VEHICLE, Decodings, WireEvent, parse_note
 from .budget import LineBudget
@@ -109,6 +111,7 @@ class BackseatObserver:
                                                         st.baud, st.resolution))
         self.silent = False
         self.faults = LineFaults()  #: what a line-fault relay's notes say the line did
+        self.line_model = UNKNOWN  #: whether the link can damage bytes, as the record states it
         self.started: Optional[float] = None  #: time of the backseat's first byte
         self.ended: Optional[float] = None
 
@@ -337,6 +340,10 @@ class BackseatObserver:
             self.faults.note(ev.t, n.value)
         elif n.kind == "relay":
             self.faults.relay_started()
+        elif n.kind == "line-model":
+            self.line_model = n.value
+            if not n.value.can_damage:
+                self.faults.clean_link()
         elif n.kind == "link" and n.value:
             st.baud = int(n.value)
             self.arrivals.baud = st.baud

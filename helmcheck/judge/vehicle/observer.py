@@ -36,7 +36,8 @@ end concludes what it held), ``not tested``/``inconclusive`` (tester facts), ``l
 for before them and still on its way, which shows the state before them; a mission waypoint
 reached whose park or end the observer has not learnt is left to the reports, from the note's
 moment on),
-``line fault …`` and ``relay started:`` (a line-fault relay's record).
+``line fault …`` and ``relay started:`` (a line-fault relay's record), ``line model:`` (a clean
+link: nothing is held, every error is the vehicle's at once, :mod:`helmcheck.judge.linemodel`).
 
 A driver reads, besides the ledger: :attr:`sent` (every classified backseat line, with its
 outcome — the handle a live driver waits on), :attr:`last_osi`, :meth:`deadline` and
@@ -56,6 +57,7 @@ from ...model import plant as P
 from ...profile import Profile
 from ..ledger import Evidence, Ledger, Reason
 from ..linefaults import LineFaults
+from ..linemodel import UNKNOWN
 from ..spoil import REPEAT, explain, explain_discard, signature
 from ..streaks import OTHER_REPEAT, Streaks
 from ..timing import JITTER_S
@@ -113,6 +115,7 @@ class VehicleObserver(Answers, Deadlines):
         #: observations a faulty line may have spoilt, held until made again (module docstring)
         self.streaks = Streaks(ledger)
         self.faults = LineFaults()  #: what a line-fault relay's notes say the line did
+        self.line_model = UNKNOWN  #: whether the link can damage bytes, as the record states it
         #: a command's bytes -> the latest sending of it answered in full, on time, nothing spoilt
         self.clean_sendings: dict = {}
         self.late_until = 0.0  #: when the latest late $ACK came (what was sent before may share its stall)
@@ -296,6 +299,10 @@ class VehicleObserver(Answers, Deadlines):
             self.faults.note(ev.t, n.value)
         elif n.kind == "relay":
             self.faults.relay_started()
+        elif n.kind == "line-model":
+            self.line_model = n.value
+            if not n.value.can_damage:
+                self.faults.clean_link()
         elif n.kind == "case":
             self.case, self.case_clauses = n.case, n.clauses
         elif n.kind == "case-end":
