@@ -84,7 +84,7 @@ def _assert_no_fail_and_named(out_dir: Path, results: dict, line, stall: bool = 
 
 def _certify_vehicle(port: str, profile, k: float, out: Path, select=FRAMING_ACK, examples=0):
     return certify(Options(port=port, profile=profile.replace(time_scale=k), time_scale=k, report_dir=out,
-                           select=select, examples=examples, progress=False, render=False, seed=1))
+                           select=select, examples=examples, progress=False, render=False, seed=1, line="noisy"))
 
 
 def _sim_profile(tmp: Path):
@@ -164,7 +164,7 @@ def run_backseat(tmp_path: Path, faults: str, k: float, duration: float, program
 
     try:
         bcertify(BOptions(profile=DEFAULT, report_dir=tmp_path / "r", time_scale=k, duration=duration,
-                          connect_timeout=20.0, progress=False, render=False, on_port=on_port))
+                          connect_timeout=20.0, progress=False, render=False, on_port=on_port, line="noisy"))
     finally:
         for p in procs:
             p.terminate()
@@ -241,7 +241,8 @@ def test_a_faulty_vehicle_behind_light_damage_still_fails_on_its_own_clause(muta
             impaired_line(port, f"{LIGHT},seed=1", link=tmp_path / "vehicle", process=True,
                           wire_log=tmp_path / "relay.log") as line:
         out = certify(Options(port=str(line.port), profile=profile, time_scale=k, report_dir=tmp_path / "r",
-                              select=list(mutant.select), examples=0, progress=False, render=False, seed=1))
+                              select=list(mutant.select), examples=0, progress=False, render=False, seed=1,
+                              line="noisy"))
     failed = {c["id"]: c["reason"] for c in out.results["clauses"] if c["verdict"] == "fail"}
     assert mutant.clause in failed, (failed, out.reason)
     assert out.exit_code == 1

@@ -18,6 +18,7 @@ from pathlib import Path
 
 from .. import exitcodes
 from ..failures import UsageError
+from .lineopt import add_line_argument
 
 __all__ = ["add_parser", "run", "EPILOG"]
 
@@ -89,6 +90,7 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
                    help="where diff.json, the wire logs and the replays go (default reports/diff; an earlier "
                         "diff there is replaced)")
     p.add_argument("--no-progress", action="store_true", help="no progress lines on standard error")
+    add_line_argument(p)
     p.set_defaults(func=run)
     return p
 
@@ -129,13 +131,13 @@ def _specs(args: argparse.Namespace) -> list:
             why = check_command(value)
             if why:
                 raise UsageError(f"--exec ({name}): {why}")
-            specs.append(SideSpec(name, "pty", p, float(k), exec_cmd=value))
+            specs.append(SideSpec(name, "pty", p, float(k), exec_cmd=value, line=args.line))
         else:
             spec = port_spec(value)
             if spec.kind == "pty":
                 raise UsageError("--port pty creates a new pseudo-terminal; give the vehicle's port (e.g. "
                                  "/dev/pts/N) or --exec CMD to start it on one")
-            specs.append(SideSpec(name, value, p, float(k)))
+            specs.append(SideSpec(name, value, p, float(k), line=args.line))
     return specs
 
 

@@ -76,7 +76,7 @@ def verify_run(directory: Path | str, public_key=None, *, public_key_name: str =
                 catalog = DirectoryCatalog(list(job.missions))
             try:
                 outcome = check_log(job.wire_path, profile=profile, role=job.role, time_scale=job.time_scale,
-                                    swap=job.swap, catalog=catalog)
+                                    swap=job.swap, catalog=catalog, line=job.line)
             except (LogFormatError, OSError, ValueError) as e:
                 out.add(job.wire_name, f"cannot be re-judged: {e}")
             else:

@@ -18,6 +18,8 @@
   :class:`~.relay.Relay` with the schedule as its stage: ``helmcheck relay``) and
   :mod:`.faultline` (:func:`~.faultline.impaired_line`, a vehicle behind a bad line for a test);
   :mod:`.faultdocs` makes its page, ``docs/line-faults.md``;
+* :mod:`.linekind` — which line model a port gets (a pty, TCP to this host: clean; a UART, a
+  serial server elsewhere: noisy);
 * :mod:`.baudguess` — which common baud rate would make a garbled capture sentences (sans-IO);
 * :mod:`.counters` — a serial port's error counters from the kernel (``TIOCGICOUNT``), or why
   there are none (a pty, a socket);

@@ -31,7 +31,7 @@ from typing import Optional
 from ..judge.linemodel import CLEAN, NOISY, LineModel, given
 from .port_spec import parse_port_spec
 
-__all__ = ["guess_line", "line_for", "is_pty_device"]
+__all__ = ["guess_line", "line_for", "line_of_sides", "is_pty_device"]
 
 #: Linux's Unix98 pty slave majors (``Documentation/admin-guide/devices.txt``: 136–143).
 _PTY_MAJORS = range(136, 144)
@@ -114,3 +114,15 @@ def guess_line(port: str, *, serving: bool = False) -> LineModel:
 def line_for(port: str, choice: Optional[str] = None, *, serving: bool = False) -> LineModel:
     """The model a run uses: the user's ``--line`` when given, else :func:`guess_line`."""
     return given(choice) if choice else guess_line(port, serving=serving)
+
+
+def line_of_sides(sides: list[tuple[str, bool]], choice: Optional[str] = None) -> LineModel:
+    """The model of a session carried over several links (a monitor's two sides; ``(port,
+    serving)`` each): noisy when any of them is, and why; the user's ``--line`` when given."""
+    if choice:
+        return given(choice)
+    models = [guess_line(port, serving=serving) for port, serving in sides]
+    noisy = [m for m in models if m.can_damage]
+    if noisy:
+        return LineModel(NOISY, "; ".join(m.why for m in noisy))
+    return LineModel(CLEAN, "; ".join(m.why for m in models))

@@ -15,7 +15,8 @@ Modules, one concern each:
 * :mod:`~helmcheck.reports.rundir` — one read of a results directory (:class:`Run`).
 * :mod:`~helmcheck.reports.view` — clause rows joined with the profile, grouped and counted.
 * :mod:`~helmcheck.reports.text` — printable text, short titles.
-* :mod:`~helmcheck.reports.linecounters` — the port's line error counters of a run, in a sentence.
+* :mod:`~helmcheck.reports.linecounters` — the line a run was judged on, in a sentence each: its model
+  (clean or noisy, and why) and its port's error counters.
 * :mod:`~helmcheck.reports.timeline` — the mode timeline SVG.
 * :mod:`~helmcheck.reports.html`, :mod:`~helmcheck.reports.junit`,
   :mod:`~helmcheck.reports.markdown`, :mod:`~helmcheck.reports.compare` — the renderings.

@@ -1,5 +1,5 @@
 """The HTML report's sections about the run: the implementation as declared and as seen on the
-wire, the run's facts (the port's line error counters among them), the process under test (``--exec``) and the vehicle's restore.
+wire, the run's facts (the line model and the port's line error counters among them), the process under test (``--exec``) and the vehicle's restore.
 """
 
 from __future__ import annotations
@@ -7,7 +7,7 @@ from __future__ import annotations
 from typing import Mapping
 
 from .html_markup import _e, _flatten, _kv_table
-from .linecounters import counters_summary
+from .linecounters import counters_summary, line_model_summary
 from .rundir import Run
 from .verdicts import describe_process
 
@@ -19,6 +19,9 @@ def _run_facts(run: Run) -> str:
             ("duration", None if r["duration_s"] is None else f'{r["duration_s"]:.3f} s'),
             ("seed", r["seed"]), ("results directory", str(run.directory))]
     rows += [(f"settings.{k}", v) for k, v in _flatten(r["settings"])]
+    model = line_model_summary(r)
+    if model is not None:
+        rows.append(("line model", model))
     counters = counters_summary(r)
     if counters is not None:
         rows.append(("line error counters", counters))

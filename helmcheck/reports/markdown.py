@@ -17,7 +17,7 @@ from __future__ import annotations
 import re
 
 from .identity import identity_rows
-from .linecounters import counters_summary
+from .linecounters import counters_summary, line_model_summary
 from .rundir import Run
 from .scope import edge_gist, headline, model_coverage_note, scope_of
 from .text import printable
@@ -112,6 +112,9 @@ def render_markdown(run: Run, comparison_md: str | None = None) -> str:
             out += ["**Vehicle NOT verified as restored**: " + md_escape("; ".join(rec.get("problems") or []))
                     + ". Set by hand: " + md_escape("; ".join(rec.get("by_hand") or [])) + ".", ""]
 
+    model = line_model_summary(r)
+    if model is not None:
+        out += [f"Line model: {md_escape(model)}.", ""]
     counters = counters_summary(r)
     if counters is not None:
         out += [f"Line error counters: {md_escape(counters)}.", ""]

@@ -61,7 +61,7 @@ from typing import Optional
 
 from ...model.observe import Finding, quick_check
 from ...model.timers import tolerance
-from ...model.transitions import REMOTE_MODES, STAY, Row
+from ...model.transitions import COMMAND_EVENTS, REMOTE_MODES, STAY, Row
 from ...model.vehicle import VehicleModel
 
 __all__ = ["Candidate", "Timed", "sig"]
@@ -202,6 +202,14 @@ class Candidate:
                     self._mode = row.target
                 if row.phase_to is not None:
                     self._phase = row.phase_to
+            if (row.error is None and not st.timer and self.timed
+                    and ((row.target != STAY and row.event in COMMAND_EVENTS) or self._mode in
+                         {tt.pre_mode for tt in self.timed})):
+                # a command took control again after a timer ran out, or the state went back to
+                # the timer's before-state, before any report showed the timer's end: no report can
+                # tell any more when (or whether) it ended there, so it is not judged (a $OMS with
+                # the range's lowest timeout restarted at once, V-65: RH-RD-3 either way)
+                self.timed = [tt for tt in self.timed if tt.timer == "lockout"]
             if st.timer:
                 fired.append(st)
                 t_old = None
