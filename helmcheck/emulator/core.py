@@ -69,7 +69,7 @@ from ..model.plant import SafetyViolation
 from ..model.vehicle import VehicleModel
 from ..profile import SAFETY_CODES, Profile
 from ..line.transport import LinePacer
-from .freedoms import DEFAULT_SETTINGS, EmulatorSettings, ReplyDelay, ReplyShaper, SkewedTimers
+from .freedoms import DEFAULT_SETTINGS, EmulatorSettings, ReplyDelay, ReplyShaper, SkewedTimers, model_readings
 from .logs import HistoryEntry, MainLog, event_text
 from .outbox import MAX_OUTBOX_BYTES, Outbox
 from .plant import Plant, PlantParams
@@ -112,6 +112,7 @@ class EmulatorCore(Timeline, Outbox):
         self.utc0 = utc0
         self.plant = Plant(profile, params or plant_params(st))
         self.model = model_factory(profile, missions)
+        self.model.readings = model_readings(st)  # the profile's open questions, as this vehicle reads them
         if st.timer_factor != 1.0 or st.timer_offset_s != 0.0:  # RH-TIM-1: a vehicle's own clock
             self.model.timers = SkewedTimers(st.timer_factor, st.timer_offset_s)
         for name, state, values in st.factory_settings:  # the vehicle's own settings (RH-SET-2)
@@ -150,7 +151,8 @@ class EmulatorCore(Timeline, Outbox):
         self.stats["bytes_in"] += len(data)
         v = self._catch_up(now)
         for ev in self.framer.feed(data):
-            if self._delay.active or self._burst:  # processed later, in arrival order (RH-ACK-2, RH-ACK-6)
+            if self._delay.active or self._burst or self.settings.process_when_idle:
+                # processed later, in arrival order (RH-ACK-2, RH-ACK-6)
                 self._inbox.append((self._due(ev, now), ev))
             elif isinstance(ev, Discard):
                 self._discard(ev, now)
@@ -179,7 +181,10 @@ class EmulatorCore(Timeline, Outbox):
 
     def _process_inbox(self, now: float) -> None:
         """Lines whose processing time has come (``reply_delay_s``), oldest first."""
+        idle_first = self.settings.process_when_idle
         while self._inbox and self._inbox[0][0] <= now:
+            if idle_first and (self._out or (self.pacer.baud and self.pacer.free_at > now + 1e-9)):
+                break  # processed once the replies before it have left: its ACK goes out at once
             _, ev = self._inbox.popleft()
             v = self._catch_up(now)
             if isinstance(ev, Discard):

@@ -291,7 +291,8 @@ CASES: tuple[Case, ...] = (
        Send(OMS), Send("OMSTOP,0"), Poll(mode="S"), Start(),
        Send("OMP,8a8a7676{motor},00,{to}"), Send("OMSTOP,0"), Poll(mode="S")),
     _c("V-47", "RH-MSN-4", "The mission ends at its last waypoint",
-       "the profile's end_mission, started by name, ends in S after its last waypoint (and its park)",
+       "the profile's end_mission (without one: the test mission, when the vehicle reports it short enough "
+       "to wait for), started by name, ends in S after its last waypoint (and its park)",
        "S", Start(which="end_mission"), MissionEnd(), needs=("end_mission",)),
     # --- §6 read/write -----------------------------------------------------------------------
     _c("V-48", "RH-POS-1", "$OPOS forms",
@@ -513,9 +514,10 @@ def unmet_need(case: Case, profile: Profile, durations=None) -> Optional[str]:
             return f"the profile's osd_letters lack {arg}"
         if kind == "safety_action" and profile.safety_action != arg:
             return f"the profile's safety_action is {profile.safety_action}, this case needs {arg}"
-        if kind == "end_mission" and not profile.end_mission:
-            return ("the profile names no end_mission (a short mission whose end a run can wait for): "
-                    "the test mission is too long to reach its end (RH-MSN-4)")
+        if kind == "end_mission" and not profile.end_mission and profile.protocol != "rh5":
+            return ("the profile names no end_mission (a short mission whose end a run can wait for), and "
+                    f"a {profile.protocol} $OSI shows no remaining mission time to tell whether the test "
+                    "mission ends soon enough (RH-MSN-4)")
         if kind == "srp_mission" and not profile.srp_mission:
             return "the profile names no srp_mission: the srp branch of SafetyAction cannot be exercised"
         if kind == "srp_field" and profile.protocol != "rh5" and profile.osi_fields < 16:

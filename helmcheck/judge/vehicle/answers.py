@@ -33,6 +33,7 @@ from typing import Optional
 
 from ...grammar import sentences as s
 from ...grammar.wirelog import escape
+from ...model.readings import BY_KEY as _READINGS
 from ...model.timers import tolerance
 from ..ledger import Evidence
 from ..spoil import REPEAT
@@ -50,6 +51,12 @@ OWN_REASON = {"RH-INT-3": "after the control that interrupted an $OPK park ended
               "RH-OMW-5": "after the control that interrupted the $OMW queue ended, the mission resumed, "
                           "not the queue",
               "RH-SAF-2": "the commands refused during the lockout had no effect after it"}
+
+
+def reading_clause(taken: str) -> str:
+    """The clause of a reading taken (``key = value``)."""
+    r = _READINGS.get(taken.split(" = ")[0])
+    return r.clause if r is not None else "a reading"
 
 
 class Answers:
@@ -372,6 +379,14 @@ class Answers:
         if res.adopted:
             for cid in cands[:1]:
                 self.ledger.remark(cid, f"explained by an unseen event: {res.adopted[-1]}.")
+        if res.reading:
+            p.reading = res.reading
+            for taken in res.reading:
+                self.readings_shown.setdefault(taken.split(" = ")[0], (taken, p.ev))
+                for cid in cands[:1]:
+                    self.ledger.remark(cid, f"the vehicle takes the reading {taken} "
+                                            f"({reading_clause(taken)}; every reading is accepted: helmcheck "
+                                            f"profile readings).")
         row = res.row
         if a.status:
             self.passed(passable(cands), lambda: f"{text_of(p)} refused with $ACK,{a.type},1,{a.err} as a conforming "

@@ -47,6 +47,7 @@ from typing import Optional
 
 from ...grammar import sentences as s
 from ...grammar.errors import SentenceError
+from ...model.readings import taken as taken_readings
 from ...model.timers import tolerance
 from ...model.transitions import INTERNAL_EVENTS, REMOTE_MODES, STAY, rows_for
 from ...model.vehicle import VehicleModel
@@ -83,6 +84,8 @@ class CommandResult:
     #: (command, row, ACK) of the accepted command before this one, with no report between, whose
     #: not being carried out explains this answer too (module docstring); () when none does
     ignored: tuple = ()
+    #: the readings of the profile's open questions the chosen state took to explain the answer
+    reading: tuple = ()
 
 
 @dataclass(slots=True)
@@ -161,9 +164,12 @@ class Beliefs:
         match = [o for o in options if reply_keys(o[1]) == got]
         if match:
             base = len(self.cands[0].story)
+            took = len(self.cands[0].took)
             self._keep([o[0] for o in match])
             chosen = match[0]
             result = CommandResult(chosen[1], True, chosen[2], chosen[3], chosen[0].story[base:], False, desync)
+            sid = getattr(item, "ID", None) or getattr(item, "sentence_id", None) or ""
+            result.reading = chosen[0].took[took:] or taken_readings(sid, chosen[0].model.readings)
         else:
             explanations = []  # each candidate's own (they may differ in what no report shows yet)
             for c in self.cands:

@@ -118,6 +118,9 @@ class VehicleObserver(Answers, Deadlines):
         self.line_model = UNKNOWN  #: whether the link can damage bytes, as the record states it
         #: a command's bytes -> the latest sending of it answered in full, on time, nothing spoilt
         self.clean_sendings: dict = {}
+        #: key -> (``key = value``, the first evidence) of every reading of the profile's open
+        #: questions the vehicle was seen to take (:mod:`helmcheck.model.readings`)
+        self.readings_shown: dict = {}
         self.late_until = 0.0  #: when the latest late $ACK came (what was sent before may share its stall)
         self._unit_fault: Optional[str] = None  #: the relay's note on the vehicle run being judged
         self._junk_wait: Optional[tuple] = None  #: bytes between lines, waiting for what follows them
