@@ -54,6 +54,12 @@ class Reading:
     judge: str  #: how the judge accepts every reading, in one sentence
     setting: Optional[str] = None  #: the emulator setting that takes each (None: nothing to take)
     vehicle3: str = ""  #: the third-party vehicle's own choice, where its README states one
+    #: the vehicle clause an answer under this reading is judged on (its pass is booked there, and
+    #: the report names the reading taken there)
+    books: str = ""
+    #: the clauses whose certification cases meet the question (the suite certifies the emulator on
+    #: them under every reading); empty: no case meets it (the exploration and logs may)
+    certify: tuple[str, ...] = ()
 
     @property
     def values(self) -> tuple[str, ...]:
@@ -75,7 +81,7 @@ READINGS: tuple[Reading, ...] = (
          Choice("31", "refused with 31 at the file look-up: a name outside the directory is one the vehicle "
                       "cannot read (never opened); a state precondition refuses first (30)")),
         "model", "the model answers the rh5 `$OMSTART` under both; a vehicle's 30 or 31 is a pass",
-        setting="srp_bad_path", vehicle3="31"),
+        books="RH-MSN-2", setting="srp_bad_path", vehicle3="31", certify=("RH-MSN-2",)),
     Reading(
         "ascent_refusal_order", "RH-RD-12",
         "After the lockout, before the surface: is a malformed `$OMS`/`$OJW`/`$OPK`/`$OMW` refused with 26 "
@@ -86,7 +92,7 @@ READINGS: tuple[Reading, ...] = (
          Choice("after fields", "the command's own error when a field is bad, else 26 (the refusal is a "
                                 "state precondition, after the fields)")),
         "model", "the model answers a command in the ascent under both",
-        setting="ascent_refusal_order", vehicle3="first"),
+        books="RH-SAF-3", setting="ascent_refusal_order", vehicle3="first"),
     Reading(
         "omw_pitch_speed", "RH-RD-9",
         "Are `$OMW` max pitch and speed bounded (as `$OMS`'s: [0, 45] and [0, max_speed_kn])?",
@@ -95,7 +101,7 @@ READINGS: tuple[Reading, ...] = (
         (Choice("bounded", "pitch above 45 or speed above max_speed_kn refused (36), as `$OMS`'s"),
          Choice("unbounded", "any non-negative pitch and speed queued")),
         "model", "the model answers an `$OMW` beyond those values under both",
-        setting="omw_pitch_speed", vehicle3="bounded"),
+        books="RH-ACK-3", setting="omw_pitch_speed", vehicle3="bounded", certify=("RH-ACK-3",)),
     Reading(
         "resumed_park", "RH-INT-2",
         "A mission park resumed after remote control moved the vehicle off station: does its time left count "
@@ -104,14 +110,14 @@ READINGS: tuple[Reading, ...] = (
         (Choice("at once", "counts from the release, wherever the vehicle is"),
          Choice("on station", "counts once back within on_station_m of the park's waypoint, which it heads for")),
         "freedom", "the mirror adopts the return on station within its window (:mod:`helmcheck.judge.vehicle.closure`)",
-        setting="resumed_park", vehicle3="at once"),
+        books="RH-INT-2", setting="resumed_park", vehicle3="at once", certify=("RH-INT-2",)),
     Reading(
         "idle_distance", "RH-RD-5",
         "`$OSI` field 7 with no navigation target (`S`, `M` from `S`)?",
         "RH-RD-5: Field 7 is the distance to the present navigation target; with none … it is the vehicle's "
         "choice (0, or the distance to the last target) and is not judged",
         (Choice("zero", "0"), Choice("last", "the distance to the last target")),
-        "judge", "field 7 is not judged there", setting="idle_distance", vehicle3="last"),
+        "judge", "field 7 is not judged there", books="RH-OUT-1", setting="idle_distance", vehicle3="last", certify=("RH-MSN-3",)),
 )
 
 BY_KEY: dict[str, Reading] = {r.key: r for r in READINGS}

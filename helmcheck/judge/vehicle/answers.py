@@ -324,7 +324,7 @@ class Answers:
             self.event(p.t, "command", text_of(p)[:60])
             if res.before[0] in ("A", "M", "mP", "W") and res.row is not None and res.row.target != "=":
                 self.interrupt_pairs.add((res.before[0], p.kind.item.ID))
-        cands = command_clauses(p.kind.item, want, res.row, res.before[0])
+        cands = command_clauses(p.kind.item, want, res.row, res.before[0], res.before[1])
         if p.kind.variant and a.status == 1 and (want is None or want.status == 0):
             # refused where a conforming vehicle accepts: the form it must still read (RH-FRM-2/3/6/7)
             # first; a wrong answer to a line it did read is about the command, not the form
@@ -381,12 +381,13 @@ class Answers:
                 self.ledger.remark(cid, f"explained by an unseen event: {res.adopted[-1]}.")
         if res.reading:
             p.reading = res.reading
-            for taken in res.reading:
-                self.readings_shown.setdefault(taken.split(" = ")[0], (taken, p.ev))
-                for cid in cands[:1]:
-                    self.ledger.remark(cid, f"the vehicle takes the reading {taken} "
-                                            f"({reading_clause(taken)}; every reading is accepted: helmcheck "
-                                            f"profile readings).")
+            for taken in res.reading:  # named in the clause's reason at the end (observer.close)
+                r = _READINGS.get(taken.split(" = ")[0])
+                cid = r.books if r is not None and r.books else (cands[0] if cands else "")
+                self.readings_shown.setdefault(taken.split(" = ")[0], (taken, cid, p.ev))
+                if cid:
+                    self.ledger.passed(cid, lambda: f"{text_of(p)} answered {brief([a])} as a conforming vehicle "
+                                                    f"taking the reading {taken} does", ev, self.case)
         row = res.row
         if a.status:
             self.passed(passable(cands), lambda: f"{text_of(p)} refused with $ACK,{a.type},1,{a.err} as a conforming "

@@ -139,14 +139,18 @@ def _dedupe(xs: tuple[str, ...]) -> tuple[str, ...]:
     return tuple(dict.fromkeys(x for x in xs if vehicle_clause(x)))
 
 
-def command_clauses(item, expected_ack: Optional[s.ACK], row, before_mode: str = "") -> tuple[str, ...]:
+def command_clauses(item, expected_ack: Optional[s.ACK], row, before_mode: str = "",
+                    before_phase: str = "") -> tuple[str, ...]:
     """The clauses an answered command speaks to, most specific first (module docstring).
     ``before_mode``: the mode the command met; a command a conforming vehicle accepts there that
     takes over from another remote control speaks first to RH-INT-1 (any remote command interrupts
-    any other), whatever else its row names."""
+    any other), whatever else its row names. ``before_phase``: the safety phase it met (a refusal
+    owed in the ascent after the lockout is RH-SAF-3's, not the lockout's)."""
     if isinstance(item, SentenceError):
         if expected_ack is not None and expected_ack.err == 26:
-            return ("RH-SAF-1",) if row is None else _dedupe(row.clauses)
+            if row is None:
+                return ("RH-SAF-3",) if before_phase == "ascent" else ("RH-SAF-1",)
+            return _dedupe(row.clauses)
         first = "RH-OSD-2" if item.sentence_id == "OSD" else item.clause
         if (first == "RH-ACK-3" or first.startswith("RH-RD-")) and item.field:
             # a field's form or range (set by a clause, or by a reading of one): the clause that sets it

@@ -64,7 +64,7 @@ from ..timing import JITTER_S
 from ..wire import FROM_VEHICLE, LINE_CACHE, NOTE, TO_VEHICLE, Decodings, WireEvent, parse_note
 from . import osichecks
 from .belief import Beliefs
-from .answers import Answers
+from .answers import Answers, reading_clause
 from .blame import command_clauses, targets
 from .catalog import GivenMissions, KnownMissions
 from .deadlines import Deadlines
@@ -118,7 +118,7 @@ class VehicleObserver(Answers, Deadlines):
         self.line_model = UNKNOWN  #: whether the link can damage bytes, as the record states it
         #: a command's bytes -> the latest sending of it answered in full, on time, nothing spoilt
         self.clean_sendings: dict = {}
-        #: key -> (``key = value``, the first evidence) of every reading of the profile's open
+        #: key -> (``key = value``, the clause it was seen on, the first evidence) of every reading of the profile's open
         #: questions the vehicle was seen to take (:mod:`helmcheck.model.readings`)
         self.readings_shown: dict = {}
         self.late_until = 0.0  #: when the latest late $ACK came (what was sent before may share its stall)
@@ -625,6 +625,10 @@ class VehicleObserver(Answers, Deadlines):
         if self.closed:
             return
         self.closed = True
+        for taken, cid, _ev in self.readings_shown.values():
+            if cid:
+                self.ledger.remark(cid, f"the vehicle takes the reading {taken} ({reading_clause(taken)}; every "
+                                        f"reading is accepted: helmcheck profile readings).")
         t = self.t
         for fe in self.framers[TO_VEHICLE].close():
             self._backseat(fe, WireEvent(t, TO_VEHICLE, b"", "", 0))
