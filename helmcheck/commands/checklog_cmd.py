@@ -227,16 +227,22 @@ def _summary(f: Path, out, res: dict, rdir: Path, how, rendered: bool = True) ->
     print(report_line(rdir, rendered))
 
 
+#: Words of a reason that gave something to a faulty line (held, or made again and dismissed).
+_LINE_WORDS = ("faulty line", "the line may have", "the line, not the implementation")
+
+
 def _line_hint(res: dict) -> str:
-    """What to do when a log that does not say what its link was is INCONCLUSIVE on what a faulty
-    line could have done (:mod:`helmcheck.judge.linemodel`)."""
+    """What to do when a log that does not say what its link was had errors given to a faulty line
+    (INCONCLUSIVE, or made again and not judged): on a pty or TCP the line cannot have made them
+    (:mod:`helmcheck.judge.linemodel`)."""
     from ..judge.linemodel import UNKNOWN
-    if res.get("verdict") != "inconclusive" or (res.get("line_model") or {}).get("why") != UNKNOWN.why:
+    if (res.get("line_model") or {}).get("why") != UNKNOWN.why:
         return ""
-    if not any(c["verdict"] == "inconclusive" and "line" in c.get("reason", "") for c in res["clauses"]):
+    if not any(w in c.get("reason", "") for c in res["clauses"] for w in _LINE_WORDS
+               if c["verdict"] in ("inconclusive", "pass", "non-strict")):
         return ""
-    return (" This log does not say what its link was, so it was judged as a line that can damage bytes: "
-            "if this capture's link was a pty or TCP, run with --line clean")
+    return (" This log does not say what its link was, so errors a faulty line could have made were given to "
+            "the line: if this capture's link was a pty or TCP, run with --line clean")
 
 
 #: From this size on a check shows its progress without --progress.

@@ -11,7 +11,7 @@ import argparse
 __all__ = ["add_line_argument"]
 
 _HELP = ("whether the link can damage bytes. clean: it cannot (a pty, TCP to this host): every "
-         "broken line, lost byte and missing or late answer is the implementation's at once. noisy: "
+         "broken line, lost byte and missing answer is the implementation's at once. noisy: "
          "it can (a UART, a serial server elsewhere): an error the line could have made is judged only "
          "when the observation, made again, repeats it. Default: {default}; the report says which and why")
 

@@ -39,6 +39,9 @@ class LineFaults:
 
     def __init__(self):
         self.instrumented = False
+        #: the record states a clean link (no relay): nothing on it damages or delays bytes, but
+        #: the implementation shares this host's CPU, whose stalls can still make an answer late
+        self.clean = False
         self._pending: dict[str, list[str]] = {TO_VEHICLE: [], FROM_VEHICLE: []}
         self._reframed: dict[str, str] = {}
         self._open: dict[tuple[str, str], float] = {}  #: (kind, direction) -> start
@@ -51,6 +54,7 @@ class LineFaults:
         """The record states a link that cannot damage bytes (a pty, TCP on this host): nothing
         the line did goes unnoted, because it does nothing (:mod:`.linemodel`)."""
         self.instrumented = True
+        self.clean = True
 
     def note(self, t: float, fault: FaultNote) -> None:
         """A line-fault note at ``t``."""

@@ -3,8 +3,10 @@
 A serial line (a UART, a radio modem, an RS-232 cable past its length) flips bits, loses bytes and
 stalls; a judge reading it holds what such a line could have done until the observation is made
 again (``docs/contracts.md``, "A faulty line"). A pseudo-terminal, or a TCP connection to this
-host, cannot: the kernel copies the bytes. On such a **clean** link every broken line, lost byte,
-missing or late answer is the implementation's, at once — no holding, no re-runs.
+host, cannot: the kernel copies the bytes. On such a **clean** link every broken line, lost byte
+and missing answer is the implementation's, at once — no holding, no re-runs. (A late answer alone
+may still be this host's: an implementation on a pty or local TCP shares its CPU, and a stall of it
+delays an answer; late again when made again, it is the implementation's.)
 
 This module owns the two models, their wire-log note and what a judge makes of it:
 
@@ -49,7 +51,7 @@ class LineModel(NamedTuple):
         """One sentence for a report: ``clean (a pty helmcheck made): every broken line …``."""
         if self.kind == CLEAN:
             return (f"clean ({self.why}): it cannot damage a byte, so every broken line, lost byte and "
-                    f"missing or late answer is the implementation's")
+                    f"missing answer is the implementation's")
         return (f"noisy ({self.why}): an error the line could have made is judged only when the "
                 f"observation, made again, repeats it")
 

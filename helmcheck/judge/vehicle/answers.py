@@ -261,6 +261,9 @@ class Answers:
         note = self.faults.held_between(p.t, p.t + dt)
         if note is not None:
             return f"the line held it (the relay's note: {note})"
+        if self.faults.clean:
+            return (f"an $ACK {dt:.2f} s after its command: the link is clean, but an implementation on a pty "
+                    f"or local TCP shares this host's CPU, whose stall may have held it")
         if self.faults.instrumented:
             return None
         return f"an $ACK {dt:.2f} s after its command: a stall of the line (or of the host) may have held it"
