@@ -55,8 +55,9 @@ bench safety: unless the profile says [bench_safety] in_water = true, no $OMP mo
 
 --exec CMD starts the vehicle under test (a simulator, a firmware build on the host) on a new
 pty ({port} is its path; without {port} the path is appended), or with --port socket://HOST:0
-on a free TCP port ({port} is socket://HOST:N, {host} and {tcp_port} its halves); {time_scale}
-is K. Its output goes to DIR/vehicle.stdout.log and DIR/vehicle.stderr.log; at the end it gets
+on a free TCP port ({port} is socket://HOST:N, {host} and {tcp_port} its halves), or with
+--port announced on the port it makes itself and prints as a line 'port: URL' (a simulator with a
+pty of its own; it is given no port); {time_scale} is K. Its output goes to DIR/vehicle.stdout.log and DIR/vehicle.stderr.log; at the end it gets
 SIGTERM, then SIGKILL after --exec-grace. A vehicle that exits or dies before the end fails the
 run (results.json "process", its last output quoted).
 
@@ -113,7 +114,8 @@ exit status: 0 pass (or non-strict without --strict), 1 fail, 2 inconclusive, li
 def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--port", metavar="URL",
                    help="what pyserial opens: /dev/ttyUSB0, /dev/pts/N, socket://HOST:PORT, rfc2217://… "
-                        "(required unless --exec; with --exec: pty, the default, or socket://HOST:0)")
+                        "(required unless --exec; with --exec: pty, the default, socket://HOST:0, or "
+                        "announced: the vehicle makes its own port and prints 'port: URL')")
     p.add_argument("--profile", metavar="FILE", help="TOML profile (the ICS; default: rh5)")
     p.add_argument("--time-scale", type=float, metavar="K",
                    help="the vehicle's clock runs K times faster than wall time (RH-TIM-2; default: the profile's)")
@@ -134,7 +136,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--no-progress", action="store_true", help="no progress display")
     p.add_argument("--exec", dest="exec_cmd", metavar="CMD",
                    help="start the vehicle under test on the port: CMD is split like a shell line, run "
-                        "without a shell; {port} is replaced by the port (appended if absent)")
+                        "without a shell; {port} is replaced by the port (appended if absent; with --port "
+                        "announced none is given), {time_scale} by K")
     p.add_argument("--exec-grace", type=float, default=5.0, metavar="S",
                    help="seconds between SIGTERM and SIGKILL when stopping it (default 5)")
     p.add_argument("--exec-ready", type=float, default=30.0, metavar="S",
@@ -211,6 +214,9 @@ def run(args: argparse.Namespace) -> int:  # noqa: C901 - argument checks, then 
     if spec.kind == "pty" and args.exec_cmd is None:
         raise UsageError("--port pty creates a new pseudo-terminal; give the vehicle's port (e.g. /dev/pts/N) "
                          "or --exec CMD to start the vehicle on it")
+    if spec.kind == "announced" and args.exec_cmd is None:
+        raise UsageError("--port announced takes the port the vehicle --exec starts prints ('port: URL'); "
+                         "without --exec give the vehicle's port")
     select = _selection(args)
     wait = _reconnect_wait(args)
     from .certificate_opts import DeclarationError, declaration

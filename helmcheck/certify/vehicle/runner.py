@@ -256,7 +256,8 @@ class Run(ExecChild):
         except Exception:  # noqa: BLE001
             pass
         self.link.note(f"link: {self.p.baud} baud 8N1 {self.o.port}")
-        self.link.note(line_note(line_for(self.o.port, self.o.line)))
+        shown = getattr(raw, "name", None) if self.o.port == "announced" else None
+        self.link.note(line_note(line_for(shown or self.o.port, self.o.line)))
         self.session = Session(self.link, self.p, self.k, self.observer, max_wait=self.o.max_wait)
         self.session.custodian = self.custodian
         if self.o.operator:
