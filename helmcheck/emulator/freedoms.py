@@ -33,7 +33,7 @@ Settings (wall seconds where the line is concerned, vehicle seconds otherwise; R
   the same clock.
 * the profile's open questions (the readings table, :mod:`helmcheck.model.readings`, where each
   is explained; every row with a setting is one here): ``srp_bad_path``, ``ascent_refusal_order``,
-  ``omw_pitch_speed`` (the model answers by them), ``resumed_park`` and ``idle_distance`` (below);
+  ``omw_pitch_speed``, ``stop_unloads`` (the model answers by them), ``resumed_park`` and ``idle_distance`` (below);
 * the mission: ``resumed_park`` — a mission park resumed after remote control (RH-INT-2) counts
   ``"at once"`` from the release, wherever the vehicle is (the reference model), or, ``"on
   station"``, only once the vehicle is back within ``on_station_m`` of the park's waypoint, which
@@ -148,6 +148,7 @@ class EmulatorSettings:
     ascent_refusal_order: str = _s(READING_DEFAULTS["ascent_refusal_order"], _reading_doc("ascent_refusal_order"),
                                    "RH-RD-12")
     omw_pitch_speed: str = _s(READING_DEFAULTS["omw_pitch_speed"], _reading_doc("omw_pitch_speed"), "RH-RD-9")
+    stop_unloads: str = _s(READING_DEFAULTS["stop_unloads"], _reading_doc("stop_unloads"), "RH-RD-6")
 
     @property
     def is_default(self) -> bool:
@@ -192,7 +193,8 @@ class EmulatorSettings:
 DEFAULT_SETTINGS = EmulatorSettings()
 
 #: settings that take one of a few words: the readings table's (every reading of its rows) and the line's
-_CHOICES = {"pacing": ("baud", "burst"), **{r.setting: r.values for r in READINGS if r.setting}}
+_CHOICES = {"pacing": ("baud", "burst"), **{r.setting: r.values for r in READINGS
+                                            if r.setting and isinstance(getattr(DEFAULT_SETTINGS, r.setting), str)}}
 #: the readings the model itself answers by (the rest the emulator or the judge takes care of)
 MODEL_READINGS = tuple(r.key for r in READINGS if r.how == "model")
 

@@ -66,7 +66,9 @@ def _chk_omload(m: VehicleModel, c: s.OMLOAD) -> Optional[int]:
 
 def _chk_omstart(m: VehicleModel, c: Union[s.OMSTART, s.OMSTARTPaper]) -> Optional[int]:
     if isinstance(c, s.OMSTARTPaper):
-        return None if m.loaded is not None else 17
+        if m.loaded is None or (m.stopped_loaded and m.readings["stop_unloads"] == "unloaded"):
+            return 17
+        return None
     found = m._lookup(c.name)
     if isinstance(found, MissingMission):
         return 1
@@ -212,6 +214,7 @@ def _do_omstop(m: VehicleModel, row: Row, c: s.OMSTOP, now: float) -> list[s.Rep
 def _do_omload(m: VehicleModel, row: Row, c: s.OMLOAD, now: float) -> list[s.Reply]:
     """RH-MSN-1: the mission becomes the loaded one."""
     m.loaded = m._lookup(c.name)  # type: ignore[assignment]
+    m.stopped_loaded = False
     return [_ack(2)]
 
 
@@ -340,6 +343,7 @@ def _next_waypoint(m: VehicleModel, row: Row, now: float) -> None:
         m.mission_mode = "N"
         m.mission_wp = 0
         m.srp_active = False
+        m.stopped_loaded = True
         m._transition(row, now)
         m._pending.append(ev.MissionEnded(now))
     else:

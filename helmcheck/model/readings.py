@@ -103,6 +103,17 @@ READINGS: tuple[Reading, ...] = (
         "model", "the model answers an `$OMW` beyond those values under both",
         books="RH-ACK-3", setting="omw_pitch_speed", vehicle3="bounded", certify=("RH-ACK-3",)),
     Reading(
+        "stop_unloads", "RH-RD-6",
+        "After `$OMSTOP` or the mission's end, is the mission still loaded (does the paper form "
+        "`$OMSTART,<flag>` start it again)?",
+        "RH-MSN-2: The paper form `$OMSTART,<flag>` … starts the loaded mission; RH-RD-6: `$OMSTART` paper "
+        "form with no mission loaded: err 17",
+        (Choice("kept", "the last mission stays loaded: the paper form starts it again"),
+         Choice("unloaded", "a stopped or ended mission is no longer loaded: the paper form is refused (17) "
+                            "until the next `$OMLOAD`")),
+        "model", "the model answers a paper-form `$OMSTART` after a stop under both",
+        books="RH-MSN-2", setting="stop_unloads", vehicle3="kept", certify=("RH-MSN-2",)),
+    Reading(
         "resumed_park", "RH-INT-2",
         "A mission park resumed after remote control moved the vehicle off station: does its time left count "
         "from the release, or once back on station?",
@@ -111,6 +122,26 @@ READINGS: tuple[Reading, ...] = (
          Choice("on station", "counts once back within on_station_m of the park's waypoint, which it heads for")),
         "freedom", "the mirror adopts the return on station within its window (:mod:`helmcheck.judge.vehicle.closure`)",
         books="RH-INT-2", setting="resumed_park", vehicle3="at once", certify=("RH-INT-2",)),
+    Reading(
+        "process_when_idle", "RH-RD-15",
+        "When replies are still going out, is a command processed at once (its `$ACK` waits behind them) "
+        "or only once the line is idle (its `$ACK` goes out the instant it is processed)?",
+        "RH-RD-15: Durations start when the vehicle processes the command, the instant its ACK goes out; "
+        "RH-ACK-6: Commands are processed in arrival order",
+        (Choice("false", "processed when due; its `$ACK` queues behind the replies before it"),
+         Choice("true", "processed only once the line is idle (a serial loop that answers one line at a "
+                        "time): its `$ACK` goes out at once and its durations start there")),
+        "freedom", "a command's instant is bounded by its `$ACK`'s arrival less every reply byte since it "
+                   "was sent, so either start of a duration lies in the window the judge allows "
+                   "(:mod:`helmcheck.judge.vehicle.answers`)",
+        books="RH-TIM-1", setting="process_when_idle", vehicle3="true", certify=("RH-SRV-4", "RH-ACK-6")),
+    Reading(
+        "omload_flag", "RH-MSN-1",
+        "Which `$OMLOAD` flags does a vehicle accept?",
+        "RH-MSN-1: `$OMLOAD,<name>,<flag>` (ACK 2, err 29; 1 file not found): accepted only in `S` "
+        "(no range is given for the flag)",
+        (Choice("any", "any flag"), Choice("0-3", "the paper's flags 0–3; any other refused (29)")),
+        "judge", "the flag is not judged, and the tester sends only 0 and 1", vehicle3="0-3"),
     Reading(
         "idle_distance", "RH-RD-5",
         "`$OSI` field 7 with no navigation target (`S`, `M` from `S`)?",
@@ -128,6 +159,7 @@ _MODEL_APPLIES: dict[str, tuple[str, ...]] = {
     "srp_bad_path": ("OMSTART",),
     "ascent_refusal_order": ("OMS", "OJW", "OPK", "OMW"),
     "omw_pitch_speed": ("OMW",),
+    "stop_unloads": ("OMSTART",),
 }
 
 

@@ -127,6 +127,9 @@ class VehicleModel(VehicleStatus, StateEffects):
         self.phase = "none"
         # mission sub-state (frozen while remote control or a safety episode is active)
         self.loaded: Optional[Mission] = None
+        #: the loaded mission has run and was stopped (``$OMSTOP``) or ended since it was loaded or
+        #: started: whether it is still loaded then is a reading (``stop_unloads``, :mod:`.readings`)
+        self.stopped_loaded = False
         self.mission: Optional[Mission] = None
         self.mission_mode = "N"
         self.mission_wp = 0
