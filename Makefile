@@ -50,9 +50,11 @@ explore-reach: $(STAMP)
 # backseat device and a monitored side that never come back (tests/test_unplugged.py); the
 # emulator, the independent simulator and the example backseat behind every line fault, and every
 # faulty vehicle behind light damage (tests/test_bad_line.py); the independent simulator's own
-# missions at x5 and two exploration findings replayed (make test's budget keeps x20 and one replay).
+# missions at x5 and two exploration findings replayed (make test's budget keeps x20 and one replay);
+# the third vehicle on its own default line and every one of its 36 mutants on its clause
+# (tests/test_vehicle3.py), and the emulator under every reading of the readings table (tests/test_readings.py).
 matrix: $(STAMP)
-	HELMCHECK_MATRIX=1 $(PY) -m pytest -n 2 tests/test_line_budget.py tests/test_slow_line.py tests/test_unplugged.py tests/test_bad_line.py tests/test_third_party_vehicle.py::test_its_own_missions_with_oxflt_certify tests/test_explore_replays.py
+	HELMCHECK_MATRIX=1 $(PY) -m pytest -n 2 tests/test_line_budget.py tests/test_slow_line.py tests/test_unplugged.py tests/test_bad_line.py tests/test_third_party_vehicle.py::test_its_own_missions_with_oxflt_certify tests/test_explore_replays.py tests/test_vehicle3.py tests/test_readings.py
 
 # Not run by CI (several minutes): every --help example, the slow ones and those that need a
 # vehicle too (run against the emulator on their port); make test runs the others.
