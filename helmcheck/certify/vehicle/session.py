@@ -447,13 +447,23 @@ class Session:
         ``$OSI``: with a ``probe`` (a command only the lockout refuses) it is left when the probe
         is answered without err 26 (RH-SAF-1), so what follows is judged after it for certain."""
         dl = self.obs.deadline(timer)
-        if (dl is None and timer == "lockout" and self.profile.trigger in ("mission-rule", "operator")
-                and self.obs.state().phase != "lockout" and self.obs.state().error_state != "N"):
-            # the vehicle's own rule (or the operator) tripped and its lockout ran out before the
-            # case could watch it end: what follows is judged; the lockout's length is not, here
-            self.note(f"{self.case}: the lockout ended before the case could watch it (the vehicle's own "
-                      f"violation came while it was busy): its length is not judged in this case")
-            return self.poll()
+        if (dl is None and timer == "lockout" and self.obs.state().phase != "lockout"
+                and self.obs.state().error_state != "N"):
+            if self.profile.trigger in ("mission-rule", "operator"):
+                # the vehicle's own rule (or the operator) tripped and its lockout ran out before the
+                # case could watch it end: what follows is judged; the lockout's length is not, here
+                self.note(f"{self.case}: the lockout ended before the case could watch it (the vehicle's own "
+                          f"violation came while it was busy): its length is not judged in this case")
+                return self.poll()
+            # raised by the tester, and over before the line brought back an answer from inside
+            # it: this line cannot carry the case at this time scale (the tester's choice, not a
+            # finding, and not INCONCLUSIVE)
+            d = self.durations(fresh=True)
+            reason = (f"{self.case}: the {self.profile.lockout_s:g} s lockout was over before an answer from "
+                      f"inside it came back on this line at time scale {self.k:g} (RH-SAF-1, the line: "
+                      f"{d.budget.describe()}); run at {d.advice('lockout')}")
+            self.tester("not-tested", [clause] if clause else self.case_clauses[:1], reason)
+            raise CaseStop("not-tested", reason)
         if dl is None:
             self._budget(f"the {timer or 'next'} timer", 0.0, clause,
                          "the case did not reach the state whose timer it waits for")
