@@ -48,7 +48,7 @@ examples:
       --time-scale 20 --budget 10 --seed 1            # two vehicles helmcheck starts itself
   helmcheck diff --port /dev/ttyUSB0 --profile iver3.toml --time-scale 1 \\
       --exec 'helmcheck emulate --port {port} --time-scale {time_scale}' \\
-      --profile-b helmcheck/profiles/emulator.toml --time-scale-b 20   # a vehicle against the emulator
+      --profile-b examples/emulator.toml --time-scale-b 20   # a vehicle against the emulator
 
 exit status: 0 no divergence within the budget, 1 a divergence, 2 inconclusive (link fault,
   a clock not at its time scale, nothing ran) or tester error, 64 usage.
