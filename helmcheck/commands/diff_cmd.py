@@ -18,6 +18,7 @@ from pathlib import Path
 
 from .. import exitcodes
 from ..failures import UsageError
+from .messages import report_line_for
 
 __all__ = ["add_parser", "run", "EPILOG"]
 
@@ -184,6 +185,7 @@ def run(args: argparse.Namespace) -> int:
         for link in opened:
             link.close()
     print(out.line)
+    print(report_line_for(out.report_dir / "diff.json"))  # like every command: where to look next
     sys.stdout.flush()
     for w in wire:
         w.check()  # a wire log lost on the way: exit 2, after the result line
