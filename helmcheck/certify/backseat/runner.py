@@ -369,16 +369,14 @@ class Runner:
             self._after_vehicle(now)
 
     def _mark_command(self, line: bytes, at: float) -> None:
-        """A command the backseat sent (not its ``$OSD`` polls), for the report's timeline at the
+        """A sentence the backseat sent (not its ``$OSD`` polls), for the report's timeline at the
         time the wire log has it (``at``): the same marks a vehicle run gives the tester's
-        commands. Judges nothing."""
-        if self._commands_marked >= MAX_COMMAND_EVENTS:
+        commands. A malformed or out-of-range command is marked too (it is often the finding).
+        Judges nothing."""
+        if self._commands_marked >= MAX_COMMAND_EVENTS or not line.startswith(b"$") or line.startswith(b"$OSD,"):
             return
-        cmd = decode(line, self.profile).sentence
-        if isinstance(cmd, s.Command) and not isinstance(cmd, s.OSD):
-            self._commands_marked += 1
-            text = line.decode("latin-1", "replace").rstrip("\r\n")
-            self.outcome.events.append((at, "command", text[:60]))
+        self._commands_marked += 1
+        self.outcome.events.append((at, "command", line.decode("latin-1", "replace").rstrip("\r\n")[:60]))
 
     def _deliver(self, raw: bytes, line: Optional[bytes], now: float) -> None:
         """One framed run from the backseat to the vehicle (``line`` None: a discarded run)."""
