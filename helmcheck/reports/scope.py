@@ -1,4 +1,7 @@
-"""Scope: whether a run is a certificate, and the one line every rendering leads with.
+"""Scope: whether a run is a certificate, and the one line every rendering leads with; then what
+every banner says under it, in this order: what failed (:func:`failures`, each clause with its
+reason), what was not judged (:meth:`Scope.why`), what timing judged coarser than nominal
+precision means for the user (:func:`precision_note`).
 
 A verdict says how the judged clauses went; the scope says how much was judged. The rule:
 
