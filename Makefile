@@ -11,11 +11,20 @@ FUZZ_TESTS := tests/test_grammar_fastpath.py tests/test_grammar_framer.py tests/
               tests/test_model_observe.py tests/test_model_stateful.py tests/test_reports_results.py \
               tests/test_certify_backseat_judge.py tests/test_cli_contracts.py tests/test_emulator_freedoms.py
 
+# Says what it does (pip is quiet for half a minute). The editable install of this flat layout
+# is setuptools' import-hook kind, which ends with an informational "Editable installation"
+# notice ("careful with folders named like the package in your working directory": here that
+# folder is the package itself); pip shows it as a boxed BuildBackendWarning, so it is filtered
+# by its message. Every other warning still shows.
 $(STAMP): pyproject.toml
-	$(PYTHON) -m venv $(VENV)
-	$(PY) -m pip install --quiet --upgrade pip
-	$(PY) -m pip install --quiet -e '.[test]'
-	touch $(STAMP)
+	@echo "setting up $(VENV)/ (once, about a minute): a virtual environment for helmcheck"
+	@$(PYTHON) -m venv $(VENV)
+	@echo "  updating pip in $(VENV)/"
+	@$(PY) -m pip install --quiet --upgrade pip
+	@echo "  installing helmcheck from this checkout (editable: your edits run at once) with its test and docs tools"
+	@PYTHONWARNINGS='ignore:Editable installation' $(PY) -m pip install --quiet -e '.[test]'
+	@touch $(STAMP)
+	@echo "$(VENV)/ is ready"
 
 # Certifies the built-in emulator into demo-out/ (ignored by git: the checkout stays clean).
 demo: $(STAMP)

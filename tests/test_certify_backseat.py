@@ -31,6 +31,7 @@ import pytest
 
 from helmcheck.commands import certify_backseat_cmd as cli
 from helmcheck.checklog.checker import check_log
+from helmcheck.grammar.wirelog import read_records
 from helmcheck.profile import DEFAULT
 from helmcheck.reports.results import load_results
 
@@ -138,6 +139,28 @@ def test_rh_bs_1_to_8_well_behaved_backseat_passes_every_scenario(runs, scale):
     assert {"A", "S"} <= set(r["coverage"]["modes"])
     for name in ("report.html", "report.md", "junit.xml", "wire.log"):
         assert (run["dir"] / name).stat().st_size > 0
+
+
+def test_the_timeline_marks_every_command_the_backseat_sent(runs):
+    """Issue 43: the report's commands lane shows the backseat's commands — each line it sent
+    (not its $OSD polls; a malformed one too) marked at the time the wire log has it, and drawn."""
+    short = [e["label"] for e in runs["short-omp", K]["results"]["events"] if e["kind"] == "command"]
+    assert any(label.startswith("$OMP,") for label in short), short  # the faulty $OMP, refused, is marked
+    run = runs["good", K]
+    sent, pending = [], b""
+    with open(run["dir"] / "wire.log", "rb") as f:
+        for rec in read_records(f):
+            if rec.dir != ">":
+                continue
+            *lines, pending = (pending + rec.data).split(b"\n")  # a line is marked when it is complete
+            for line in lines:
+                text = line.decode("latin-1").rstrip("\r")
+                if text.startswith("$") and not text.startswith("$OSD,"):
+                    sent.append((rec.t, text[:60]))
+    marked = [(e["t"], e["label"]) for e in run["results"]["events"] if e["kind"] == "command"]
+    assert len(sent) > 5 and marked == sent
+    html = (run["dir"] / "report.html").read_text(encoding="utf-8")
+    assert html.count('class="ev-command"') == len(sent)
 
 
 FAULT_PARAMS = [pytest.param(f, id=f"{FAULTS[f][0]}-{f}") for f in sorted(FAULTS)]

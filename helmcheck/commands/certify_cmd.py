@@ -26,7 +26,7 @@ ROLES = {
 
 EPILOG = """\
 examples:
-  helmcheck certify vehicle --port /dev/pts/N --time-scale 20 --profile helmcheck/profiles/emulator.toml
+  helmcheck certify vehicle --port /dev/pts/N --time-scale 20 --profile examples/emulator.toml
   helmcheck certify backseat --duration 10 --time-scale 10 \\
       --exec 'python3 examples/backseat.py --port {port} --time-scale {time_scale}'
 

@@ -93,9 +93,9 @@ results: DIR/results.json (schema 1), DIR/wire.log, DIR/profile.toml, DIR/signat
 
 examples:
   helmcheck emulate --port pty --time-scale 20 &        # a vehicle to certify; prints port: /dev/pts/N
-  helmcheck certify vehicle --port /dev/pts/N --time-scale 20 --profile helmcheck/profiles/emulator.toml
+  helmcheck certify vehicle --port /dev/pts/N --time-scale 20 --profile examples/emulator.toml
   helmcheck certify vehicle --exec 'helmcheck emulate --port {port} --time-scale {time_scale}' \\
-      --time-scale 20 --profile helmcheck/profiles/emulator.toml --select 'RH-SRV-*' --examples 0 \\
+      --time-scale 20 --profile examples/emulator.toml --select 'RH-SRV-*' --examples 0 \\
       --report-dir reports/servo                        # start the vehicle too; four clauses, no exploration
   helmcheck certify vehicle --plan --time-scale 1 --profile iver3.toml   # how long a run takes; no port
   helmcheck certify vehicle --port /dev/ttyUSB0 --profile iver3.toml --hypothesis-profile patient

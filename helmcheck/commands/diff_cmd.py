@@ -19,6 +19,7 @@ from pathlib import Path
 from .. import exitcodes
 from ..failures import UsageError
 from .lineopt import add_line_argument
+from .messages import report_line_for
 
 __all__ = ["add_parser", "run", "EPILOG"]
 
@@ -49,7 +50,7 @@ examples:
       --time-scale 20 --budget 10 --seed 1            # two vehicles helmcheck starts itself
   helmcheck diff --port /dev/ttyUSB0 --profile iver3.toml --time-scale 1 \\
       --exec 'helmcheck emulate --port {port} --time-scale {time_scale}' \\
-      --profile-b helmcheck/profiles/emulator.toml --time-scale-b 20   # a vehicle against the emulator
+      --profile-b examples/emulator.toml --time-scale-b 20   # a vehicle against the emulator
 
 exit status: 0 no divergence within the budget, 1 a divergence, 2 inconclusive (link fault,
   a clock not at its time scale, nothing ran) or tester error, 64 usage.
@@ -186,6 +187,7 @@ def run(args: argparse.Namespace) -> int:
         for link in opened:
             link.close()
     print(out.line)
+    print(report_line_for(out.report_dir / "diff.json"))  # like every command: where to look next
     sys.stdout.flush()
     for w in wire:
         w.check()  # a wire log lost on the way: exit 2, after the result line

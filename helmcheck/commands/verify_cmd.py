@@ -32,7 +32,7 @@ what is checked (in any results directory: certify vehicle, certify backseat, ch
 examples:
   helmcheck verify reports/vehicle
   helmcheck keygen --out lab                        # once: lab.key signs, lab.pub checks
-  helmcheck certify vehicle --port /dev/pts/N --time-scale 20 --profile helmcheck/profiles/emulator.toml \\
+  helmcheck certify vehicle --port /dev/pts/N --time-scale 20 --profile examples/emulator.toml \\
       --sign-key lab.key --report-dir reports/signed
   helmcheck verify reports/signed --public-key lab.pub   # the run must be signed by this key
 

@@ -3,7 +3,8 @@
 Contents, top to bottom. The first screen (and, printed, the first page) is the certificate: a
 PARTIAL warning when the run was interrupted; the verdict banner, which leads with the scope
 (:func:`helmcheck.reports.scope.headline`, "PASS — partial: 4 of 60 claimed clauses judged; not
-a certificate") and lists why clauses were not judged; what was tested
+a certificate"), then what failed (each failed clause with its reason), then why clauses were not
+judged, then what timing judged coarser than nominal precision means; what was tested
 (:func:`helmcheck.reports.identity.identity_rows`: implementation, serial, version, name on the
 wire, operator, site, profile SHA-256, tester version and revision); the digest and the
 signature; clause counts. Under it a line of links to every section, then what needs attention:
@@ -42,6 +43,7 @@ from .html_clauses import EVIDENCE_LIMIT, _findings, _has_finding, _matrix, _pas
 from .html_coverage import _coverage, _coverage_gist, _event_summary, _events_table
 from .html_markup import _e, _flatten, _fold, _kv_table, _section, md_inline
 from .html_run import _identity, _process, _restore, _run_facts, restore_headline
+from .identity import backseat_name
 from .html_style import _CSP, _CSS
 from .rundir import Run
 from .scope import headline
@@ -114,6 +116,8 @@ def _contents(run: Run, findings: int, comparison: bool) -> str:
 
 
 def _name_mismatch(run: Run) -> bool:
+    if run.results["role"] == "backseat":
+        return False  # the $OSI name is the vehicle helmcheck played
     declared, seen = run.results["implementation"].get("vehicle_name"), run.wire["osi_vehicle_name"]
     return bool(declared and seen is not None and declared != seen)
 
@@ -122,8 +126,12 @@ def _implementation_gist(run: Run) -> str:
     seen = run.wire["osi_vehicle_name"]
     if _name_mismatch(run):
         return ('<span class="warn">the vehicle name on the wire differs from the declared one</span>')
-    parts = [f"name on the wire: {seen}" if seen is not None else "",
-             f"{run.wire['records']} wire-log records" if run.wire["present"] else "no wire log"]
+    if run.results["role"] == "backseat":
+        name = backseat_name(run.results)[0]
+        first = f"backseat: {name}" if name else "backseat: not named (--implementation)"
+    else:
+        first = f"name on the wire: {seen}" if seen is not None else ""
+    parts = [first, f"{run.wire['records']} wire-log records" if run.wire["present"] else "no wire log"]
     return _e(" · ".join(p for p in parts if p))
 
 

@@ -71,6 +71,7 @@ from .scenarios import LOCKOUT_CODE, Plan
 __all__ = ["Runner", "RunRecord", "HangupPty", "MAX_OUT"]
 
 MAX_OUT = 256 * 1024  #: bytes waiting for a link nobody reads; beyond this they are dropped
+MAX_COMMAND_EVENTS = 5000  #: the backseat's commands marked on the report's timeline; the rest are in the wire log
 _TICK = 0.05
 #: the core's note about an overlong run it logged in part; the recorder here logs every byte
 _PARTIAL = re.compile(r"^RH-FRM-\d+: \d+ bytes discarded, first \d+ logged$")
@@ -149,6 +150,7 @@ class Runner:
         self._silent = False
         self._rejecting = False
         self._silence_noted = False
+        self._commands_marked = 0
         self._lockout = False
         self._mode = ""
         self._scenario = ""
@@ -359,10 +361,22 @@ class Runner:
                 self.progress.start(self.plan.total)
             self._due(now)
         self._service(now)  # the vehicle up to now first: a lockout that ended is noted before
-        self.recorder.bytes(self.rel(now), TO_VEHICLE, data)
+        at = self.recorder.bytes(self.rel(now), TO_VEHICLE, data)  # the time the wire log gives them
         for ev in self._framer.feed(data):
+            if not isinstance(ev, Discard):
+                self._mark_command(ev.raw, at)
             self._deliver(ev.raw, None if isinstance(ev, Discard) else ev.raw, now)
             self._after_vehicle(now)
+
+    def _mark_command(self, line: bytes, at: float) -> None:
+        """A sentence the backseat sent (not its ``$OSD`` polls), for the report's timeline at the
+        time the wire log has it (``at``): the same marks a vehicle run gives the tester's
+        commands. A malformed or out-of-range command is marked too (it is often the finding).
+        Judges nothing."""
+        if self._commands_marked >= MAX_COMMAND_EVENTS or not line.startswith(b"$") or line.startswith(b"$OSD,"):
+            return
+        self._commands_marked += 1
+        self.outcome.events.append((at, "command", line.decode("latin-1", "replace").rstrip("\r\n")[:60]))
 
     def _deliver(self, raw: bytes, line: Optional[bytes], now: float) -> None:
         """One framed run from the backseat to the vehicle (``line`` None: a discarded run)."""

@@ -71,7 +71,7 @@ from .exec_child import ExecChild
 from .flow import LinkLost, LinkSilent
 from .interpreter import run_case
 from .link import TesterLink
-from .progress import Progress
+from .progress import Progress, explored_text
 from .generate import EXPLORE_WRITES
 from .rejoin import rejoin
 from .restore import Custodian, written_settings
@@ -464,7 +464,7 @@ def certify(opts: Options) -> Outcome:
             if explore_now and run.aborted is None:
                 from .explore import explore
                 _again(run, "the exploration", lambda: explore(run))
-                run.progress.step("exploration", "done")
+                run.progress.step("exploration", explored_text(run.stats.get("explore")))
         except (ClockMismatch, CoarseTiming) as e:  # the declared time scale is clearly wrong, or too
             run.aborted = run.stopped = str(e)          # coarse for --precision nominal: INCONCLUSIVE
             run.progress.note(f"stopped: {e}")
