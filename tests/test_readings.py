@@ -30,7 +30,7 @@ from helmcheck.emulator.missionfile import DirectoryCatalog, builtin_dir
 from helmcheck.grammar import checksum_hex
 from helmcheck.model.readings import BY_KEY, DEFAULTS, READINGS
 from tests.faulty_vehicles import EMU_PROFILE
-from tests.virtual_vehicle import VirtualVehicle
+from tests.virtual_vehicle import VirtualVehicle, osi_fields
 
 ROOT = Path(__file__).resolve().parents[1]
 PROFILE = EMU_PROFILE.replace(time_scale=1.0, baud=19200)
@@ -151,6 +151,28 @@ def _stop(d: Drive) -> list[str]:
     return got
 
 
+def _ctd(d: Drive) -> list[str]:
+    got = []
+    for c, t in (("42.5", "17.5"), ("43.5", "18.5")):
+        d.send(f"OPOS,41.53,-71.32,0,{c},{t}")  # 1.1 km away, at the surface in S: not applied (RH-RD-10)
+        d.after(1.0)
+        out = d.send("OSD,T").decode()
+        ctd = next(ln for ln in out.split("\r\n") if ln.startswith("$OCTD"))
+        got.append("shown" if ctd.split("*")[0].split(",")[1:3] == [f"{c}0", f"{t}0"] else "own")
+    return got
+
+
+def _park(d: Drive) -> list[str]:
+    d.send("OMSTART,0,0,0,0,conformance.mis,")
+    for _ in range(200):  # until the mission park (virtual seconds)
+        d.after(5.0, poll_every=5.0)
+        f = osi_fields(d.send("OSD,S"))
+        if f[2] == "P":
+            d.after(5.0)
+            return [f[3]]
+    raise AssertionError("the test mission never parked")
+
+
 #: key -> (how the situation is reached, the answers under each reading, the clauses judged,
 #: an answer no reading allows: (the text to replace, its replacement, the clause it fails))
 SITUATIONS = {
@@ -162,13 +184,18 @@ SITUATIONS = {
     "omw_pitch_speed": (_omw, {"bounded": ["$ACK,16,1,36", "$ACK,16,1,36"],
                                "unbounded": ["$ACK,16,0,0", "$ACK,16,0,0"]},
                         ("RH-OMW-1", "RH-ACK-3"), ("$ACK,16,1,36", "$ACK,16,1,20", "RH-ACK-3")),
+    "opos_ctd": (_ctd, {"reported": ["shown", "shown"], "internal": ["own", "own"]}, ("RH-POS-2",),
+                 ("$OCTD,43.50,18.50", "$OCTD,42.50,17.50", "RH-POS-2")),  # shown once, then not: held to it
+    "park_waypoint": (_park, {"parked": ["1"], "next": ["2"]}, ("RH-OUT-4",),
+                      (",P,1,", ",P,3,", "RH-OUT-4", 0)),
     "stop_unloads": (_stop, {"kept": ["$ACK,3,0,0", "$ACK,3,0,0"], "unloaded": ["$ACK,3,0,0", "$ACK,3,1,17"]},
                      ("RH-MSN-2",), ("$ACK,3,0,0", "$ACK,3,1,30", "RH-MSN-2", 2)),
 }
 
 
 def test_every_reading_the_model_answers_by_has_a_situation_here():
-    assert {r.key for r in READINGS if r.how == "model"} == set(SITUATIONS)
+    assert {r.key for r in READINGS if r.in_model} == set(SITUATIONS)
+    assert {r.key for r in READINGS if r.how == "model"} <= {r.key for r in READINGS if r.in_model}
 
 
 @pytest.mark.parametrize("key,value", [(k, v) for k in SITUATIONS for v in BY_KEY[k].values],
@@ -192,11 +219,19 @@ def test_an_answer_no_reading_allows_still_fails_on_its_clause(key, tmp_path):
     drive(d)
 
     def edit(text: str) -> str:
+        if nth == [0]:  # every such answer (a vehicle that always gives it)
+            while old in text:
+                text = edit_one(text, 1)
+            return text
+        return edit_one(text, nth[0] if nth else 1)
+
+    def edit_one(text: str, n: int) -> str:
         first = -1
-        for _ in range(nth[0] if nth else 1):  # the answer the question turns on, made one no reading gives
+        for _ in range(n):  # the answer the question turns on, made one no reading gives
             first = text.index(old, first + 1)
-        body = new[1:]
-        return text[:first] + f"${body}*{checksum_hex(body)}" + text[first + len(old) + 3:]
+        start, end = text.rindex("$", 0, first + 1), text.index("*", first)  # the whole sentence, its sum again
+        body = text[start + 1:end].replace(old.lstrip("$"), new.lstrip("$"), 1)
+        return text[:start] + f"${body}*{checksum_hex(body)}" + text[end + 3:]
     v = d.judged(tmp_path, edit)
     assert v[clause]["verdict"] == "fail", failed(v)
 

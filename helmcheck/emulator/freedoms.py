@@ -149,6 +149,8 @@ class EmulatorSettings:
                                    "RH-RD-12")
     omw_pitch_speed: str = _s(READING_DEFAULTS["omw_pitch_speed"], _reading_doc("omw_pitch_speed"), "RH-RD-9")
     stop_unloads: str = _s(READING_DEFAULTS["stop_unloads"], _reading_doc("stop_unloads"), "RH-RD-6")
+    opos_ctd: str = _s(READING_DEFAULTS["opos_ctd"], _reading_doc("opos_ctd"), "RH-POS-2")
+    park_waypoint: str = _s(READING_DEFAULTS["park_waypoint"], _reading_doc("park_waypoint"), "RH-OUT-1")
 
     @property
     def is_default(self) -> bool:
@@ -196,7 +198,7 @@ DEFAULT_SETTINGS = EmulatorSettings()
 _CHOICES = {"pacing": ("baud", "burst"), **{r.setting: r.values for r in READINGS
                                             if r.setting and isinstance(getattr(DEFAULT_SETTINGS, r.setting), str)}}
 #: the readings the model itself answers by (the rest the emulator or the judge takes care of)
-MODEL_READINGS = tuple(r.key for r in READINGS if r.how == "model")
+MODEL_READINGS = tuple(r.key for r in READINGS if r.in_model)
 
 
 def model_readings(st: "EmulatorSettings") -> dict[str, str]:

@@ -233,9 +233,10 @@ def _do_omstart(m: VehicleModel, row: Row, c: Union[s.OMSTART, s.OMSTARTPaper],
 def _do_opos(m: VehicleModel, row: Row, c: s.OPOS, now: float) -> list[s.Reply]:
     """RH-POS-2, RH-RD-10: C and T always applied; position and speed only without a GPS fix."""
     changes: dict[str, float] = {}
-    if c.conductivity is not None and c.conductivity != "":
+    reported = m.readings["opos_ctd"] == "reported"  # else used inside, $OCTD its own sensor's
+    if reported and c.conductivity is not None and c.conductivity != "":
         changes["conductivity"] = float(c.conductivity)
-    if c.temperature is not None and c.temperature != "":
+    if reported and c.temperature is not None and c.temperature != "":
         changes["temperature"] = float(c.temperature)
     applied = not m.gps_fix
     if applied:

@@ -19,7 +19,7 @@ it:
   when a row is missing from one of those places.
 
 A row's ``how`` says which machinery accepts it: ``model`` (the model branches on it),
-``judge`` (a judge's own rule accepts every reading; no model state differs), ``freedom`` (an
+``judge`` (a judge's own rule accepts every reading; the model has no say), ``freedom`` (an
 emulator freedom of timing or plant the judge allows for in its windows), ``backseat`` (the
 backseat judge). Pure data and two small functions: no I/O.
 """
@@ -54,6 +54,8 @@ class Reading:
     judge: str  #: how the judge accepts every reading, in one sentence
     setting: Optional[str] = None  #: the emulator setting that takes each (None: nothing to take)
     vehicle3: str = ""  #: the third-party vehicle's own choice, where its README states one
+    #: the model itself behaves by this reading (``VehicleModel.readings``; the emulator takes it there)
+    in_model: bool = False
     #: the vehicle clause an answer under this reading is judged on (its pass is booked there, and
     #: the report names the reading taken there)
     books: str = ""
@@ -81,7 +83,7 @@ READINGS: tuple[Reading, ...] = (
          Choice("31", "refused with 31 at the file look-up: a name outside the directory is one the vehicle "
                       "cannot read (never opened); a state precondition refuses first (30)")),
         "model", "the model answers the rh5 `$OMSTART` under both; a vehicle's 30 or 31 is a pass",
-        books="RH-MSN-2", setting="srp_bad_path", vehicle3="31", certify=("RH-MSN-2",)),
+        books="RH-MSN-2", in_model=True, setting="srp_bad_path", vehicle3="31", certify=("RH-MSN-2",)),
     Reading(
         "ascent_refusal_order", "RH-RD-12",
         "After the lockout, before the surface: is a malformed `$OMS`/`$OJW`/`$OPK`/`$OMW` refused with 26 "
@@ -92,7 +94,7 @@ READINGS: tuple[Reading, ...] = (
          Choice("after fields", "the command's own error when a field is bad, else 26 (the refusal is a "
                                 "state precondition, after the fields)")),
         "model", "the model answers a command in the ascent under both",
-        books="RH-SAF-3", setting="ascent_refusal_order", vehicle3="first"),
+        books="RH-SAF-3", in_model=True, setting="ascent_refusal_order", vehicle3="first"),
     Reading(
         "omw_pitch_speed", "RH-RD-9",
         "Are `$OMW` max pitch and speed bounded (as `$OMS`'s: [0, 45] and [0, max_speed_kn])?",
@@ -101,7 +103,7 @@ READINGS: tuple[Reading, ...] = (
         (Choice("bounded", "pitch above 45 or speed above max_speed_kn refused (36), as `$OMS`'s"),
          Choice("unbounded", "any non-negative pitch and speed queued")),
         "model", "the model answers an `$OMW` beyond those values under both",
-        books="RH-ACK-3", setting="omw_pitch_speed", vehicle3="bounded", certify=("RH-ACK-3",)),
+        books="RH-ACK-3", in_model=True, setting="omw_pitch_speed", vehicle3="bounded", certify=("RH-ACK-3",)),
     Reading(
         "stop_unloads", "RH-RD-6",
         "After `$OMSTOP` or the mission's end, is the mission still loaded (does the paper form "
@@ -112,7 +114,7 @@ READINGS: tuple[Reading, ...] = (
          Choice("unloaded", "a stopped or ended mission is no longer loaded: the paper form is refused (17) "
                             "until the next `$OMLOAD`")),
         "model", "the model answers a paper-form `$OMSTART` after a stop under both",
-        books="RH-MSN-2", setting="stop_unloads", vehicle3="kept", certify=("RH-MSN-2",)),
+        books="RH-MSN-2", in_model=True, setting="stop_unloads", vehicle3="kept", certify=("RH-MSN-2",)),
     Reading(
         "resumed_park", "RH-INT-2",
         "A mission park resumed after remote control moved the vehicle off station: does its time left count "
@@ -122,6 +124,25 @@ READINGS: tuple[Reading, ...] = (
          Choice("on station", "counts once back within on_station_m of the park's waypoint, which it heads for")),
         "freedom", "the mirror adopts the return on station within its window (:mod:`helmcheck.judge.vehicle.closure`)",
         books="RH-INT-2", setting="resumed_park", vehicle3="at once", certify=("RH-INT-2",)),
+    Reading(
+        "park_waypoint", "RH-OUT-1",
+        "During a mission park (`P`), does `$OSI` field 3 show the waypoint parked on, or the one after it?",
+        "RH-OUT-1: 3 next waypoint (0-based); RH-RD-5: `$OSI` field 3 shows the frozen mission waypoint in A, "
+        "M, mP and W, and 0 in `S` (P is not named)",
+        (Choice("parked", "the waypoint parked on; it becomes the next when the park ends"),
+         Choice("next", "the next waypoint from the arrival on (the parked one is behind it)")),
+        "judge", "in `P` either is taken as the mission's waypoint (:func:`helmcheck.model.observe.shown_waypoints`)",
+        books="RH-OUT-4", in_model=True, setting="park_waypoint", vehicle3="parked", certify=("RH-INT-2",)),
+    Reading(
+        "opos_ctd", "RH-POS-2",
+        "Does `$OCTD` report the conductivity and temperature an `$OPOS` applied, or the vehicle's own sensor?",
+        "RH-POS-2: Conductivity and temperature are always applied (\"applied\" is not defined; the paper: "
+        "they are accepted every time)",
+        (Choice("reported", "`$OCTD` shows the values `$OPOS` gave"),
+         Choice("internal", "they are used inside (sound speed, salinity) and `$OCTD` shows its own sensor")),
+        "model", "an `$OCTD` that shows them passes; one that does not is not judged, unless the vehicle "
+                 "showed an earlier `$OPOS`'s values (then it is held to it: :mod:`helmcheck.judge.vehicle.osichecks`)",
+        books="RH-POS-2", in_model=True, setting="opos_ctd", vehicle3="reported", certify=("RH-POS-2",)),
     Reading(
         "process_when_idle", "RH-RD-15",
         "When replies are still going out, is a command processed at once (its `$ACK` waits behind them) "

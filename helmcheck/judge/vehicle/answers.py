@@ -473,6 +473,9 @@ class Answers:
                 self.book("fail", cands, msg, ev, at=p)
             self.checks.after_osi(osi, p, t, ev, judged=False)
             return
+        m = self.beliefs.primary.model
+        if osi.mode == "P" and m.mode == "P" and osi.next_waypoint == m.mission_wp + 1:  # park_waypoint = next
+            self.readings_shown.setdefault("park_waypoint", ("park_waypoint = next", "RH-OUT-4", evd))
         self.ledger.passed("RH-OUT-4", lambda: f"mode {osi.mode}, waypoint {osi.next_waypoint}, P{osi.park_time}, "
                                        f"error {osi.error_state} as a conforming vehicle reports", ev, self.case)
         if res.adopted:
