@@ -11,7 +11,6 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from helmcheck.certify.backseat.scenarios import SCENARIOS, make_plan
 from helmcheck.grammar import checksum_hex
 from helmcheck.judge import Ledger, WireEvent
 from helmcheck.judge.backseat import BS_CLAUSES, POLL_INTERVAL_S, BackseatObserver, line_budget
@@ -247,7 +246,7 @@ def test_rh_bs_3_command_behind_an_unanswered_start_is_judged_by_its_outcome():
     r.bs(2.0, frame("OMSTART,0,0,0,0,conformance.mis,"))
     r.bs(2.01, OMS)
     r.veh(2.05, frame("ACK,3,0,0") + frame("ACK,9,0,0"))
-    assert r.fails("RH-BS-3") == 0 and r.ledger.counts("RH-BS-3")["pass"] == 2  # $OMSTART, $OMS
+    assert r.fails("RH-BS-3") == 0 and r.ledger.counts("RH-BS-3")["pass"] == 1  # the $OMS (behind the start)
     r.bs(3.0, frame("ORWSET,SafetyAction,R"))  # mission reported running
     assert r.fails("RH-BS-3") == 1
     r = Run().bs(0.0, POLL).veh(0.1, osi("S"))
@@ -282,14 +281,23 @@ def test_rh_bs_3_a_report_sent_before_the_command_excuses_it():
     assert r.verdict("RH-BS-3") == "pass"
 
 
-def test_rh_bs_3_every_precondition_the_table_shows():
-    """$OMLOAD and $OMSTART need no running mission, $OLOGD a running one (RH-BS-3 judges every
-    precondition a backseat can know, from the transition table)."""
+def test_rh_bs_3_judges_the_commands_it_names_and_no_others():
+    """RH-BS-3 names ``$OLOGL``/``$ORWSET`` before a mission and ``$OMS``, ``$OJW``, ``$OPK``,
+    ``$OMW`` during one. Whether that list is exhaustive is a reading the words leave open, so both
+    are accepted: an ``$OLOGD`` after the mission's end (the vehicle answers err 25), an
+    ``$OMSTART`` or ``$OMLOAD`` while one runs, are no RH-BS-3 violation; the named ones are."""
     r = Run().veh(0.0, osi("N"))
     r.bs(1.0, frame("OMSTART,0,0,0,0,conformance.mis,")).bs(1.5, frame("OMLOAD,conformance.mis,0"))
-    assert r.fails("RH-BS-3") == 2
-    r = Run().veh(0.0, osi("S")).bs(1.0, frame("OLOGD,1,2"))
-    assert r.fails("RH-BS-3") == 1
+    r.close(3.0)
+    assert r.fails("RH-BS-3") == 0 and r.verdict("RH-BS-3") == "not-tested"
+    assert "$OLOGL, $ORWSET, $OMS, $OJW, $OPK, $OMW" in r.ledger.verdict("RH-BS-3").reason
+    r = Run().veh(0.0, osi("A")).bs(0.5, frame("OLOGD,1,2")).veh(1.0, osi("S"))
+    r.bs(2.0, frame("OLOGD,1,2")).veh(2.1, frame("ACK,4,1,25")).close(3.0)
+    assert r.fails("RH-BS-3") == 0 and r.verdict("RH-BS-3") == "not-tested"
+    for named, mode in (("ORWSET,SafetyAction,R", "N"), ("OLOGL,depth", "N"), ("OJW,1", "S"),
+                        ("OPK,41.52,-71.32,5,1.0", "S"), ("OMW,Clr", "S"), ("OMS,10.0,2.0,20.0,1.0,10", "S")):
+        r = Run().veh(0.0, osi(mode)).bs(1.0, frame(named))
+        assert r.fails("RH-BS-3") == 1, named
 
 
 # ------------------------------------------------------------------ RH-BS-5 rejections, lockout
@@ -448,16 +456,6 @@ def test_clean_backseat_passes_and_untested_rules_say_why():
     assert v["RH-BS-1"] == v["RH-BS-4"] == v["RH-BS-7"] == v["RH-BS-8"] == "pass"
     assert v["RH-BS-5"] == v["RH-BS-6"] == "not-tested"
     assert "rejected" in r.ledger.verdict("RH-BS-5").reason
-
-
-def test_plan_fits_the_lockout_and_keeps_the_order():
-    p = make_plan(list(SCENARIOS), 60, time_scale=1.0, lockout_s=20.0)
-    assert [s.name for s in p.slots] == list(SCENARIOS)
-    lock = next(s for s in p.slots if s.name == "lockout")
-    assert lock.end - lock.start >= 20 + 2
-    assert abs(p.total - 60) < 1e-6 and not p.note
-    short = make_plan(["lockout"], 5, time_scale=1.0, lockout_s=20.0)
-    assert short.total > 20 and "lengthened" in short.note
 
 
 def test_results_document_strict_and_partial():

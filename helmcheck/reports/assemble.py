@@ -78,9 +78,13 @@ def assemble(role: str, judged: Any, facts: Optional[RunFacts] = None, *, strict
     verdicts = [c["verdict"] for c in clauses]
     verdict = run_verdict(verdicts, strict=strict, partial=cut, process_failed=facts.ended_early)
     reason = describe_verdict(clauses, strict=strict, partial=cut, process=process,
-                              subject=role if role in ("vehicle", "backseat") else "implementation")
+                              subject=role if role in ("vehicle", "backseat") else "implementation",
+                              interrupted=partial is not None or facts.partial is None or facts.interrupted)
     if lead and not facts.ended_early:  # an implementation that ended early: its end is the reason
         reason = f"{lead[:1].upper()}{lead[1:]}. {reason}"
+    if facts.overrun:  # a remark: it changes no verdict (RH-BS-4 bounds what the backseat sends)
+        reason += (f" Line overrun (a remark beside RH-BS-4, which bounds only the bytes the backseat sends): "
+                   f"{facts.overrun}.")
     scope = scope_of({"role": role, "clauses": clauses, "partial": cut})
     return Assembly(role, clauses, cut, process, facts.line_model.as_dict(), verdict, reason, scope)
 

@@ -29,11 +29,13 @@ from __future__ import annotations
 
 from ...grammar import sentences as s
 from ...grammar.errors import FRAMING
+from ...grammar.ranges import check_ranges
 from ...model.validate import field_error
 from ..ledger import Ledger
 from ..spoil import REPEAT, SHORTEST_COMMAND, explain, explain_discard, signature
 from ..streaks import OTHER_REPEAT, Streaks
 from .common import SentLine, Settings
+from .words import discard_words, field_words, finding_words, framing_words
 
 __all__ = ["LineRules"]
 
@@ -93,7 +95,7 @@ class LineRules:
         d = line.discard
         if line.raw[:1] != b"$":
             self._junk_before = True
-        self._hold(line, [("RH-BS-1", f"{d.length} byte(s) that are no sentence ({d.clause}: {d.reason})")])
+        self._hold(line, [("RH-BS-1", discard_words(d.length, d.clause, d.reason))])
 
     def line(self, line: SentLine) -> None:
         d = line.decoded
@@ -101,27 +103,29 @@ class LineRules:
         self.lines += 1
         junk, self._junk_before = self._junk_before, False
         if d.findings:
-            fails.append(("RH-BS-7", str(d.findings[0])))
+            fails.append(("RH-BS-7", finding_words(d.findings[0].message)))
         else:
             self._pass("RH-BS-7", "upper-case checksum hex and CR LF", line)
         err = d.error
         if err is not None:
             if err.kind == FRAMING:
-                fails.append(("RH-BS-1", str(err)))
+                fails.append(("RH-BS-1", framing_words(err)))
             else:
-                self._pass("RH-BS-1", "well framed, correct checksum", line)
-                fails.append(("RH-BS-2", str(err)))
+                self._pass("RH-BS-1", "well framed, with a correct two-digit checksum", line)
+                fails.append(("RH-BS-2", field_words(err)))
             self._hold(line, fails)
             return
-        self._pass("RH-BS-1", "well framed, correct checksum", line)
+        self._pass("RH-BS-1", "well framed, with a correct two-digit checksum", line)
         cmd = d.sentence
         if isinstance(cmd, s.Command):
             self.commands += 1
             code = field_error(cmd, self.s.profile)
             if code is not None:
-                fails.append(("RH-BS-2", f"${cmd.ID}: a field is out of range (a vehicle answers err {code})"))
+                bad = check_ranges(cmd, self.s.profile)
+                fails.append(("RH-BS-2", field_words(bad) if bad is not None else
+                              f"${cmd.ID}: a field outside the ranges of §4–6 (a vehicle answers err {code})"))
             else:
-                self._pass("RH-BS-2", f"${cmd.ID} fields within range", line)
+                self._pass("RH-BS-2", f"every field of ${cmd.ID} within the ranges of §4–6", line)
         if fails:
             self._hold(line, fails)
             return
