@@ -152,7 +152,9 @@ BAD_LINES = [
 def test_rh_bs_1_2_7_framing_fields_and_style_are_judged_per_line(bad, clause, verdict):
     """Sent the same way again and again (spoil.REPEAT times: a faulty line does not repeat its
     damage), a broken line is the backseat's; once, then sent whole, it was the line's (counted,
-    not judged); once and never again, INCONCLUSIVE naming what the line may have done."""
+    not judged); once and never again, INCONCLUSIVE naming what the line may have done. A
+    well-framed line with a right checksum (a field out of range: RH-BS-2) is judged as sent, on
+    any link: it is the backseat's at once."""
     r = Run().bs(0.0, POLL)
     for i in range(REPEAT):
         r.bs(0.5 + 0.1 * i, bad)
@@ -164,9 +166,15 @@ def test_rh_bs_1_2_7_framing_fields_and_style_are_judged_per_line(bad, clause, v
     assert (ev.t, ev.lineno) == (0.5, 2)
     again = Run().bs(0.0, POLL).bs(0.5, bad).bs(0.6, frame("OMS,10.0,2.0,20.0,1.0,10")).bs(0.7, POLL)
     again.bs(0.8, frame("OMP,8080808080,00,5")).close(2.0)
+    once = Run().bs(0.0, POLL).bs(0.5, bad).close(2.0)
+    from helmcheck.grammar import decode
+    from helmcheck.judge.spoil import SHORTEST_COMMAND, explain
+    if clause == "RH-BS-2" and explain(bad, DEFAULT, decode(bad), SHORTEST_COMMAND) is None:  # as sent
+        assert again.fails(clause) == 1 and not again.ledger.spoiled_count(clause)
+        assert once.verdict(clause) == "fail" and "line" not in once.ledger.verdict(clause).reason.split("first: ")[1]
+        return
     assert not again.fails(clause) and again.ledger.spoiled_count(clause) == 1
     assert again.verdict(clause) == "pass", again.ledger.verdict(clause).reason
-    once = Run().bs(0.0, POLL).bs(0.5, bad).close(2.0)
     assert once.verdict(clause) == "inconclusive" and "the line" in once.ledger.verdict(clause).reason
 
 
@@ -398,6 +406,21 @@ def test_rh_bs_6_servo_refresh_after_the_timeout_ran_out():
     r.veh(5.01, frame("ACK,10,0,0") + frame("ACK,9,0,0"))
     r.bs(9.5, frame("OMS,13.0,2.0,20.0,1.0,10"))  # over 2 × 2 s after its ACK: a new start
     assert r.fails("RH-BS-6") == 1
+
+
+def test_rh_bs_6_a_refused_oms_that_does_not_read_ends_servo_control_too():
+    """An ``$OMS`` refused for a field out of range (timeout 121: it does not even decode as a
+    command) is refused like any other: the backseat cannot keep what the vehicle will not give,
+    so servo control is no longer held and the late refresh after it is not judged. The range
+    is RH-BS-2's, quoted from §4."""
+    r = Run(time_scale=5.0)  # timeout 10 s of vehicle time = 2 s of wall time
+    r.bs(0.0, OMS).veh(0.01, frame("ACK,9,0,0"))
+    r.bs(0.5, frame("OMS,11.0,2.0,20.0,1.0,121")).veh(0.51, frame("ACK,9,1,20"))
+    r.bs(2.7, frame("OMS,12.0,2.0,20.0,1.0,10")).veh(2.71, frame("ACK,9,0,0")).close(3.0)
+    assert r.fails("RH-BS-6") == 0
+    assert r.fails("RH-BS-2") == 1
+    reason = r.ledger.verdict("RH-BS-2").reason
+    assert "$OMS timeout 121 is outside [1, 120]; §4 gives it “timeout integer [1,120] s” (RH-SRV-2)" in reason
 
 
 def test_rh_bs_6_refresh_in_time_counts_even_when_its_ack_is_late():

@@ -23,8 +23,8 @@ Settings (wall seconds where the line is concerned, vehicle seconds otherwise; R
   RH-RD-15); ``seed`` for the draws. ``$OXFLT`` raises its violation at once (RH-SAF-5): it
   waits only for the lines that came before it. ``overrun`` — what the vehicle does when requests
   ask for more replies than the line carries (the profile leaves it open): ``"queue"`` (every reply
-  waits its turn: queue and lag) or ``"drop"`` (a request whose replies could not start within the
-  ACK window is not answered, its replies dropped whole; :mod:`.outbox`).
+  waits its turn: queue and lag) or ``"drop"`` (a poll whose replies could not start within the
+  ACK window is not answered, its replies dropped whole; commands are always answered; :mod:`.outbox`).
 * the clock (RH-TIM-1): ``control_tick_s`` — the control loop runs every this many vehicle
   seconds: timer expiries and plant events take effect on the next tick, sensors are sampled on
   ticks; ``timer_factor`` and ``timer_offset_s`` — every protocol duration the vehicle times
@@ -103,8 +103,8 @@ class EmulatorSettings:
                                  "processed at its next turn, replies written at once)", "RH-ACK-2, RH-RD-15")
     seed: int = _s(0, "seed of the reply-delay draws")
     overrun: str = _s("queue", "requests asking for more replies than the line carries: queue (every reply waits "
-                      "its turn) or drop (a request whose replies could not start within the ACK window is "
-                      "not answered)", "RH-ACK-1, RH-ACK-2, RH-BS-4")
+                      "its turn) or drop (a poll whose replies could not start within the ACK window is "
+                      "not answered; commands always are)", "RH-ACK-1, RH-ACK-2, RH-BS-4")
     # --- the clock
     control_tick_s: float = _s(0.0, "vehicle seconds between control-loop ticks (0: continuous)", "RH-TIM-1")
     timer_factor: float = _s(1.0, "every timed duration lasts duration × factor + offset", "RH-TIM-1")

@@ -6,9 +6,12 @@ does what its ``overrun`` setting says (:mod:`.freedoms`; the profile leaves it 
 
 * ``"queue"`` — every reply waits its turn, however long the queue grows (queue and lag), up to
   :data:`MAX_OUTBOX_BYTES`, beyond which a request's replies are dropped (memory stays bounded);
-* ``"drop"`` — a request whose replies could not start within the ACK window (the queue ahead
-  takes longer than ``ack_window_s`` to drain) is not answered: its replies, data and ``$ACK``
-  alike, are dropped whole. What is sent then always leaves within RH-ACK-2's window.
+* ``"drop"`` — while the requests of the last :data:`~.outload.WINDOW_S` seconds ask for more than
+  the line carries (a sustained overrun, not a burst), a poll (``$OSD``) whose replies could not
+  start within the ACK window (the queue ahead takes longer than ``ack_window_s`` to drain) is not
+  answered: its data sentences and its ``$ACK,8`` are dropped whole. A command is always answered,
+  in order: it changes the vehicle's state, and its ``$ACK`` is a few bytes. The queue then never
+  holds much more than the ACK window's worth, so what is sent leaves about when RH-ACK-2 says.
 
 Either way the demand, the longest wait and what was dropped are metered
 (:class:`~.outload.OutputLoad`, :attr:`Outbox.load`) and the first drop is noted in the wire log.
@@ -60,9 +63,12 @@ class Outbox:
         why = ""
         if self._out_bytes + n > MAX_OUTBOX_BYTES:
             why = f"more than {MAX_OUTBOX_BYTES // 1024} KiB of replies were waiting for the line"
-        elif self.settings.overrun == "drop" and self.backlog_s(now) > self.profile.ack_window_s:
-            why = (f"the replies queued before them took {self.backlog_s(now):.2f} s to leave, longer than the "
-                   f"{self.profile.ack_window_s:g} s ACK window (overrun = \"drop\")")
+        elif (self.settings.overrun == "drop" and sid == "OSD" and self.backlog_s(now) > self.profile.ack_window_s
+              and self.load.recent_rate(now - self.start) > self.load.capacity):
+            why = (f"the replies queued before a poll's took {self.backlog_s(now):.2f} s to leave, longer than the "
+                   f"{self.profile.ack_window_s:g} s ACK window, while the requests asked for "
+                   f"{self.load.recent_rate(now - self.start):.0f} bytes a second of a line that carries "
+                   f"{self.load.capacity:.0f} (overrun = \"drop\")")
         if why:
             if not self.stats["dropped_out"]:
                 self._note(now, f"output overflow: replies dropped (the line is slower than the requests): {why}")

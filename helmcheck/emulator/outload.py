@@ -67,9 +67,19 @@ class OutputLoad:
         if lag > self.max_lag_s:
             self.max_lag_s, self.max_lag_at = lag, t
 
+    def recent_rate(self, t: float) -> float:
+        """Bytes a second asked over the last :data:`WINDOW_S` seconds up to ``t``: a demand the line
+        cannot carry for that long is an overrun, a burst it carries in that time is not."""
+        if self._first is None:
+            return 0.0
+        sec = int(math.floor(t))
+        lo = max(self._first, sec - WINDOW_S + 1)
+        return sum(self._per_s.get(s, 0) for s in range(lo, sec + 1)) / WINDOW_S
+
     def worst_rate(self) -> tuple[float, Optional[int]]:
-        """The highest demand (bytes a second) over any :data:`WINDOW_S` whole seconds (fewer
-        when the record is shorter), and the second that window starts at."""
+        """The highest demand (bytes a second) over any :data:`WINDOW_S` whole seconds, and the
+        second that window starts at (a record shorter than that is averaged over the window too:
+        what the line carries in that time is no overrun)."""
         if not self._per_s:
             return 0.0, None
         lo, hi = min(self._per_s), max(self._per_s)
@@ -81,7 +91,7 @@ class OutputLoad:
                 total += self._per_s.get(start + span - 1, 0) - self._per_s.get(start - 1, 0)
             if total > best:
                 best, at = float(total), start
-        return best / span, at
+        return best / WINDOW_S, at
 
     def main_request(self) -> str:
         """The request ID that asked for most of the replies ('' if none)."""
@@ -92,11 +102,11 @@ class OutputLoad:
 
     def summary(self, *, ack_window_s: float = 1.0) -> Optional[dict]:
         """The overrun, or None when the line carried what was asked: the demand of the worst
-        window was over the line's capacity, a reply waited longer than ``ack_window_s``, or
-        something was dropped."""
+        window was over the line's capacity, or something was dropped. (A reply that waited
+        longer than ``ack_window_s`` behind a burst is no overrun: the queue is for bursts.)"""
         rate, at = self.worst_rate()
         over = rate > self.capacity
-        if not (over or self.dropped_bytes or self.max_lag_s > ack_window_s):
+        if not (over or self.dropped_bytes):
             return None
         return {"asked_Bps": round(rate, 1), "window_start_s": at, "line_Bps": self.capacity,
                 "baud": self.baud, "max_lag_s": round(self.max_lag_s, 3),

@@ -70,7 +70,10 @@ def render_markdown(run: Run, comparison_md: str | None = None) -> str:
     out += [f"- {md_escape(line)}" for line in scope.why()]
     if scope.gaps:
         out.append("")
-    if r["partial"]:
+    if r["partial"] and scope.unexercised:
+        out += ["> **PARTIAL RUN**: the run finished, but not every scenario was exercised (a moment it "
+                "exists for did not reach the backseat in time); this is not a complete certificate.", ""]
+    elif r["partial"]:
         out += ["> **PARTIAL RUN**: the run was interrupted before it finished; "
                 "this is not a complete certificate.", ""]
     if not run.wire["present"]:

@@ -14,8 +14,11 @@
 * **RH-BS-7** (SHOULD) — upper-case checksum hex and CR LF: a grammar finding on the line
   (lower-case hex, bare LF) is a violation; every other line meets it.
 
-A faulty line between the backseat and the vehicle breaks lines the backseat wrote whole, so a
-broken line's violations are held, not booked (``docs/contracts.md``, "A faulty line"; the
+A well-framed line with a right checksum is judged as sent, on any link: a field out of range
+under a right checksum is what the backseat wrote (RH-BS-2 at once). On a link that cannot damage
+a byte (``line model: clean``) every broken line is the backseat's at once too. Elsewhere a faulty
+line between the backseat and the vehicle breaks lines the backseat wrote whole, so a broken
+line's violations are held, not booked (``docs/contracts.md``, "A faulty line"; the
 repetition rule, :mod:`helmcheck.judge.streaks`, and the damage's form,
 :mod:`helmcheck.judge.spoil`): the next line of the same sentence read whole makes them the
 line's; the same error on the backseat's next lines of that sentence, as often as its form
@@ -73,6 +76,13 @@ class LineRules:
                 self.ledger.failed(cid, reason, [line.evidence()], case)
             return
         raw, d = line.raw, line.decoded
+        if (fault is None and d is not None and not d.findings and (d.error is None or d.error.kind != FRAMING)
+                and explain(raw, self.s.profile, d, SHORTEST_COMMAND) is None):
+            # well framed with a right checksum: judged as sent, on any link (no one line fault
+            # makes it; a value out of range under a right checksum is what the backseat wrote)
+            for cid, reason in fails:
+                self.ledger.failed(cid, reason, [line.evidence()], case)
+            return
         junk = d is None and raw[:1] != b"$"
         key = ("bs-junk",) if junk else ("bs", line.sid or "?")
         if fault is not None:

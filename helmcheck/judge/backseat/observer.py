@@ -316,7 +316,7 @@ class BackseatObserver:
         self.reaction.answered(line, a.status, arrived)
         self.preconditions.answered(line, accepted)
         event = line.event
-        if event == "OMS":
+        if event == "OMS" or (not accepted and line.sid == "OMS"):  # a refused $OMS, readable or not
             self.servo.answered(line, accepted, t)
         if accepted and event in LOCKOUT_REFUSED:
             ended = self.lockout.clear(t, reset_code=event in ("OMSTART", "OMSTOP"))
