@@ -220,7 +220,7 @@ class EmulatorCore(Timeline, Outbox):
         """Send ``reply`` in the vehicle's place, behind the replies already waiting and paced
         like them (RH-ACK-2's transmit time, RH-ACK-6's order); returns bytes to send now."""
         self._catch_up(now)
-        self._send(format_sentence(reply), now)
+        self._send_set([format_sentence(reply)], now)
         return self._release(now)
 
     @property

@@ -50,34 +50,37 @@ class Outbox:
         return max(0.0, pacer.free_at - now) + pacer.transmit_time(self._out_bytes)
 
     def _send(self, raw: bytes, now: float) -> None:
-        self._send_set((raw,), now)
+        """One sentence into the queue (a test's faulty vehicle rewrites its sentences here)."""
+        if self._out_bytes + len(raw) > MAX_OUTBOX_BYTES:
+            self._dropped(now, len(raw), f"more than {MAX_OUTBOX_BYTES // 1024} KiB of replies were waiting "
+                                         f"for the line")
+            return
+        self._out.append((raw, now))
+        self._out_bytes += len(raw)
 
     def _send_set(self, raws: Iterable[bytes], now: float, sid: str = "") -> None:
-        """The replies to one request (``sid``: its sentence ID), queued together or, when the
-        line cannot take them (module docstring), dropped together."""
+        """The replies to one request (``sid``: its sentence ID), queued together (one by one,
+        :meth:`_send`) or, when the line cannot take them (module docstring), dropped together."""
         raws = [r for r in raws if r]
         if not raws:
             return
         n = sum(len(r) for r in raws)
         self.load.asked(now - self.start, n, sid)
-        why = ""
-        if self._out_bytes + n > MAX_OUTBOX_BYTES:
-            why = f"more than {MAX_OUTBOX_BYTES // 1024} KiB of replies were waiting for the line"
-        elif (self.settings.overrun == "drop" and sid == "OSD" and self.backlog_s(now) > self.profile.ack_window_s
-              and self.load.recent_rate(now - self.start) > self.load.capacity):
-            why = (f"the replies queued before a poll's took {self.backlog_s(now):.2f} s to leave, longer than the "
-                   f"{self.profile.ack_window_s:g} s ACK window, while the requests asked for "
-                   f"{self.load.recent_rate(now - self.start):.0f} bytes a second of a line that carries "
-                   f"{self.load.capacity:.0f} (overrun = \"drop\")")
-        if why:
-            if not self.stats["dropped_out"]:
-                self._note(now, f"output overflow: replies dropped (the line is slower than the requests): {why}")
-            self.stats["dropped_out"] += n
-            self.load.dropped(now - self.start, n)
+        if (self.settings.overrun == "drop" and sid == "OSD" and self.backlog_s(now) > self.profile.ack_window_s
+                and self.load.recent_rate(now - self.start) > self.load.capacity):
+            self._dropped(now, n, f"the replies queued before a poll's took {self.backlog_s(now):.2f} s to leave, "
+                                  f"longer than the {self.profile.ack_window_s:g} s ACK window, while the requests "
+                                  f"asked for {self.load.recent_rate(now - self.start):.0f} bytes a second of a "
+                                  f"line that carries {self.load.capacity:.0f} (overrun = \"drop\")")
             return
         for raw in raws:
-            self._out.append((raw, now))
-            self._out_bytes += len(raw)
+            self._send(raw, now)
+
+    def _dropped(self, now: float, n: int, why: str) -> None:
+        if not self.stats["dropped_out"]:
+            self._note(now, f"output overflow: replies dropped (the line is slower than the requests): {why}")
+        self.stats["dropped_out"] += n
+        self.load.dropped(now - self.start, n)
 
     def _release(self, now: float) -> bytes:
         if not self._out:

@@ -49,7 +49,10 @@ def build_results(outcome: Optional[RunRecord], *, profile: Profile, settings: d
         facts = RunFacts(not_judged={cid: f"not judged: {why}" for cid in BS_CLAUSES}, partial=why)
     else:
         ledger, facts = outcome.observer.ledger, outcome.facts
-    a = assemble("backseat", ledger, facts, strict=strict, lead=facts.partial or "")
+    # the lead: why a run was cut short (the outcome's words: they name a signal), or why a run that
+    # finished is partial all the same (a scenario's moment did not reach the backseat)
+    lead = why if facts.interrupted else (facts.partial or "")
+    a = assemble("backseat", ledger, facts, strict=strict, lead=lead)
     if outcome is not None and outcome.status != "never-connected":
         for t, kind, label in outcome.events:
             add_event(results, round(t, 6), kind, label)
