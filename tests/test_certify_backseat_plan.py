@@ -41,7 +41,7 @@ def test_each_scenario_lasts_what_it_must_show_at_the_time_scale_and_on_the_line
     assert p.slots[0].start == 0.0 and all(a.end == pytest.approx(b.start) for a, b in zip(p.slots, p.slots[1:]))
     assert p.total == pytest.approx(p.needed) and p.total == pytest.approx(sum(s.length for s in p.slots))
     assert not p.short and not p.note
-    want = {"nominal": NOMINAL_S, "reject": LEAD_S + 2.0 + reach + TAIL_S,
+    want = {"nominal": NOMINAL_S, "reject": LEAD_S + 5.0 + reach + 1.0 + TAIL_S,
             "lockout": LEAD_S + 20.0 / k + 10.0 / k + reach, "mission-end": LEAD_S + reach + 1.0,
             "silence": LEAD_S + SILENCE_S + TAIL_S}
     for s in p.slots:

@@ -169,7 +169,7 @@ def test_configured_to_start_missions_itself_it_drives_with_no_mission_rh_bs_3_f
 def at_x1(tmp_path_factory):
     if not MATRIX:
         pytest.skip("×1 certifications are make matrix's (HELMCHECK_MATRIX=1)")
-    root = tmp_path_factory.mktemp("realtime-x1")
+    root = tmp_path_factory.mktemp("at-x1-")
     rt = f"{REALTIME} {{port}} --baud {{baud}}"
     return _batch(root, {
         "19200": (rt.replace("{baud}", "19200"), "--time-scale", "1", "--baud", "19200"),

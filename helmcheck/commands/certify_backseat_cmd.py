@@ -16,7 +16,10 @@ earlier run without ``--overwrite``). Progress goes to standard error.
 
 With ``--exec CMD`` helmcheck starts the backseat itself once the port is open and stops it at
 the end (:mod:`helmcheck.certify.backseat.process`); a backseat that exits or dies before
-the end fails the run.
+the end fails the run. ``--plan`` prints each scenario's length at the time scale and baud, and
+why (:func:`~helmcheck.certify.backseat.certifier.plan_for`), and exits 0 without opening a port;
+the default ``--duration`` is that plan's. ``--overrun drop|queue`` chooses what the vehicle does
+with requests that ask for more replies than its line carries.
 
 This module turns the arguments into :class:`helmcheck.certify.backseat.certifier.Options`,
 checks every path and opens the port before anything runs, and calls

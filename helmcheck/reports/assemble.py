@@ -9,8 +9,10 @@
 * the verdict ledger of the role's observer (:class:`helmcheck.judge.ledger.Ledger`), or the
   entries of one (``check-log`` returns entries);
 * the run facts read from the wire log's notes (:class:`helmcheck.judge.runfacts.RunFacts`):
-  the selection, the clauses not judged, the implementation under test's end (``process``),
-  whether the run was cut short (``run partial``), the line model (``line model:``).
+  the selection, the clauses not judged, a backseat scenario's observations not claimed
+  (``not claimed``), the implementation under test's end (``process``), whether the run was cut
+  short or a scenario not exercised (``run partial``), the line model (``line model:``), a line
+  overrun (``line overrun:``, a remark the reason ends with).
 
 Its outputs (:class:`Assembly`): the clause entries of ``results.json`` (the facts booked into
 the ledger first: a clause not selected or not judged is NOT-TESTED unless a violation was

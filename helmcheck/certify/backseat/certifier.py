@@ -214,8 +214,6 @@ def _run(opts: Options, profile: Profile, plan, report_dir: Path, link: Link, lo
                   file=sys.stderr)
             if plan.note and not plan.short:
                 print(f"helmcheck certify backseat: {plan.note}", file=sys.stderr)
-        if opts.on_port is not None:
-            opts.on_port(link.name)
         spec = parse_port_spec(opts.port)
         runner = Runner(link, profile, plan, time_scale=profile.time_scale,
                         missions=DirectoryCatalog([builtin_dir()]), log=log, meta=meta,
@@ -228,6 +226,8 @@ def _run(opts: Options, profile: Profile, plan, report_dir: Path, link: Link, lo
         runner.recorder.note(0.0, f"plan: {plan.describe()[0]}; the vehicle's line: overrun = {opts.overrun}")
         if plan.note:
             runner.recorder.note(0.0, f"plan: {plan.note}")
+        if opts.on_port is not None:  # the port is announced once the vehicle is ready to read it
+            opts.on_port(link.name)
         if opts.exec_cmd:
             from .process import start_backseat
             try:

@@ -12,7 +12,7 @@ state before it.
 ``nominal`` (:data:`NOMINAL_S`: two of RH-BS-8's longest poll intervals)
     Nothing is staged: the reference vehicle answers exactly as the model does. The backseat
     is expected to start its mission, poll and drive.
-``reject`` (the lead, a window of two resend spacings and a reach, :data:`TAIL_S`)
+``reject`` (the lead, a window of one of RH-BS-8's poll intervals, a reach and a resend spacing, :data:`TAIL_S`)
     In the window every command other than ``$OSD`` is refused with a valid error ``$ACK``: status
     1 and the command's own "incorrect values" error (RH-ACK-3/4, e.g. ``$ACK,9,1,20`` for
     ``$OMS``). The refused command is not passed to the vehicle, so it changes nothing (a servo
@@ -155,9 +155,10 @@ def make_plan(names: list[str] | tuple[str, ...], duration: float | None = None,
             needs[n] = (NOMINAL_S, f"the backseat polls, starts its mission and takes control: two of RH-BS-8's "
                                    f"{POLL_INTERVAL_S:g} s poll intervals", cycles)
         elif n == "reject":
-            length = LEAD_S + 2 * RESEND_SPACING_S + reach + TAIL_S
-            needs[n] = (length, f"a staged refusal reaching the backseat ({line}) and two "
-                                f"{RESEND_SPACING_S:g} s resend spacings after it", 0.0)
+            length = LEAD_S + POLL_INTERVAL_S + reach + RESEND_SPACING_S + TAIL_S
+            needs[n] = (length, f"a command within one of RH-BS-8's {POLL_INTERVAL_S:g} s poll intervals, its "
+                                f"staged refusal reaching the backseat ({line}) and a {RESEND_SPACING_S:g} s resend "
+                                f"spacing after it", 0.0)
         elif n == "lockout":
             length = LEAD_S + lockout_wall + ascent_wall + reach
             asc = (f" and the ascent from {ascent_depth_m:g} m at {ascent_mps:g} m/s ({_fmt(ascent_wall)} s)"
