@@ -14,7 +14,10 @@ its mission with an empty SRP field. What must hold:
   run is partial, with the reason — never a certificate that claims a lockout the backseat only
   heard of at its end (``--overrun queue``: the replies queue and lag, and it does not);
 * configured to start missions itself, it drives while the vehicle reports no mission: RH-BS-3 FAIL;
-* ``check-log`` of its wire log, and ``helmcheck verify``, give the same verdicts.
+* ``check-log`` of its wire log, and ``helmcheck verify``, give the same verdicts;
+* a backseat whose own cycle is longer than a scenario's plan (the longest servo timeout, 120 s,
+  refreshed only after it ran out) holds the scenario open until that cycle was seen twice: its
+  late refresh is seen (RH-BS-6 NON-STRICT), not left for the next scenario to swallow.
 
 ``make test`` runs it at ×10 (three certifications at once, about 40 s); ``make matrix``
 (``HELMCHECK_MATRIX=1``) at ×1 as its users would, on 19200 and 115200 baud, where the plan's
@@ -40,6 +43,7 @@ from helmcheck.reports.scope import scope_of
 MATRIX = os.environ.get("HELMCHECK_MATRIX") == "1"
 ROOT = Path(__file__).resolve().parent.parent
 REALTIME = ROOT / "tests" / "backseats" / "realtime_backseat.py"
+FAULTY = ROOT / "tests" / "backseats" / "faulty_backseat.py"
 EXAMPLE = ROOT / "examples" / "backseat.py"
 
 pytestmark = pytest.mark.xdist_group("test_certify_backseat_realtime")
@@ -73,6 +77,8 @@ def runs(tmp_path_factory):
         "x10-queue": (rt, "--time-scale", "10", "--overrun", "queue", "--scenario", "nominal", "--scenario", "lockout"),
         "x10-starts": (rt + " --start-missions", "--time-scale", "10", "--scenario", "nominal",
                        "--scenario", "mission-end"),
+        "x10-long-cycle": (f"{FAULTY} {{port}} --fault late-refresh-120 --time-scale {{time_scale}}", "--time-scale",
+                           "10", "--scenario", "nominal"),
     })
 
 
@@ -161,6 +167,21 @@ def test_configured_to_start_missions_itself_it_drives_with_no_mission_rh_bs_3_f
     assert "$OMS sent" in bs3["reason"] and "report of no running mission" in bs3["reason"], bs3
     assert run["results"]["verdict"] == "fail" and run["rc"] == 1
     assert_one_judge(run)
+
+
+def test_a_scenario_outlasts_the_backseats_own_cycle_so_a_late_refresh_is_seen(runs):
+    """The backseat chose a 120 s timeout (12 s at ×10) and refreshes only 14.4 s after: the 10 s
+    nominal scenario is held open until that timeout was seen run out twice, so the late refresh
+    comes inside it (RH-BS-6 NON-STRICT) — the run says so, and says how long it held it open."""
+    run = runs["x10-long-cycle"]
+    r = run["results"]
+    nominal = r["coverage"]["scenarios"][0]
+    assert nominal["claimed"] and nominal["extended_s"] > 10.0 and nominal["ran_s"] > 24.0, nominal
+    assert "its 12.00 s timeout seen run out twice" in nominal["exercised"], nominal
+    bs6 = clauses(run)["RH-BS-6"]
+    assert bs6["verdict"] == "non-strict" and "after its 120 s timeout (12.00 s at ×10) ran out" in bs6["reason"], bs6
+    assert "scenario nominal extended: waiting for the servo timeout the backseat chose" in \
+        (run["dir"] / "wire.log").read_text()
 
 
 # ------------------------------------------------------------------ as its users would: ×1 (make matrix)

@@ -23,6 +23,8 @@ fast-resend         RH-BS-5    resends a rejected command every 0.3 s
 resend-burst        RH-BS-5    answers its first refused ``$OMS`` with four copies of it
                                within 0.1 s
 late-refresh        RH-BS-6    refreshes ``$OMS`` only after 1.6 × its timeout
+late-refresh-120    RH-BS-6    chooses the longest timeout, 120 s, and refreshes ``$OMS`` only after
+                               1.2 × it (at ×10: every 14.4 s; a scenario must outlast its cycle)
 no-poll             RH-BS-8    polls ``$OSD`` every 7 s
 ==================  =========  ================================================================
 
@@ -196,6 +198,13 @@ class LateRefresh(Backseat):
         self.refresh_every = 1.6 * self.servo_timeout / self.k
 
 
+class LateRefresh120(Backseat):
+    def __init__(self, *a, **kw):
+        super().__init__(*a, **kw)
+        self.servo_timeout = 120
+        self.refresh_every = 1.2 * self.servo_timeout / self.k
+
+
 class NoPoll(Backseat):
     poll_every = 7.0
 
@@ -261,7 +270,7 @@ FAULTS = {
     "bare-lf": BareLf, "short-omp": ShortOmp, "rwset-after-start": RwsetAfterStart,
     "oms-while-stopped": OmsWhileStopped, "hasty-oms": HastyOms, "flood": Flood, "lockout-ignore": LockoutIgnore,
     "fast-resend": FastResend, "resend-burst": ResendBurst, "late-refresh": LateRefresh,
-    "no-poll": NoPoll,
+    "no-poll": NoPoll, "late-refresh-120": LateRefresh120,
     "once-bad-checksum": OnceBadChecksum, "once-timeout-121": OnceTimeout121,
     "once-heading-360": OnceHeading360, "once-opk-minutes-0": OnceOpkMinutes0, "omw-dollar-sum": OmwDollarSum,
 }
