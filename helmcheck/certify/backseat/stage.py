@@ -6,24 +6,24 @@ scenario open, past its planned end, until they have reached the backseat — by
 observations in that scenario out of the claim (a ``not claimed`` note, :mod:`helmcheck.judge.runfacts`;
 the run is then partial, not a certificate). Times are seconds since the certifier started.
 
-========== =============================================================== ==========================
-scenario   its moments (the run waits for each)                            not claimed when missing
-========== =============================================================== ==========================
-nominal    the servo timeout the backseat chose, seen run out twice after   RH-BS-6 (its refreshes)
-           its first accepted ``$OMS`` (if it took servo control in it)
-reject     a staged refusal reaching the backseat, and a resend spacing     RH-BS-5
-           and ``reaction_s`` after it (the window stays open until then)
-lockout    its start reaching the backseat *in time* — the first sign       RH-BS-5
-           (``$OSI`` field 8, err 26) arrived within the backseat's poll
-           cycle (at most RH-BS-8's 5 s), the ACK window and a reply's
-           transmit time of the start, so the lockout is judged whole —
-           and its end reaching it (the first ``$OSI`` the vehicle made
-           after the end had arrived)
+=========== ============================================================== ==========================
+scenario    its moments (the run waits for each)                           not claimed when missing
+=========== ============================================================== ==========================
+nominal     the servo timeout the backseat chose, seen run out twice after RH-BS-6 (its refreshes)
+            its first accepted ``$OMS`` (if it took servo control in it)
+reject      a staged refusal reaching the backseat, and a resend spacing   RH-BS-5
+            and ``reaction_s`` after it (the window stays open until then)
+lockout     its start reaching the backseat *in time* — the first sign     RH-BS-5
+            (``$OSI`` field 8, err 26) arrived within the backseat's poll
+            cycle (at most RH-BS-8's 5 s), the ACK window and a reply's
+            transmit time of the start, so the lockout is judged whole —
+            and its end reaching it (the first ``$OSI`` the vehicle made
+            after the end had arrived)
 mission-end a running mission to end (the run waits for one), and its end  RH-BS-3
-           reaching the backseat (the first ``$OSI`` saying ``S``)
-silence    the silence outlasting the timeout the backseat chose (its       RH-BS-4, RH-BS-8
-           latest accepted ``$OMS``) and two of its poll cycles
-========== =============================================================== ==========================
+            reaching the backseat (the first ``$OSI`` saying ``S``)
+silence     the silence outlasting the timeout the backseat chose (its     RH-BS-4, RH-BS-8
+            latest accepted ``$OMS``) and two of its poll cycles
+=========== ============================================================== ==========================
 
 When a report reached the backseat is when its bytes had fully arrived: the vehicle's release of
 the sentence (the emulator core's output pacing, :attr:`~helmcheck.emulator.outbox.Outbox.on_release`)
