@@ -60,10 +60,12 @@ explore-reach: $(STAMP)
 # emulator, the independent simulator and the example backseat behind every line fault, and every
 # faulty vehicle behind light damage (tests/test_bad_line.py); the independent simulator's own
 # missions at x5 and two exploration findings replayed (make test's budget keeps x20 and one replay);
+# backseats certified at x1 as their users would (about 70 s): the real-time backseat on 19200 and
+# 115200 baud, the example backseat (tests/test_certify_backseat_realtime.py; make test: x10);
 # the third vehicle on its own default line and every one of its 36 mutants on its clause
 # (tests/test_vehicle3.py), and the emulator under every reading of the readings table (tests/test_readings.py).
 matrix: $(STAMP)
-	HELMCHECK_MATRIX=1 $(PY) -m pytest -n 2 tests/test_line_budget.py tests/test_slow_line.py tests/test_unplugged.py tests/test_bad_line.py tests/test_third_party_vehicle.py::test_its_own_missions_with_oxflt_certify tests/test_explore_replays.py tests/test_vehicle3.py tests/test_readings.py
+	HELMCHECK_MATRIX=1 $(PY) -m pytest -n 2 tests/test_line_budget.py tests/test_slow_line.py tests/test_unplugged.py tests/test_bad_line.py tests/test_third_party_vehicle.py::test_its_own_missions_with_oxflt_certify tests/test_explore_replays.py tests/test_vehicle3.py tests/test_readings.py tests/test_certify_backseat_realtime.py
 
 # Not run by CI (several minutes): every --help example, the slow ones and those that need a
 # vehicle too (run against the emulator on their port); make test runs the others.

@@ -149,7 +149,9 @@ def test_a_vehicle_we_did_not_write_behind_lost_bytes_noise_and_a_stall_is_never
 
 def run_backseat(tmp_path: Path, faults: str, k: float, duration: float, program: list) -> tuple[dict, object]:
     """``certify backseat`` on a new pty, the relay (a process of its own) between it and
-    ``program`` (argv after the interpreter; ``{port}`` is the relay's backseat-side port)."""
+    ``program`` (argv after the interpreter; ``{port}`` is the relay's backseat-side port). The
+    certifier's own port is a pty it made, which cannot damage a byte; the relay behind it can,
+    so the run says so: ``--line noisy`` (``line="noisy"``)."""
     from helmcheck.certify.backseat.certifier import Options as BOptions, certify as bcertify
     from helmcheck.line.faultline import RelayProcess
     from helmcheck.profile import DEFAULT
@@ -179,9 +181,12 @@ def run_backseat(tmp_path: Path, faults: str, k: float, duration: float, program
 
 
 def test_the_example_backseat_behind_flipped_bits_is_never_failed(tmp_path):
+    """Behind ``helmcheck relay`` flipping bits, run with ``--line noisy`` (the relay, not
+    helmcheck's pty, is the link): the example backseat is not failed for the relay's damage."""
     results, line = run_backseat(tmp_path, "baud=19200,flip=3e-4,seed=2", 10.0, 15.0,
                                  [str(EXAMPLE_BACKSEAT), "--port", "{port}", "--time-scale", "10"])
     assert line is not None and _injected(line), "no fault was injected: the test tests nothing"
+    assert results["line_model"]["kind"] == "noisy" and results["line_model"]["why"] == "--line noisy given"
     failed, unnamed = _problems(results)
     assert not failed and not unnamed, (failed, unnamed)
     _relay_judged_exactly(tmp_path / "relay.log", "backseat", 10.0, emulator_profile())

@@ -243,6 +243,8 @@ def _kind(argv: list[str]) -> tuple[str, str]:
         return ("live" if RUN_ALL else "skip"), "it needs a vehicle on its port"
     if ("--exec" in argv and argv[:2] == ["certify", "backseat"]) or argv[:1] == ["diff"]:
         return ("run" if RUN_ALL else "skip"), "it takes more than a few seconds"
+    if argv[:2] == ["certify", "backseat"] and "--plan" in argv:
+        return "run", ""  # prints the plan and exits: no port
     if argv[:1] == ["emulate"] or (argv[:2] == ["certify", "backseat"] and "--exec" not in argv):
         return "serve", "it serves until stopped"
     return "run", ""

@@ -105,7 +105,7 @@ def test_rh_bs_8_a_poll_interval_across_a_run_resumed_note_is_not_judged_one_aft
     assert run(False, 9.0).verdict("RH-BS-8") in ("fail", "non-strict")  # the gap, held against it
     late = run(True, 14.0)  # 6 s after the poll that followed the note: still the backseat's
     assert late.verdict("RH-BS-8") in ("fail", "non-strict")
-    assert "after the previous one" in late.ledger.verdict("RH-BS-8").reason
+    assert "after its previous poll" in late.ledger.verdict("RH-BS-8").reason
 
 
 def test_rh_bs_1_a_line_the_gap_cut_is_nobody_s():

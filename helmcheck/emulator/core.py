@@ -72,6 +72,7 @@ from ..line.transport import LinePacer
 from .freedoms import DEFAULT_SETTINGS, EmulatorSettings, ReplyDelay, ReplyShaper, SkewedTimers, model_readings
 from .logs import HistoryEntry, MainLog, event_text
 from .outbox import MAX_OUTBOX_BYTES, Outbox
+from .outload import OutputLoad
 from .plant import Plant, PlantParams
 from .rules import OperationTimeRule
 from .settingsfile import load_settings, save_settings
@@ -132,8 +133,9 @@ class EmulatorCore(Timeline, Outbox):
         self.settings_path = settings_path
         self.history: deque[HistoryEntry] = deque(maxlen=history)
         self.v = 0.0  #: vehicle time the model and plant have reached
-        self._out: deque[bytes] = deque()
+        self._out: deque[tuple[bytes, float]] = deque()  #: (sentence, wall time it was queued)
         self._out_bytes = 0
+        self.load = OutputLoad(self.pacer.baud)  #: what the requests asked of the line (:mod:`.outload`)
         self._on_error = on_error
         self.stats = {"lines_in": 0, "commands": 0, "answered_errors": 0, "discarded": 0,
                       "sentences_out": 0, "bytes_in": 0, "bytes_out": 0, "dropped_out": 0,
@@ -223,7 +225,7 @@ class EmulatorCore(Timeline, Outbox):
         """Send ``reply`` in the vehicle's place, behind the replies already waiting and paced
         like them (RH-ACK-2's transmit time, RH-ACK-6's order); returns bytes to send now."""
         self._catch_up(now)
-        self._send(format_sentence(reply), now)
+        self._send_set([format_sentence(reply)], now)
         return self._release(now)
 
     @property
@@ -250,6 +252,7 @@ class EmulatorCore(Timeline, Outbox):
         if self._out:
             self._note(now, f"link: {len(self._out)} unsent sentences dropped")
             self.stats["dropped_out"] += self._out_bytes
+            self.load.dropped(now - self.start, self._out_bytes)
         self._out.clear()
         self._out_bytes = 0
         self.pacer.reset(now)
@@ -334,8 +337,7 @@ class EmulatorCore(Timeline, Outbox):
                 self._save_settings(self.settings_path)
         if self._shaper.active:
             replies = [self._shaper.shape(r, self._idle_distance(), m.snapshot.utc) for r in replies]
-        for r in replies:
-            self._send(format_sentence(r), now)
+        self._send_set([format_sentence(r) for r in replies], now, getattr(item, "ID", None) or getattr(item, "sentence_id", None) or "")
         self._after_model(now)
         return next((r for r in reversed(replies) if isinstance(r, s.ACK)), None)
 

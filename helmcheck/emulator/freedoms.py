@@ -24,7 +24,10 @@ Settings (wall seconds where the line is concerned, vehicle seconds otherwise; R
   turns every this many wall seconds: the lines that arrived are processed at its next turn and
   their replies written at once (the instant the ACK goes out is the instant of processing,
   RH-RD-15); ``seed`` for the draws. ``$OXFLT`` raises its violation at once (RH-SAF-5): it
-  waits only for the lines that came before it.
+  waits only for the lines that came before it. ``overrun`` — what the vehicle does when requests
+  ask for more replies than the line carries (the profile leaves it open): ``"queue"`` (every reply
+  waits its turn: queue and lag) or ``"drop"`` (a poll whose replies could not start within the
+  ACK window is not answered, its replies dropped whole; commands are always answered; :mod:`.outbox`).
 * the clock (RH-TIM-1): ``control_tick_s`` — the control loop runs every this many vehicle
   seconds: timer expiries and plant events take effect on the next tick, sensors are sampled on
   ticks; ``timer_factor`` and ``timer_offset_s`` — every protocol duration the vehicle times
@@ -115,6 +118,9 @@ class EmulatorSettings:
     process_when_idle: bool = _s(False, "a line is processed (its state change and replies together) only once "
                                  "the replies before it have left the line, so its ACK goes out the instant "
                                  "it is processed and every duration starts there", "RH-ACK-6, RH-RD-15")
+    overrun: str = _s("queue", "requests asking for more replies than the line carries: queue (every reply waits "
+                      "its turn) or drop (a poll whose replies could not start within the ACK window is "
+                      "not answered; commands always are)", "RH-ACK-1, RH-ACK-2, RH-BS-4")
     # --- the clock
     control_tick_s: float = _s(0.0, "vehicle seconds between control-loop ticks (0: continuous)", "RH-TIM-1")
     timer_factor: float = _s(1.0, "every timed duration lasts duration × factor + offset", "RH-TIM-1")
@@ -195,7 +201,7 @@ class EmulatorSettings:
 DEFAULT_SETTINGS = EmulatorSettings()
 
 #: settings that take one of a few words: the readings table's (every reading of its rows) and the line's
-_CHOICES = {"pacing": ("baud", "burst"), **{r.setting: r.values for r in READINGS
+_CHOICES = {"pacing": ("baud", "burst"), "overrun": ("queue", "drop"), **{r.setting: r.values for r in READINGS
                                             if r.setting and isinstance(getattr(DEFAULT_SETTINGS, r.setting), str)}}
 #: the readings the model itself answers by (the rest the emulator or the judge takes care of)
 MODEL_READINGS = tuple(r.key for r in READINGS if r.in_model)

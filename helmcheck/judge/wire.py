@@ -61,6 +61,9 @@ wire-log format (``docs/contracts.md``):
                                             (:mod:`.linemodel`); clean: every broken line,
                                             lost byte or missing answer is the
                                             implementation's; none stated: noisy
+``line overrun: <what>``                    the backseat's requests asked for more replies
+                                            than the line carries (``certify backseat``): a
+                                            remark on RH-BS-4, never a verdict
 ``re-run …``                                the tester makes a spoilt observation again
                                             (evidence only: the judge's repetition rule,
                                             :mod:`.streaks`, reads the lines themselves)
@@ -118,7 +121,7 @@ class Note:
 
     kind: str  #: case | case-end | not-tested | inconclusive | link | budget | plant | fault | lockout |
     #: lockout-end | scenario | silence | silence-end | reject | reject-end | operator | aborted |
-    #: resumed | line-fault | relay | line-model
+    #: resumed | line-fault | relay | line-model | overrun
     case: str = ""
     clauses: tuple[str, ...] = ()
     text: str = ""
@@ -212,6 +215,8 @@ def parse_note(text: str) -> Optional[Note]:
         return Note(m.group(1), clauses=tuple(c for c in (m.group(2) or "").split(",") if c), text=m.group(3))
     if text.startswith("run resumed: "):
         return Note("resumed", text=text[13:])
+    if text.startswith("line overrun: "):
+        return Note("overrun", text=text[14:])
     return None
 
 

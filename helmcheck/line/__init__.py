@@ -3,6 +3,7 @@
 * :mod:`.transport` — opening a byte link (pty, serial device, TCP serial server, any pyserial
   URL) from a port spec; it re-exports the names of the modules below:
 * :mod:`.port_spec` — parsing a ``--port`` value, the baud rates;
+* :mod:`.linekind` — the line model a port gets (a pty or TCP on this host: clean; a UART: noisy);
 * :mod:`.link` — the :class:`~helmcheck.line.link.Link` interface: polling, writing, blocking
   helpers;
 * :mod:`.pty_link`, :mod:`.serial_link`, :mod:`.tcp_link` — the pseudo-terminal, the serial

@@ -25,7 +25,8 @@ Modules, one concern each:
   tables; :mod:`~helmcheck.reports.html_certificate` — the first page;
   :mod:`~helmcheck.reports.html_clauses` — clause matrix, findings, passing evidence;
   :mod:`~helmcheck.reports.html_run` — implementation, run, process, restore;
-  :mod:`~helmcheck.reports.html_coverage` — model coverage and the event table.
+  :mod:`~helmcheck.reports.html_coverage` — model coverage and the event table;
+  :mod:`~helmcheck.reports.html_scenarios` — a backseat run's scenarios, what each exercised.
 * :mod:`~helmcheck.reports.render` — :func:`render_all` (the command line is ``helmcheck report``).
 * :mod:`~helmcheck.reports.matrix` — several runs side by side (``helmcheck matrix``).
 

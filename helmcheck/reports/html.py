@@ -12,7 +12,9 @@ one finding per non-pass clause (worst first) with its replay steps and wire exc
 helmcheck started the implementation (``--exec``) a "Process under test" section says how it
 ended, with its last output; a vehicle run says how the vehicle was restored. Then the clause
 matrix by section of the reference profile (requirement text from ``helmcheck.clauses``), each
-section folded unless a clause in it failed or was inconclusive. The rest is folded behind a title
+section folded unless a clause in it failed or was inconclusive; a backseat run's scenarios
+(:mod:`~helmcheck.reports.html_scenarios`: what each exercised and for how long, open when one is
+not claimed in full). The rest is folded behind a title
 and a one-line gist (:func:`~helmcheck.reports.html_markup._fold`): the evidence of every passing
 clause; the implementation as declared and as seen on the wire (first ``$OSI``, RH-OUT-1 field
 18); the run (command, times, settings); the profile; model coverage, with what it means for the
@@ -30,8 +32,9 @@ This module assembles the page (:func:`render_html`); the parts are
 :mod:`~helmcheck.reports.html_style` (CSS, CSP), :mod:`~helmcheck.reports.html_markup` (escaping,
 tables, folds), :mod:`~helmcheck.reports.html_certificate` (the first page),
 :mod:`~helmcheck.reports.html_clauses` (matrix, findings, evidence),
-:mod:`~helmcheck.reports.html_run` (implementation, run, process, restore) and
-:mod:`~helmcheck.reports.html_coverage` (coverage, events).
+:mod:`~helmcheck.reports.html_run` (implementation, run, process, restore),
+:mod:`~helmcheck.reports.html_coverage` (coverage, events) and
+:mod:`~helmcheck.reports.html_scenarios` (a backseat run's scenarios).
 """
 
 from __future__ import annotations
@@ -44,6 +47,7 @@ from .html_coverage import _coverage, _coverage_gist, _event_summary, _events_ta
 from .html_markup import _e, _flatten, _fold, _kv_table, _section, md_inline
 from .html_run import _identity, _process, _restore, _run_facts, restore_headline
 from .identity import backseat_name
+from .html_scenarios import scenarios_section
 from .html_style import _CSP, _CSS
 from .rundir import Run
 from .scope import headline
@@ -70,6 +74,7 @@ def render_html(run: Run, comparison_html: str | None = None) -> str:
         *([_fold("restore", "Vehicle restored", _restore(run), _e(restore_headline(r["restore"])),
                  open_=not r["restore"].get("verified"))] if isinstance(r.get("restore"), Mapping) else []),
         _section("matrix", f"Clauses ({len(rows)})", _matrix(run)),
+        *([scenarios_section(run)] if scenarios_section(run) else []),
         _fold("evidence", "Evidence for passing clauses", _pass_evidence(run),
               _e(f"the wire evidence of {passed} passing clause(s)")),
         _fold("implementation", "Implementation", _identity(run), _implementation_gist(run),
@@ -108,7 +113,8 @@ def _contents(run: Run, findings: int, comparison: bool) -> str:
     links = [("findings", f"Findings ({findings})" if findings else "Findings"),
              *([("process", "Process")] if isinstance(r.get("process"), Mapping) else []),
              *([("restore", "Restore")] if isinstance(r.get("restore"), Mapping) else []),
-             ("matrix", "Clauses"), ("evidence", "Evidence"), ("implementation", "Implementation"),
+             ("matrix", "Clauses"), *([("scenarios", "Scenarios")] if scenarios_section(run) else []),
+             ("evidence", "Evidence"), ("implementation", "Implementation"),
              ("run", "Run"), ("profile", "Profile"), ("coverage", "Coverage"), ("timeline", "Timeline"),
              *([("comparison", "Comparison")] if comparison else [])]
     return ('<nav class="contents" id="contents">'

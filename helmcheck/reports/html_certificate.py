@@ -25,7 +25,12 @@ from .view import VERDICT_LABEL, counts
 def _banner(run: Run) -> str:
     r = run.results
     out = []
-    if r["partial"]:
+    if r["partial"] and scope_of(r).unexercised:
+        out.append('<div class="partial" id="partial">PARTIAL RUN — the run finished, but not every scenario '
+                   'was exercised: a moment it exists for did not reach the backseat in time, and its '
+                   'observations there are not claimed (<a href="#scenarios">Scenarios</a>); this is not a '
+                   "complete certificate.</div>")
+    elif r["partial"]:
         out.append('<div class="partial" id="partial">PARTIAL RUN — the run was interrupted before it '
                    "finished. Clauses it did not reach are missing or NOT-TESTED; this is not a "
                    "complete certificate.</div>")

@@ -71,7 +71,10 @@ def render_markdown(run: Run, comparison_md: str | None = None) -> str:
     impl = r["implementation"]
     scope = scope_of(r)
     out = [f"## helmcheck {md_escape(r['role'])} report: **{md_escape(headline(r))}**", ""]
-    if r["partial"]:
+    if r["partial"] and scope.unexercised:
+        out += ["> **PARTIAL RUN**: the run finished, but not every scenario was exercised (a moment it "
+                "exists for did not reach the backseat in time); this is not a complete certificate.", ""]
+    elif r["partial"]:
         out += ["> **PARTIAL RUN**: the run was interrupted before it finished; "
                 "this is not a complete certificate.", ""]
     if not run.wire["present"]:

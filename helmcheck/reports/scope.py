@@ -74,6 +74,9 @@ class Scope:
     judged: tuple[str, ...]
     gaps: tuple[Gap, ...]
     interrupted: bool
+    #: the run finished, but a scenario's moment did not reach the backseat (its observations not
+    #: claimed, ``coverage.scenarios``): partial without having been cut short
+    unexercised: bool = False
 
     @property
     def statement(self) -> str:
@@ -82,7 +85,8 @@ class Scope:
         n, k = len(self.claimed), len(self.judged)
         if self.certificate:
             return f"certificate: all {n} claimed clauses judged"
-        stopped = "the run was interrupted; " if self.interrupted else ""
+        stopped = ("not every scenario was exercised; " if self.unexercised
+                   else "the run was interrupted; " if self.interrupted else "")
         return f"partial: {stopped}{k} of {n} claimed clauses judged; not a certificate"
 
     def why(self, limit: int = _GAPS_SHOWN) -> list[str]:
@@ -128,7 +132,9 @@ def scope_of(results: Mapping[str, Any], verdicts: Mapping[str, str] | None = No
     gaps = tuple(Gap(tuple(ids), v, r) for (v, r), ids in groups.items())
     interrupted = bool(results.get("partial"))
     certificate = not interrupted and not gaps and bool(claimed)
-    return Scope(certificate, tuple(claimed), judged, gaps, interrupted)
+    run = results.get("run")
+    unexercised = interrupted and isinstance(run, Mapping) and run.get("status") == "complete"
+    return Scope(certificate, tuple(claimed), judged, gaps, interrupted, unexercised)
 
 
 def _plain_reason(reason: str) -> str:
