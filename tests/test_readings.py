@@ -46,7 +46,8 @@ def test_every_row_is_a_real_question_with_every_reading_takeable(r):
     assert r.words and r.question.endswith("?")
     assert r.how in ("model", "judge", "freedom", "backseat")
     if r.setting is None:  # nothing differs on the wire that a judge rules on (its text says why)
-        assert r.how == "judge" and ("not judged" in r.judge or "sends only" in r.judge), r.judge
+        assert (r.how == "judge" and ("not judged" in r.judge or "sends only" in r.judge)
+                or r.how == "backseat" and "judged" in r.judge), r.judge
         return
     fields = {f.name for f in dataclasses.fields(EmulatorSettings)}
     assert r.setting in fields, f"the emulator has no setting {r.setting!r} for reading {r.key}"
@@ -173,6 +174,10 @@ def _park(d: Drive) -> list[str]:
     raise AssertionError("the test mission never parked")
 
 
+def _flag(d: Drive) -> list[str]:
+    return [answer(d.send(f"OMLOAD,conformance.mis,{flag}")) for flag in (0, 1, 3, 4)]
+
+
 #: key -> (how the situation is reached, the answers under each reading, the clauses judged,
 #: an answer no reading allows: (the text to replace, its replacement, the clause it fails))
 SITUATIONS = {
@@ -188,6 +193,9 @@ SITUATIONS = {
                  ("$OCTD,43.50,18.50", "$OCTD,42.50,17.50", "RH-POS-2")),  # shown once, then not: held to it
     "park_waypoint": (_park, {"parked": ["1"], "next": ["2"]}, ("RH-OUT-4",),
                       (",P,1,", ",P,3,", "RH-OUT-4", 0)),
+    "omload_flag": (_flag, {"any": ["$ACK,2,0,0"] * 4, "0-3": ["$ACK,2,0,0"] * 3 + ["$ACK,2,1,29"],
+                            "0": ["$ACK,2,0,0"] + ["$ACK,2,1,29"] * 3}, ("RH-MSN-1",),
+                    ("$ACK,2,0,0", "$ACK,2,1,28", "RH-MSN-1", 2)),
     "stop_unloads": (_stop, {"kept": ["$ACK,3,0,0", "$ACK,3,0,0"], "unloaded": ["$ACK,3,0,0", "$ACK,3,1,17"]},
                      ("RH-MSN-2",), ("$ACK,3,0,0", "$ACK,3,1,30", "RH-MSN-2", 2)),
 }

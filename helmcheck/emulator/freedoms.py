@@ -157,6 +157,7 @@ class EmulatorSettings:
     stop_unloads: str = _s(READING_DEFAULTS["stop_unloads"], _reading_doc("stop_unloads"), "RH-RD-6")
     opos_ctd: str = _s(READING_DEFAULTS["opos_ctd"], _reading_doc("opos_ctd"), "RH-POS-2")
     park_waypoint: str = _s(READING_DEFAULTS["park_waypoint"], _reading_doc("park_waypoint"), "RH-OUT-1")
+    omload_flag: str = _s(READING_DEFAULTS["omload_flag"], _reading_doc("omload_flag"), "RH-MSN-1")
 
     @property
     def is_default(self) -> bool:

@@ -27,7 +27,7 @@ from .transitions import STAY, Row
 if TYPE_CHECKING:  # pragma: no cover
     from .vehicle import VehicleModel
 
-__all__ = ["CHECKS", "APPLY", "EXPIRE", "ack", "reading_field_error", "reading_repair"]
+__all__ = ["CHECKS", "APPLY", "EXPIRE", "ack", "reading_field_error", "reading_repair", "reading_flag_error"]
 
 _ACKS: dict[tuple[int, int, int], s.ACK] = {}
 
@@ -103,6 +103,12 @@ def reading_repair(m: VehicleModel, err) -> Optional[s.Command]:
             return None
         return dataclasses.replace(part, **{name: value}) if value.is_finite() and value >= 0 else None
     return None
+
+
+def reading_flag_error(m: VehicleModel, c: s.OMLOAD) -> Optional[int]:
+    """An ``$OMLOAD`` flag outside the flags the vehicle takes (``omload_flag``: any, 0-3 or 0): 29."""
+    allowed = {"0-3": (0, 1, 2, 3), "0": (0,)}.get(m.readings["omload_flag"])
+    return 29 if allowed is not None and int(c.flag) not in allowed else None
 
 
 def reading_field_error(m: VehicleModel, c: s.Command, err: int) -> Optional[int]:

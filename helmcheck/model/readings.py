@@ -161,8 +161,33 @@ READINGS: tuple[Reading, ...] = (
         "Which `$OMLOAD` flags does a vehicle accept?",
         "RH-MSN-1: `$OMLOAD,<name>,<flag>` (ACK 2, err 29; 1 file not found): accepted only in `S` "
         "(no range is given for the flag)",
-        (Choice("any", "any flag"), Choice("0-3", "the paper's flags 0–3; any other refused (29)")),
-        "judge", "the flag is not judged, and the tester sends only 0 and 1", vehicle3="0-3"),
+        (Choice("any", "any flag"), Choice("0-3", "the paper's flags 0–3; any other refused (29)"),
+         Choice("0", "only 0 (public client code always sends it); any other refused (29)")),
+        "model", "the model answers an `$OMLOAD` under each", in_model=True, setting="omload_flag",
+        books="RH-MSN-1", vehicle3="0-3", certify=("RH-MSN-1",)),
+    Reading(
+        "overrun", "RH-ACK-2",
+        "When a backseat's requests ask for more replies than the line carries, does the vehicle queue every "
+        "reply (and lag), or leave requests it cannot answer in time unanswered?",
+        "RH-ACK-1: Every well-framed command of a known type gets exactly one `$ACK`; RH-ACK-2: … within the "
+        "ACK window …, plus serial transmit time at the line's baud; RH-BS-4 bounds only what the backseat sends",
+        (Choice("queue", "every reply waits its turn (RH-ACK-2's transmit time taken to include what is queued "
+                         "ahead)"),
+         Choice("drop", "a poll whose replies could not start within the ACK window goes unanswered, data and "
+                        "`$ACK,8` together; commands are always answered")),
+        "backseat", "the backseat judge judges each report from when it arrived; a scenario's moment that "
+                    "arrived too late is not claimed (`helmcheck certify backseat` plays drop; `--overrun queue`)",
+        setting="overrun"),
+    Reading(
+        "bs3_list", "RH-BS-3",
+        "Is RH-BS-3's list of commands exhaustive, or examples of the preconditions a backseat can know "
+        "(`$OLOGD` after the mission's end, `$OMSTART` while one runs)?",
+        "RH-BS-3: It respects preconditions it can know: `$OLOGL` and `$ORWSET` only before starting a mission; "
+        "`$OMS`, `$OJW`, `$OPK`, `$OMW` only while the vehicle reports a running mission",
+        (Choice("exhaustive", "only the six commands named are judged"),
+         Choice("examples", "other commands' preconditions bind the backseat too")),
+        "backseat", "only the six named commands are judged (never a FAIL for one outside the list); \"before "
+                    "starting a mission\" read as no mission running (RH-RD-1)"),
     Reading(
         "idle_distance", "RH-RD-5",
         "`$OSI` field 7 with no navigation target (`S`, `M` from `S`)?",
@@ -181,6 +206,7 @@ _MODEL_APPLIES: dict[str, tuple[str, ...]] = {
     "ascent_refusal_order": ("OMS", "OJW", "OPK", "OMW"),
     "omw_pitch_speed": ("OMW",),
     "stop_unloads": ("OMSTART",),
+    "omload_flag": ("OMLOAD",),
 }
 
 

@@ -78,7 +78,7 @@ from .missions import BadMission, InMemoryCatalog, Mission, MissingMission, Miss
 from .plant import (AtSurface, OnStation, PlantEvent, PlantSnapshot, QueueWaypointReached, SafetyViolation,
                     Submerged, WaypointReached)
 from .records import LogRow, OposRecord
-from .handlers import APPLY as _APPLY, CHECKS as _CHECKS, EXPIRE as _EXPIRE, ack as _ack, reading_field_error, reading_repair
+from .handlers import APPLY as _APPLY, CHECKS as _CHECKS, EXPIRE as _EXPIRE, ack as _ack, reading_field_error, reading_flag_error, reading_repair
 from .settings import SettingsStore
 from .status import VehicleStatus
 from .timers import Timers
@@ -287,6 +287,8 @@ class VehicleModel(VehicleStatus, StateEffects):
         err = field_error(item, self.profile)  # type: ignore[arg-type]
         if err is not None:
             err = reading_field_error(self, item, err)
+        elif cls is s.OMLOAD and self.readings["omload_flag"] != "any":
+            err = reading_flag_error(self, item)
         if err is None:
             err = row.error
         if err is None:
