@@ -112,8 +112,8 @@ class VehicleStatus:
         waypoint parked on, or the one after it (the readings table's ``park_waypoint``)."""
         if self.mission is None:
             return 0
-        if self.mode == "P" and self.readings["park_waypoint"] == "next":
-            return self.mission_wp + 1
+        if self.readings["park_waypoint"] == "next" and (self.mode == "P" or self.mission_mode == "P"):
+            return self.mission_wp + 1  # the index moved on at the arrival, also while the park is frozen
         return self.mission_wp
 
     def state(self, now: Optional[float] = None) -> tuple[str, int, str, int, bool]:
