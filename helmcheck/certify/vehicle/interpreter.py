@@ -129,6 +129,10 @@ def raw_line(kind: str, body: str, profile: Profile) -> bytes:
         return b"$" + body.encode() + b"\r\n"
     if kind == "shortck":
         return b"$" + body.encode() + b"*" + checksum_hex(body)[:1].encode() + b"\r\n"
+    if kind == "longck":  # the right two digits and one more
+        return b"$" + body.encode() + b"*" + checksum_hex(body).encode() + b"0\r\n"
+    if kind == "hexck":
+        return b"$" + body.encode() + b"*GZ\r\n"
     if kind == "twostar":
         b2 = body + "*"
         return b"$" + b2.encode() + b"*" + checksum_hex(b2).encode() + b"\r\n"

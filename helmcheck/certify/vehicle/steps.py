@@ -39,6 +39,8 @@ RAW_KINDS = {
     "lowerck": "RH-FRM-3: lower-case checksum hex",
     "nock": "RH-FRM-4: no *hh",
     "shortck": "RH-FRM-4: one hex digit",
+    "longck": "RH-FRM-4: three hex digits",
+    "hexck": "RH-FRM-4: two characters that are not hex digits",
     "twostar": "RH-FRM-4, RH-RD-16: two '*'",
     "unknown": "RH-FRM-5: an unknown ID (sent as is)",
     "lowerid": "RH-FRM-5, RH-RD-16: a lower-case ID",
