@@ -90,7 +90,11 @@ def _probe_cell(r: Rule) -> str:
     out = []
     for p in r.probe:
         m = STEP_REF.match(p)
-        out.append(f"{m.group(1)} step {m.group(2)}" if m else _cell(p))
+        if m:
+            hint = f" (`{m.group(3).replace('|', '/')}`)" if m.group(3) and "`" not in m.group(3) else ""
+            out.append(f"{m.group(1)} step {m.group(2)}{hint}")
+        else:
+            out.append(_cell(p))
     return "<br>".join(dict.fromkeys(out))
 
 
@@ -128,7 +132,7 @@ def render_markdown() -> str:
             lines += ["", f"## {sec} {title}".rstrip(), "", "| clause | the profile's words | FAILed by | booked on |",
                       "|---|---|---|---|"]
         note = "".join(f"<br>*{_cell(x)}*" for x in (r.note, r.decision and "decision: " + r.decision) if x)
-        lines.append(f"| {r.clause} | {_cell(r.words)}{note} | {_probe_cell(r)} | {r.books} |")
+        lines.append(f"| {r.clause} | {_cell(r.words)}{note} | {_probe_cell(r)} | {r.books if r.probed else '—'} |")
     lines += ["", "## Decisions: evidence that fits several clauses", "",
               "A fault whose evidence fits several clauses is booked on the clause whose rule it broke; the "
               "others are named as related.", "", "| rule | booked on | why |", "|---|---|---|"]
