@@ -11,7 +11,8 @@ of each is classified (:func:`classify`):
   and the run FAILs the clause the traceability table books that reading's rule on
   (:func:`helmcheck.rules.reading_books`);
 * ``elsewhere``: FAIL, on other clauses only;
-* ``pass``: a PASS (exit 0); ``other``: anything else (INCONCLUSIVE, a tester error).
+* ``pass``: no FAIL (but a known false verdict, :data:`KNOWN_FALSE`) and nothing INCONCLUSIVE;
+  ``other``: anything else (INCONCLUSIVE, a tester error).
 
 Used by ``tests/test_vehicle3_mutants.py`` (the full sweep behind ``HELMCHECK_MATRIX=1``) and by
 hand: ``python -m tests.vehicle3_sweep [--jobs 2] [--time-scale 20] [--precision nominal] [NAME …]``
@@ -90,9 +91,20 @@ def vehicle3(workdir: Path, k: float, mutant: str = "", baud: int = 115200, late
                 proc.wait()
 
 
+def outcome(workdir: Path, code: int, seconds: float) -> dict:
+    """What a run in ``workdir`` ended with: {code, verdicts, reasons, seconds}."""
+    try:
+        results = json.loads((workdir / "run" / "results.json").read_text())
+    except (OSError, ValueError):
+        results = {"clauses": []}
+    verdicts = {c["id"]: c["verdict"] for c in results.get("clauses", [])}
+    return {"code": code, "verdicts": verdicts, "seconds": seconds,
+            "reasons": {c["id"]: c.get("reason", "") for c in results.get("clauses", []) if c["verdict"] != "pass"}}
+
+
 def certify(workdir: Path, k: float, mutant: str = "", precision: str = "", extra: tuple = (),
             python: str = sys.executable, baud: int = 115200) -> dict:
-    """Certify one vehicle3 (a mutant, or the correct one): {code, verdicts, results, seconds}."""
+    """Certify one vehicle3 (a mutant, or the correct one): {code, verdicts, reasons, seconds}."""
     prof = workdir / "ics.toml"
     workdir.mkdir(parents=True, exist_ok=True)
     prof.write_text(ICS + f"baud = {baud}\ntime_scale = {k:g}\n")
@@ -106,13 +118,8 @@ def certify(workdir: Path, k: float, mutant: str = "", precision: str = "", extr
             cmd += ["--precision", precision]
         proc = subprocess.run(cmd, capture_output=True, text=True, timeout=3600, cwd=str(ROOT))
     (workdir / "certify.out").write_text(proc.stdout + proc.stderr)
-    try:
-        results = json.loads((out / "results.json").read_text())
-    except (OSError, ValueError):
-        results = {"clauses": []}
-    verdicts = {c["id"]: c["verdict"] for c in results.get("clauses", [])}
-    return {"code": proc.returncode, "verdicts": verdicts, "seconds": round(time.monotonic() - t0, 1),
-            "reasons": {c["id"]: c.get("reason", "") for c in results.get("clauses", []) if c["verdict"] != "pass"}}
+    (workdir / "exit").write_text(f"{proc.returncode} {time.monotonic() - t0:.1f}\n")
+    return outcome(workdir, proc.returncode, round(time.monotonic() - t0, 1))
 
 
 def refined(clause: str) -> str:
@@ -126,16 +133,29 @@ def refined(clause: str) -> str:
     return books.get(clause, clause)
 
 
+#: A false verdict known on the code these measurements began from, being fixed apart (issue 42's
+#: brief): V-72's RH-MSN-1 FAIL for err 31 where 30 is expected, an SRP name outside the mission
+#: directory (RH-RD-6 lets a vehicle decide it at the look-up). Left out of the classification.
+KNOWN_FALSE = {"RH-MSN-1": re.compile(r"^1 violation\(s\).*first: V-72: \$OMSTART.*got \$ACK,3,1,31")}
+
+
+def failed_clauses(outcome: dict) -> set[str]:
+    """The clauses the run FAILed, less a known false verdict (:data:`KNOWN_FALSE`)."""
+    return {c for c, v in outcome["verdicts"].items() if v == "fail"
+            and not (c in KNOWN_FALSE and KNOWN_FALSE[c].search(outcome["reasons"].get(c, "")))}
+
+
 def classify(clause: str, outcome: dict) -> str:
     """``own``, ``refined``, ``elsewhere``, ``pass`` or ``other`` (module docstring)."""
-    failed = {c for c, v in outcome["verdicts"].items() if v == "fail"}
+    failed = failed_clauses(outcome)
     if clause in failed:
         return "own"
     if clause.startswith("RH-RD-") and refined(clause) in failed:
         return "refined"
     if failed:
         return "elsewhere"
-    return "pass" if outcome["code"] == 0 else "other"
+    return "pass" if outcome["code"] == 0 or not (set(outcome["verdicts"].values()) - {"pass", "fail", "not-tested"}) \
+        else "other"
 
 
 def main(argv=None) -> int:
@@ -147,14 +167,20 @@ def main(argv=None) -> int:
     ap.add_argument("--work", type=Path, default=Path("/tmp/vehicle3-sweep"))
     ap.add_argument("--out", type=Path, default=None)
     ap.add_argument("--python", default=sys.executable, help="the Python whose helmcheck certifies")
+    ap.add_argument("--reuse", action="store_true", help="a mutant whose run in --work ended is read, not run again")
     args = ap.parse_args(argv)
     table = mutants()
     names = args.names or list(table)
 
     def one(name):
-        got = certify(args.work / name, args.time_scale, name, args.precision, python=args.python)
+        done = args.work / name / "exit"
+        if args.reuse and done.is_file():
+            code, secs = done.read_text().split()
+            got = outcome(args.work / name, int(code), float(secs))
+        else:
+            got = certify(args.work / name, args.time_scale, name, args.precision, python=args.python)
         got["clause"], got["class"] = table[name], classify(table[name], got)
-        failed = sorted(c for c, v in got["verdicts"].items() if v == "fail")
+        failed = sorted(failed_clauses(got))
         print(f"{name:28} {table[name]:10} {got['class']:9} exit {got['code']} {got['seconds']:6.0f}s "
               f"fail: {' '.join(failed)}", flush=True)
         return name, got

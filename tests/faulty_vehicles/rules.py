@@ -144,6 +144,22 @@ class ThreeDigitChecksumRead(EmulatorCore):
         return super()._line(raw, now, v)
 
 
+class AnswersTwiceAfterSilence(EmulatorCore):
+    """RH-ACK-1: after 4 s with nothing received, the first line is processed twice (an input
+    stage that wakes on a quiet line and replays what woke it): two ``$ACK`` for one command.
+    (One that *loses* that line is not told apart: a lone lost answer answered on its re-run is the
+    line's, as the observer's line model takes it.)"""
+
+    last_in = None
+
+    def _line(self, raw, now, v):
+        quiet = self.last_in is not None and now - self.last_in > 4.0
+        self.last_in = now
+        if quiet:
+            super()._line(raw, now, v)
+        return super()._line(raw, now, v)
+
+
 MUTANTS = (
     Mutant("oms-accepted-after-omstop", "RH-SRV-1", ("RH-SRV-1",), model=OmsAcceptedAfterStop,
            time_scales=ONE_SCALE),
@@ -158,5 +174,7 @@ MUTANTS = (
     Mutant("ojw-fraction-truncated", "RH-JW-1", ("RH-JW-1",), core=OjwFractionTruncated, time_scales=ONE_SCALE),
     Mutant("mission-type-ignored", "RH-MSN-2", ("RH-MSN-2",), model=MissionTypeIgnored, time_scales=ONE_SCALE),
     Mutant("three-digit-checksum-read", "RH-FRM-4", ("RH-FRM-4",), core=ThreeDigitChecksumRead,
+           time_scales=ONE_SCALE),
+    Mutant("answers-twice-after-silence", "RH-ACK-1", ("RH-ACK-1",), core=AnswersTwiceAfterSilence,
            time_scales=ONE_SCALE),
 )

@@ -27,7 +27,7 @@ from .flow import CaseStop
 from .safety import BenchSafetyRefused
 from .session import Session, frame
 from .steps import (Burst, Case, ClearWords, Fault, MissionEnd, Octd, Poll, Raw, Send, SetRoundTrip, Settle, Start,
-                    Until, Wait, WithSetting)
+                    Until, Wait, WithSetting, Quiet)
 
 __all__ = ["run_case", "run_step", "raw_line", "context", "fill"]
 
@@ -266,6 +266,8 @@ def run_step(session: Session, st, ctx: dict) -> None:
         _clear_words(session, st, ctx)
     elif isinstance(st, SetRoundTrip):
         _set_round_trip(session, st)
+    elif isinstance(st, Quiet):
+        session.quiet(st.wall_s, st.reopen)
     elif isinstance(st, Octd):
         if "T" in session.profile.osd_letters:
             session.exchange(frame("OSD,T"))

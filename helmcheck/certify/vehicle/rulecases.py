@@ -13,6 +13,9 @@ breaking exactly that rule answers differently from the model:
   backslash, a lower-case drive letter: RH-MSN-1), a keyword that ends every kind of remote control
   (RH-RD-4), the SRP flag of a type-1 start and a missing SRP file (RH-RD-6), a malformed checksum
   of three digits or of non-hex letters (RH-FRM-4);
+* a line that goes quiet and comes back — the tester silent for a while, its end of the link
+  closed and opened again where the port's name allows (a client reconnecting) — and the first
+  command after it (RH-ACK-1);
 
 and :data:`RULE_CASES` is appended to :data:`.catalogue.CASES`. Case IDs start at V-80 so that
 cases added to the catalogue meanwhile keep theirs. The steps are the same vocabulary
@@ -21,7 +24,7 @@ cases added to the catalogue meanwhile keep theirs. The steps are the same vocab
 
 from __future__ import annotations
 
-from .steps import Case, Fault, Poll, Raw, Send, Settle, Start, Until, Wait
+from .steps import Case, Fault, Poll, Quiet, Raw, Send, Settle, Start, Until, Wait
 
 __all__ = ["RULE_CASES"]
 
@@ -102,4 +105,8 @@ RULE_CASES: tuple[Case, ...] = (
        "a line whose checksum has three hex digits, or two characters that are not hex, is discarded (no ACK, "
        "the mode stays); `$osd` is an unknown ID (RH-RD-16): no answer", "N",
        Raw("longck", "OMSTOP,0"), Raw("hexck", "OMSTOP,0"), Poll(mode="N|P"), Raw("lowerid", "OSD,S"), Poll()),
+    _c("V-90", "RH-ACK-1 RH-ACK-2", "The first command after a quiet line",
+       "nothing is sent for 6 s, then the link is closed and opened again where the port's name allows it (a "
+       "client reconnecting); the first command after it, and the next, each get their $ACK in the window",
+       "S", Quiet(6.0, reopen=True), Send("OSD,S"), Send("OPOS,{lat},{lon},0,,", expect="$ACK,6,0,0"), Poll(mode="S")),
 )

@@ -30,7 +30,7 @@ from dataclasses import dataclass
 from typing import Optional
 
 __all__ = ["Send", "Raw", "Poll", "Wait", "Settle", "Until", "Fault", "Start", "MissionEnd", "WithSetting",
-           "Burst", "SetRoundTrip", "Octd", "ClearWords", "Case", "RAW_KINDS"]
+           "Burst", "SetRoundTrip", "Octd", "ClearWords", "Quiet", "Case", "RAW_KINDS"]
 
 #: Mutations of a valid sentence (:func:`.interpreter.raw_line`), each tied to its clause.
 RAW_KINDS = {
@@ -177,6 +177,18 @@ class ClearWords:
     must be refused — the keyword edges of :func:`.edges.edge_list`."""
 
     queue: str
+
+
+@dataclass(frozen=True)
+class Quiet:
+    """The line goes quiet: nothing is sent for ``wall_s`` wall seconds (no poll either). With
+    ``reopen`` the tester then closes its end of the link and opens it again under the same name,
+    where a name can be opened again (a device path, ``socket://``: a client reconnecting; not a
+    pseudo-terminal the run made, nor a vehicle it started). The next step is the first command
+    after it (RH-ACK-1: every command gets its ``$ACK``, the first after a silence too)."""
+
+    wall_s: float = 5.0
+    reopen: bool = False
 
 
 @dataclass(frozen=True)
