@@ -92,6 +92,32 @@ def test_a_field_count_or_a_range_only_a_reading_sets_stays_RH_ACK_3(tmp_path, c
     assert verdict(v, "RH-ACK-3") == "fail", v["RH-ACK-3"]
 
 
+@pytest.mark.parametrize("labels,mission,cmd,ack_type,clause", [
+    ("", False, "OLOGL,1,2,3,4,5,6,7,8,9,10,11,12,13", 5, "RH-LOG-1"),   # 13 labels: RH-LOG-1's 1–12
+    ("", False, "OLOGL,a,,b", 5, "RH-LOG-1"),                              # an empty label (RH-RD-9)
+    ("OLOGL,1,2,3,4,5,6,7,8,9,10,11,12", True, "OLOGD,1,2,3,4,5,6,7,8,9,10,11,12,13", 4, "RH-LOG-2"),
+])
+def test_a_count_a_clause_states_accepted_is_booked_on_that_clause(tmp_path, labels, mission, cmd, ack_type,
+                                                                   clause):
+    """A count the grammar refuses where a clause states it (``$OLOGL`` 1–12 labels, ``$OLOGD`` 12
+    values) is that clause's rule broken, not only RH-ACK-3's "wrong number of fields" (the
+    traceability table); a conforming refusal passes it."""
+    rec = poll(0.0, mode="S")
+    if labels:
+        rec += send(0.1, labels, "ACK,5,0,0")
+    rec += (send(0.2, "OMSTART,0,0,0,0,conformance.mis,", "ACK,3,0,0") + poll(0.3, mode="N", dist=150.0, speed=2.0)
+            if mission else [])
+    bad = rec + send(1.0, cmd, f"ACK,{ack_type},0,0") + poll(1.5, mode="N" if mission else "S", dist=150.0)
+    v = judge(tmp_path, bad)
+    assert verdict(v, clause) == "fail", v[clause]
+    assert verdict(v, "RH-ACK-3") != "fail", v["RH-ACK-3"]
+    ok = rec + send(1.0, cmd, f"ACK,{ack_type},1,{24 if ack_type == 5 else 25}") + poll(1.5, mode="N" if mission else "S",
+                                                                                     dist=150.0)
+    (tmp_path / "ok").mkdir()
+    v = judge(tmp_path / "ok", ok)
+    assert verdict(v, clause) != "fail", v[clause]
+
+
 @pytest.mark.parametrize("cmd,answer,clause", [
     ("OMSTART,0,0,0,0,sub/../../conformance.mis,", "ACK,3,1,1", "RH-MSN-1"),   # followed out: not found
     ("OMSTART,0,0,0,0,../conformance.mis,", "ACK,3,0,0", "RH-MSN-1"),        # accepted
