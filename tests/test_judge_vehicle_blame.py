@@ -111,6 +111,7 @@ def test_a_count_a_clause_states_accepted_is_booked_on_that_clause(tmp_path, lab
     v = judge(tmp_path, bad)
     assert verdict(v, clause) == "fail", v[clause]
     assert verdict(v, "RH-ACK-3") != "fail", v["RH-ACK-3"]
+    assert "(related: RH-ACK-3)" in v[clause]["reason"], v[clause]["reason"]  # named, not booked
     ok = rec + send(1.0, cmd, f"ACK,{ack_type},1,{24 if ack_type == 5 else 25}") + poll(1.5, mode="N" if mission else "S",
                                                                                      dist=150.0)
     (tmp_path / "ok").mkdir()
