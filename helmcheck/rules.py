@@ -122,6 +122,15 @@ def render_markdown() -> str:
         "a rule-bearing word or number no row quotes, when a quote is not in its clause, or when a step "
         "it names is no longer in the case catalogue.",
         "",
+        "The split was made twice and the two reconciled: once clause by clause from the words alone, once "
+        "from the single faults of the independent vehicles and of the suite's faulty vehicles "
+        "(`tests/third_party_faults.py`, `tests/faulty_vehicles/`), asking which rule each breaks. Every "
+        "fault's rule is a row; the second pass added no rule the first lacked, and both found the same "
+        "rules no case could fail until the cases V-80..V-90 were written for them (a `..` that resolves "
+        "inside the mission directory, a command with bad fields in the lockout, \"only while a mission "
+        "is running\" after `$OMSTOP` and in an `M` entered from `S`, the order of the checks, a refused "
+        "`$OMS` in the timeout, the first command after a quiet line, …).",
+        "",
     ]
     section = None
     for r in rows:
