@@ -144,6 +144,19 @@ class ThreeDigitChecksumRead(EmulatorCore):
         return super()._line(raw, now, v)
 
 
+class LabelsFromRefusedOlogl(EmulatorCore):
+    """RH-LOG-2: an ``$OLOGL`` refused for an empty label still sets the labels (the count an
+    ``$OLOGD`` is held to): the labels must be the last *accepted* ``$OLOGL``'s."""
+
+    def _line(self, raw, now, v):
+        out = super()._line(raw, now, v)
+        if raw.startswith(b"$OLOGL,") and b"*" in raw:
+            f = body(raw).decode("latin-1").split(",")[1:]
+            if "" in f and 1 <= len(f) <= 12:
+                self.model.log_labels = tuple(f)
+        return out
+
+
 class AnswersTwiceAfterSilence(EmulatorCore):
     """RH-ACK-1: after 4 s with nothing received, the first line is processed twice (an input
     stage that wakes on a quiet line and replays what woke it): two ``$ACK`` for one command.
@@ -175,6 +188,7 @@ MUTANTS = (
     Mutant("mission-type-ignored", "RH-MSN-2", ("RH-MSN-2",), model=MissionTypeIgnored, time_scales=ONE_SCALE),
     Mutant("three-digit-checksum-read", "RH-FRM-4", ("RH-FRM-4",), core=ThreeDigitChecksumRead,
            time_scales=ONE_SCALE),
+    Mutant("labels-from-refused-ologl", "RH-LOG-2", ("RH-LOG-2",), core=LabelsFromRefusedOlogl, time_scales=ONE_SCALE),
     Mutant("answers-twice-after-silence", "RH-ACK-1", ("RH-ACK-1",), core=AnswersTwiceAfterSilence,
            time_scales=ONE_SCALE),
 )

@@ -92,10 +92,12 @@ RULE_CASES: tuple[Case, ...] = (
        Send(OMS_RESTART), Poll(mode="A"), Wait("{gap}"), Send("OMS,360,2,20,{speed},{to_restart}",
                                                              expect="$ACK,9,1,20"),
        Poll(mode="A"), Settle("remote"), Poll(mode="N|P")),
-    _c("V-87", "RH-JW-1 RH-PK-1 RH-LOG-1", "Integers are integers, labels are not empty",
-       "an $OLOGL with an empty label is refused (24, RH-RD-9); an $OJW to waypoint 1.5 (19) and an $OPK of "
-       "1.5 minutes (22) are refused", "S",
-       Send("OLOGL,a,,b", expect="$ACK,5,1,24"), Start(), Send("OJW,1.5", expect="$ACK,7,1,19"),
+    _c("V-87", "RH-JW-1 RH-PK-1 RH-LOG-1 RH-LOG-2", "Integers are integers, labels are not empty",
+       "an $OLOGL of one label is accepted, one with an empty label refused (24, RH-RD-9); in the mission two "
+       "values are refused (25): the labels are the accepted $OLOGL's, not the refused one's; an $OJW to "
+       "waypoint 1.5 (19) and an $OPK of 1.5 minutes (22) are refused", "S",
+       Send("OLOGL,a", expect="$ACK,5,0,0"), Send("OLOGL,a,,b", expect="$ACK,5,1,24"), Start(),
+       Send("OLOGD,1,2", expect="$ACK,4,1,25"), Send("OJW,1.5", expect="$ACK,7,1,19"),
        Send("OPK,{lat},{lon},1.5,{speed}", expect="$ACK,11,1,22"), Poll(mode="N|P")),
     _c("V-88", "RH-MSN-2", "Mission type 1 runs as an SRP",
        "the rh5 $OMSTART with mission type 1 starts the mission with $OSI field 17 True (RH-RD-6)", "S",
