@@ -168,9 +168,13 @@ def main(argv=None) -> int:
     ap.add_argument("--out", type=Path, default=None)
     ap.add_argument("--python", default=sys.executable, help="the Python whose helmcheck certifies")
     ap.add_argument("--reuse", action="store_true", help="a mutant whose run in --work ended is read, not run again")
+    ap.add_argument("--correct", action="store_true", help="certify the correct vehicle too (row 'correct')")
     args = ap.parse_args(argv)
     table = mutants()
     names = args.names or list(table)
+    if args.correct:
+        table["correct"] = "-"
+        names = ["correct", *names]
 
     def one(name):
         done = args.work / name / "exit"
@@ -178,7 +182,8 @@ def main(argv=None) -> int:
             code, secs = done.read_text().split()
             got = outcome(args.work / name, int(code), float(secs))
         else:
-            got = certify(args.work / name, args.time_scale, name, args.precision, python=args.python)
+            got = certify(args.work / name, args.time_scale, "" if name == "correct" else name, args.precision,
+                          python=args.python)
         got["clause"], got["class"] = table[name], classify(table[name], got)
         failed = sorted(failed_clauses(got))
         print(f"{name:28} {table[name]:10} {got['class']:9} exit {got['code']} {got['seconds']:6.0f}s "

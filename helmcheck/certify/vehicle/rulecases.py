@@ -52,9 +52,13 @@ RULE_CASES: tuple[Case, ...] = (
        "$OMP from S (M); $OMS, $OJW, $OPK, $OMW are refused with their own error, $OLOGL and an $ORWSET read "
        "are accepted (RH-RD-1: \"accepted only in S\" means no mission running); $OMSTART is accepted there "
        "and ends the primitive control", "S",
-       Send(OMP_LONG, expect="$ACK,10,0,0"), Send(OMS, expect="$ACK,9,1,20"), Send("OJW,0", expect="$ACK,7,1,19"),
-       Send("OPK,{lat},{lon},1,{speed}", expect="$ACK,11,1,22"), Send(FAR_OMW, expect="$ACK,16,1,36"),
-       Send("OLOGL,a,b", expect="$ACK,5,0,0"), Send("ORWSET,Sle,R", expect="$ACK,12,0,0"), Poll(mode="M"),
+       # each refused command right after an $OMP that holds M (RH-RD-3 restarts it): M on the slowest line too
+       Send(OMP_LONG, expect="$ACK,10,0,0"), Poll(mode="M"), Send(OMS, expect="$ACK,9,1,20"),
+       Send(OMP_LONG), Send("OJW,0", expect="$ACK,7,1,19"),
+       Send(OMP_LONG), Send("OPK,{lat},{lon},1,{speed}", expect="$ACK,11,1,22"),
+       Send(OMP_LONG), Send(FAR_OMW, expect="$ACK,16,1,36"),
+       Send(OMP_LONG), Send("OLOGL,a,b", expect="$ACK,5,0,0"),
+       Send(OMP_LONG), Send("ORWSET,Sle,R", expect="$ACK,12,0,0"), Poll(mode="M"),
        Send("OMSTART,0,0,0,0,{mission},", expect="$ACK,3,0,0"), Poll(mode_not="M")),
     _c("V-82", "RH-ACK-4 RH-PK-1 RH-MSN-1 RH-MSN-2", "Checks in their order",
        "RH-RD-2: an $OPK ~111 km away in S is refused for the state (22), not the distance (40); a start whose "
@@ -89,9 +93,8 @@ RULE_CASES: tuple[Case, ...] = (
     _c("V-86", "RH-SRV-4 RH-ACK-3", "A refused $OMS does not restart the servo timeout",
        "an $OMS refused (heading 360) well into the timeout leaves the first timeout running: control is "
        "released when it ends (\"no accepted $OMS\"), not a whole timeout after the refused one", "N",
-       Send(OMS_RESTART), Poll(mode="A"), Wait("{gap}"), Send("OMS,360,2,20,{speed},{to_restart}",
-                                                             expect="$ACK,9,1,20"),
-       Poll(mode="A"), Settle("remote"), Poll(mode="N|P")),
+       Send(OMS_RESTART), Poll(mode="A"), Wait("{gap}"),
+       Send("OMS,360,2,20,{speed},{to_restart}", expect="$ACK,9,1,20"), Settle("remote"), Poll(mode="N|P")),
     _c("V-87", "RH-JW-1 RH-PK-1 RH-LOG-1 RH-LOG-2", "Integers are integers, labels are not empty",
        "an $OLOGL of one label is accepted, one with an empty label refused (24, RH-RD-9); in the mission two "
        "values are refused (25): the labels are the accepted $OLOGL's, not the refused one's; an $OJW to "
