@@ -482,3 +482,27 @@ def test_RH_OMW_3_an_OMW_with_an_empty_depth_2_refused_is_RH_OMW_3_s(tmp_path):
                                                                                     speed=2.0)
     v = judge(tmp_path, rec)
     assert failed(v) == {"RH-OMW-3"}, {c: v[c]["reason"] for c in failed(v)}
+
+
+# ===================================== a lockout's after-effect: RH-SAF-2's, also inside RH-SAF-1's case
+
+@pytest.mark.parametrize("replayed", [True, False])
+def test_a_command_refused_in_the_lockout_carried_out_after_it_is_RH_SAF_2_even_in_the_lockout_s_case(
+        tmp_path, replayed):
+    """Inside the lockout's own case (V-58, RH-SAF-1) a servo control that comes back after the
+    lockout — the $OMS the lockout refused, carried out when it ended — broke RH-SAF-2's rule ("a
+    command sent during the lockout has no effect even after the lockout ends"; the traceability
+    table): booked there, RH-SAF-1 named as related, not failed. A vehicle that stays in N passes."""
+    rec = start() + [(0.5, "!", "case V-58 RH-SAF-1: The lockout refuses everything but $OSD for lockout_s")]
+    rec += poll(1.0, mode="N", err="Sfp", dist=150.0)  # a violation the vehicle raised by itself
+    rec += [(1.5, ">", "OMS,90,2,20,0.5,60"), (1.51, "<", "ACK,9,1,26")]
+    rec += poll(2.0, mode="N", err="Sfp", dist=150.0)
+    rec += poll(30.0, mode="A" if replayed else "N", err="Sfp", dist=150.0, speed=0.5)  # the lockout over
+    v = judge(tmp_path, rec)
+    if replayed:
+        assert verdict(v, "RH-SAF-2") == "fail", v["RH-SAF-2"]
+        assert verdict(v, "RH-SAF-1") != "fail", v["RH-SAF-1"]
+        related = v["RH-SAF-2"]["reason"].rpartition("(related: ")[2]
+        assert "RH-SAF-1" in related, v["RH-SAF-2"]["reason"]
+    else:
+        assert not failed(v), {c: v[c]["reason"] for c in failed(v)}

@@ -158,7 +158,7 @@ class LabelsFromRefusedOlogl(EmulatorCore):
 
 
 class AnswersTwiceAfterSilence(EmulatorCore):
-    """RH-ACK-1: after 4 s with nothing received, the first line is processed twice (an input
+    """RH-ACK-1: after 2.5 s with nothing received, the first line is processed twice (an input
     stage that wakes on a quiet line and replays what woke it): two ``$ACK`` for one command.
     (One that *loses* that line is not told apart: a lone lost answer answered on its re-run is the
     line's, as the observer's line model takes it.)"""
@@ -166,7 +166,7 @@ class AnswersTwiceAfterSilence(EmulatorCore):
     last_in = None
 
     def _line(self, raw, now, v):
-        quiet = self.last_in is not None and now - self.last_in > 4.0
+        quiet = self.last_in is not None and now - self.last_in > 2.5
         self.last_in = now
         if quiet:
             super()._line(raw, now, v)

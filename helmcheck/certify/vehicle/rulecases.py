@@ -111,7 +111,7 @@ RULE_CASES: tuple[Case, ...] = (
        "the mode stays); `$osd` is an unknown ID (RH-RD-16): no answer", "N",
        Raw("longck", "OMSTOP,0"), Raw("hexck", "OMSTOP,0"), Poll(mode="N|P"), Raw("lowerid", "OSD,S"), Poll()),
     _c("V-90", "RH-ACK-1 RH-ACK-2", "The first command after a quiet line",
-       "nothing is sent for 6 s, then the link is closed and opened again where the port's name allows it (a "
+       "nothing is sent for 4 s, then the link is closed and opened again where the port's name allows it (a "
        "client reconnecting); the first command after it, and the next, each get their $ACK in the window",
-       "S", Quiet(6.0, reopen=True), Send("OSD,S"), Send("OPOS,{lat},{lon},0,,", expect="$ACK,6,0,0"), Poll(mode="S")),
+       "S", Quiet(4.0, reopen=True), Send("OSD,S"), Send("OPOS,{lat},{lon},0,,", expect="$ACK,6,0,0"), Poll(mode="S")),
 )

@@ -451,7 +451,7 @@ class Answers:
                 self.book("inconclusive", cands, f"{msg} — not judged: the observer lost track of the "
                                                  f"vehicle's state before ({res.desync})", ev, at=p)
             else:
-                self.book("fail", cands, msg, ev, at=p)
+                self.book("fail", cands, msg, ev, at=p, stated=res.diagnosis)
             self.checks.after_osi(osi, p, t, ev, judged=False)
             return
         self.ledger.passed("RH-OUT-4", lambda: f"mode {osi.mode}, waypoint {osi.next_waypoint}, P{osi.park_time}, "
