@@ -92,6 +92,17 @@ def test_a_field_count_or_a_range_only_a_reading_sets_stays_RH_ACK_3(tmp_path, c
     assert verdict(v, "RH-ACK-3") == "fail", v["RH-ACK-3"]
 
 
+@pytest.mark.parametrize("control,mode", [("OMP,8080808080,00,60", "M"), ("OMS,90,2,20,0,60", "A")])
+def test_an_OJW_past_the_last_waypoint_accepted_under_remote_control_is_RH_JW_1(tmp_path, control, mode):
+    """The range of n is RH-JW-1's, whatever control the $OJW meets (the row under M is RH-JW-2's:
+    it ends remote control): a data check's clause, not the row's (the traceability table)."""
+    ack = {"M": "ACK,10,0,0", "A": "ACK,9,0,0"}[mode]
+    rec = start() + send(0.5, control, ack) + poll(0.7, mode=mode, dist=150.0, speed=1.0)
+    v = judge(tmp_path, rec + send(1.0, "OJW,4", "ACK,7,0,0") + poll(1.5, mode="N", wp=3, dist=150.0, speed=1.0))
+    assert verdict(v, "RH-JW-1") == "fail", v["RH-JW-1"]
+    assert verdict(v, "RH-JW-2") != "fail", v["RH-JW-2"]
+
+
 @pytest.mark.parametrize("labels,mission,cmd,ack_type,clause", [
     ("", False, "OLOGL,1,2,3,4,5,6,7,8,9,10,11,12,13", 5, "RH-LOG-1"),   # 13 labels: RH-LOG-1's 1–12
     ("", False, "OLOGL,a,,b", 5, "RH-LOG-1"),                              # an empty label (RH-RD-9)

@@ -90,7 +90,7 @@ RULE_CASES: tuple[Case, ...] = (
        "(RH-RD-2: the lockout first); $OSD is still served", "N",
        Fault("Sle", then=("OMS,400,2,20,{speed},10", "OJW,x", "OMP,8080,00,5", "OSD,S")),
        Settle("lockout", probe="ORWSET,Sle,R"), needs=("violation", "lockout")),
-    _c("V-86", "RH-SRV-4 RH-ACK-3", "A refused $OMS does not restart the servo timeout",
+    _c("V-86", "RH-SRV-4", "A refused $OMS does not restart the servo timeout",
        "an $OMS refused (heading 360) well into the timeout leaves the first timeout running: control is "
        "released when it ends (\"no accepted $OMS\"), not a whole timeout after the refused one", "N",
        Send(OMS_RESTART), Poll(mode="A"), Wait("{gap}"),

@@ -70,7 +70,7 @@ from ...grammar import sentences as s
 from ...grammar.errors import SentenceError
 from ...model.transitions import COMMAND_EVENTS, MODES, PHASES, TABLE
 
-__all__ = ["command_clauses", "looked_up", "targets", "vehicle_clause", "OWN_EVIDENCE", "FIELD_CLAUSE", "COUNT_CLAUSE",
+__all__ = ["command_clauses", "looked_up", "targets", "vehicle_clause", "OWN_EVIDENCE", "FIELD_CLAUSE", "COUNT_CLAUSE", "CHECK_CLAUSE",
            "passable",
            "stated_by", "phase_exceptions", "FORMS"]
 
@@ -111,6 +111,12 @@ FIELD_CLAUSE = {
     **{("OMSTART", f): "RH-MSN-2" for f in ("ignore_gps", "ignore_sounder", "calibrate_pressure", "mission_type")},
     ("OMSTART", "name"): "RH-MSN-1", ("OMSTART", "srp"): "RH-MSN-1",
 }
+
+#: Command event → the clause that states the check a conforming vehicle refuses it by in a state
+#: its row accepts it in: ``$OJW`` n in [0, waypoints−1] (RH-JW-1, also under remote control,
+#: whose row is RH-JW-2's), the ``$OPK`` 10 miles (RH-PK-1, also in ``mP``, whose row is RH-PK-2's),
+#: ``$OLOGD``'s values against the labels (RH-LOG-2).
+CHECK_CLAUSE = {"OJW": "RH-JW-1", "OPK": "RH-PK-1", "OLOGD": "RH-LOG-2"}
 
 #: Sentence ID → the vehicle clause that states how many fields it takes, where one does beyond
 #: RH-ACK-3's "the wrong number of fields": ``$OLOGL`` 1–12 labels, none empty (RH-LOG-1, RH-RD-9),
@@ -172,8 +178,9 @@ def command_clauses(item, expected_ack: Optional[s.ACK], row, before_mode: str =
         out = ("RH-INT-1",) + tuple(c for c in out if c != "RH-INT-1")
     if expected_ack is not None and expected_ack.status == 1 and row.error is None:
         # accepted by the table, refused by a data check (index, count, file, distance): the
-        # row's own clause (RH-JW-1, RH-LOG-2, RH-MSN-1/2, RH-PK-1) says what was checked
-        out = out[:1]
+        # clause that states the check (CHECK_CLAUSE), else the row's own (RH-MSN-1/2)
+        own = CHECK_CLAUSE.get(row.event)
+        out = (own,) if own else out[:1]
     return out or ("RH-ACK-1",)
 
 
