@@ -5,7 +5,8 @@ breaking exactly that rule answers differently from the model:
 
 * a condition the other cases always satisfy — "only while a mission is running" after the
   mission was stopped, and in an ``M`` entered from ``S`` (RH-RD-1); "no *accepted* ``$OMS``"
-  with a refused one sent into the timeout (RH-SRV-4);
+  with a refused one sent into the timeout (RH-SRV-4); "after an *accepted* ``$OLOGL``" with a
+  refused one after it (RH-LOG-2: the labels are the accepted one's);
 * the order of the checks (RH-RD-2): a failed precondition met with a file that is not there, or
   a park too far away, answers the precondition's error, not the later check's; a command with bad
   fields in the lockout answers 26;
