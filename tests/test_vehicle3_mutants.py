@@ -75,7 +75,10 @@ def _nominal(tmp: Path, mutant: str, select: str) -> tuple[int, dict, str]:
     tmp.mkdir(parents=True, exist_ok=True)
     prof = tmp / "ics.toml"
     prof.write_text(sweep.ICS + "baud = 115200\ntime_scale = 20\n")
-    vehicle = (f"{sys.executable} {sweep.VEHICLE3} --tcp {{tcp_port}} --time-scale {{time_scale}} --baud 115200 "
+    # vehicle3 takes the TCP port alone (--tcp N); a command that does not name {port} gets it
+    # appended (helmcheck.line.launcher), so it is named in the environment, where vehicle3 ignores it
+    vehicle = (f"env VEHICLE3_URL={{port}} {sys.executable} {sweep.VEHICLE3} --tcp {{tcp_port}} "
+               f"--time-scale {{time_scale}} --baud 115200 "
                f"--latency-max-ms 40 --mission-dir {tmp / 'missions'}" + (f" --mutant {mutant}" if mutant else ""))
     out = tmp / "run"
     proc = subprocess.run([sys.executable, "-m", "helmcheck", "certify", "vehicle", "--port", "socket://127.0.0.1:0",
