@@ -20,6 +20,7 @@ from typing import Optional
 
 from ...grammar import sentences as s
 from ...profile import Profile
+from .rulecases import RULE_CASES
 from .steps import (Burst, Case, ClearWords, Fault, MissionEnd, Octd, Poll, Raw, Send, SetRoundTrip, Settle, Start,
                     Until, Wait, WithSetting)
 
@@ -478,6 +479,8 @@ CASES: tuple[Case, ...] = (
        *_no("OLOGL"), *_ok("OLOGL,a", "OLOGL,1,2,3,4,5,6,7,8,9,10,11,12"), Start(),
        *_no("OLOGD", "OLOGD,1,2,3,4,5,6,7,8,9,10,11,12,13"), *_ok("OLOGD,1", "OLOGD,1,2,3,4,5,6,7,8,9,10,11,12"),
        *_ok("OJW,{wp_first}"), *_no("OJW,{wp_under}"), Poll(mode="N")),
+    # --- rules no case above could fail (the traceability table): :mod:`.rulecases` ----------------
+    *RULE_CASES,
     # --- §8 time ---------------------------------------------------------------------------------
     _c("V-62", "RH-TIM-1 RH-TIM-2", "Durations hold at the declared time scale",
        "a servo timeout of 30 s or more and a primitive timeout end within max(0.5 s, 5 %) plus the "

@@ -27,7 +27,7 @@ from .flow import CaseStop
 from .safety import BenchSafetyRefused
 from .session import Session, frame
 from .steps import (Burst, Case, ClearWords, Fault, MissionEnd, Octd, Poll, Raw, Send, SetRoundTrip, Settle, Start,
-                    Until, Wait, WithSetting)
+                    Until, Wait, WithSetting, Quiet)
 
 __all__ = ["run_case", "run_step", "raw_line", "context", "fill"]
 
@@ -129,6 +129,10 @@ def raw_line(kind: str, body: str, profile: Profile) -> bytes:
         return b"$" + body.encode() + b"\r\n"
     if kind == "shortck":
         return b"$" + body.encode() + b"*" + checksum_hex(body)[:1].encode() + b"\r\n"
+    if kind == "longck":  # the right two digits and one more
+        return b"$" + body.encode() + b"*" + checksum_hex(body).encode() + b"0\r\n"
+    if kind == "hexck":
+        return b"$" + body.encode() + b"*GZ\r\n"
     if kind == "twostar":
         b2 = body + "*"
         return b"$" + b2.encode() + b"*" + checksum_hex(b2).encode() + b"\r\n"
@@ -263,6 +267,8 @@ def run_step(session: Session, st, ctx: dict) -> None:
         _clear_words(session, st, ctx)
     elif isinstance(st, SetRoundTrip):
         _set_round_trip(session, st)
+    elif isinstance(st, Quiet):
+        session.quiet(st.wall_s, st.reopen)
     elif isinstance(st, Octd):
         if "T" in session.profile.osd_letters:
             session.exchange(frame("OSD,T"))

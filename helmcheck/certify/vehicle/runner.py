@@ -57,7 +57,7 @@ from ...judge.vehicle import VehicleObserver
 from ...judge.wire import tester_note
 from ...line.linekind import line_for
 from ...line.recorder import Recorder
-from ...line.reopen import DEFAULT_WAIT_S, reopenable
+from ...line.reopen import DEFAULT_WAIT_S, reopenable, wait_for_port
 from ...line.transport import open_link
 from ...profile import Profile
 from ...reports import results as R
@@ -68,7 +68,7 @@ from .casecounters import CaseCounters
 from .catalogue import select_cases
 from .clockprobe import ClockMismatch, check_clock
 from .exec_child import ExecChild
-from .flow import LinkLost, LinkSilent
+from .flow import CaseStop, LinkLost, LinkSilent
 from .interpreter import run_case
 from .link import TesterLink
 from .progress import Progress, explored_text
@@ -260,8 +260,28 @@ class Run(ExecChild):
         self.link.note(line_note(line_for(shown or self.o.port, self.o.line)))
         self.session = Session(self.link, self.p, self.k, self.observer, max_wait=self.o.max_wait)
         self.session.custodian = self.custodian
+        self.session.reopen = self.reopen_link
         if self.o.operator:
             self.session.operator = self.tell_operator
+
+    def reopen_link(self) -> Optional[str]:
+        """Close the tester's end of the link and open it again under the same name (a client
+        reconnecting: :class:`.steps.Quiet`); None where the name cannot come back (the run's own
+        pty, ``/dev/pts/N``, a vehicle helmcheck started). A name that does not open again within
+        10 s stops the case INCONCLUSIVE (the tester's own reopen, not a finding)."""
+        port = self.o.port
+        if self.o.exec_cmd is not None or not reopenable(port) or self.link is None:
+            return None
+        try:
+            self.link.link.close()
+        except Exception:  # noqa: BLE001
+            pass
+        raw, last = wait_for_port(port, baud=self.p.baud, within_s=10.0)
+        if raw is None:
+            raise CaseStop("inconclusive", f"{port} did not open again within 10 s after the tester closed it "
+                                           f"({last}): the first command after a reconnection could not be sent")
+        self.link.reattach(raw, f"link reopened by the tester: {port} closed and opened again after a quiet line")
+        return f"line quiet: {port} closed and opened again"
 
     def _record(self, wire, meta: list) -> None:
         """The recorder of a new record: to the observer and the run facts; a ``--select`` run's

@@ -99,6 +99,10 @@ class Session:
         #: tells the person at the terminal what to do (``violation_trigger = "operator"``); None
         #: when nobody is there
         self.operator: Optional[Callable[[str], None]] = None
+        #: closes the tester's end of the link and opens it again under the same name (a client
+        #: reconnecting, :class:`.steps.Quiet`); returns what it did, or None where the name cannot
+        #: be opened again (the run's own pty, a vehicle it started). None: never (a plan)
+        self.reopen: Optional[Callable[[], Optional[str]]] = None
         #: keeps what the vehicle was found in and puts it back (:mod:`.restore`); None: not kept
         self.custodian = None
         #: what the line costs (:mod:`.linemeter`), and the durations chosen from it (:mod:`.durations`)
@@ -439,6 +443,17 @@ class Session:
         finally:
             self.trace = trace
             self.forced_wait += self.now() - t0
+
+    def quiet(self, wall_s: float, reopen: bool = False) -> None:
+        """The line goes quiet for ``wall_s`` (nothing sent, replies still read), then, with
+        ``reopen``, the link is closed and opened again where its name allows (:class:`.steps.Quiet`)."""
+        self.link.note(f"line quiet: the tester sends nothing for {wall_s:g} s")
+        t0 = self.now()
+        self.link.sleep(wall_s)
+        self.forced_wait += self.now() - t0
+        if reopen:
+            did = self.reopen() if self.reopen is not None else None
+            self.link.note(did or "line quiet: the link is kept open (its name cannot be opened again)")
 
     def settle(self, timer: Optional[str] = None, probe: Optional[bytes] = None,
                clause: Optional[str] = None) -> s.OSI:

@@ -470,7 +470,7 @@ class Answers:
                 self.book("inconclusive", cands, f"{msg} — not judged: the observer lost track of the "
                                                  f"vehicle's state before ({res.desync})", ev, at=p)
             else:
-                self.book("fail", cands, msg, ev, at=p)
+                self.book("fail", cands, msg, ev, at=p, stated=res.diagnosis)
             self.checks.after_osi(osi, p, t, ev, judged=False)
             return
         m = self.beliefs.primary.model

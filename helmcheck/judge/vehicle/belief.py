@@ -98,6 +98,10 @@ class OsiResult:
     adopted: tuple = ()
     desync: str = ""
     causes: tuple = ()  #: clauses of what changed since the last confirmed report (for blame)
+    #: the clause whose rule the report itself shows broken, booked even inside another clause's case
+    #: (that case's subject named as related): a remote control back after a lockout that refused
+    #: commands is RH-SAF-2's ("no effect even after the lockout ends"), not the lockout's own
+    diagnosis: tuple = ()
     own: set = field(default_factory=set)  #: clauses this report passes by their own evidence
     #: after a :attr:`CommandResult.ignored` answer: whether the state of a vehicle that did not
     #: carry out the command before it explains this report (None: no such question)
@@ -431,6 +435,8 @@ class Beliefs:
                 # a command refused in the lockout, and the lockout over (or ending within the
                 # tolerance before this report): what changed may be that command, carried out
                 causes.insert(0, "RH-SAF-2")
+                if osi.mode in _REMOTE and osi.mode != p.model.mode:
+                    result.diagnosis = ("RH-SAF-2",)
             if osi.mode == p.model.mode:  # the mode is right: a countdown is what differs
                 causes += {"mP": ["RH-PK-2"], "W": ["RH-OMW-4"]}.get(osi.mode, [])
             if (p.resumed and osi.mode == p.model.mode == "P"

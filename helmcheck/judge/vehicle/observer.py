@@ -65,13 +65,16 @@ from ..wire import FROM_VEHICLE, LINE_CACHE, NOTE, TO_VEHICLE, Decodings, WireEv
 from . import osichecks
 from .belief import Beliefs
 from .answers import Answers, reading_clause
-from .blame import command_clauses, targets
+from .blame import command_clauses, targets, vehicle_clause
 from .catalog import GivenMissions, KnownMissions
 from .deadlines import Deadlines
 from .lines import PREFIX_REPEAT, Kind, OutputJudge, classify
 from .sent import Sent, class_of_id, text_of
 
 __all__ = ["VehicleObserver", "Sent"]
+
+#: Never named as the related clause of a finding: the generic report check and time.
+_NOT_RELATED = frozenset({"RH-OUT-4", "RH-TIM-1", "RH-TIM-2"})
 
 _PLANT = {"WaypointReached": P.WaypointReached, "OnStation": P.OnStation,
           "QueueWaypointReached": P.QueueWaypointReached, "AtSurface": P.AtSurface,
@@ -183,7 +186,15 @@ class VehicleObserver(Answers, Deadlines):
         case, clauses = (at.case, at.case_clauses) if at is not None else (self.case, self.case_clauses)
         if case and verdict != "pass":
             reason = f"{case}: {reason}"
-        for cid in targets(candidates, clauses, stated):
+        booked = targets(candidates, clauses, stated)
+        if verdict == "fail":
+            # the other clauses the evidence fits, named beside the one whose rule it broke (the
+            # traceability table, helmcheck/spec/rules.toml)
+            related = [c for c in dict.fromkeys(candidates) if c not in booked and vehicle_clause(c)
+                       and c not in _NOT_RELATED]
+            if related:
+                reason = f"{reason} (related: {', '.join(related)})"
+        for cid in booked:
             if verdict == "fail":
                 if at is not None and at.holding:  # the line may have spoilt it: held (module docstring)
                     at.held.append((cid, reason, list(evidence), case))
