@@ -51,7 +51,7 @@ def test_RH_OUT_4_check_names_each_wrong_field():
     e = expectation(m, 30.0)
     assert e.check(osi) == []
     assert [c for c, _ in e.check(dataclasses.replace(osi, mode="N"))] == ["RH-OUT-4"]
-    msgs = e.check(dataclasses.replace(osi, next_waypoint=2, park_time=10, error_state="Sle"))
+    msgs = e.check(dataclasses.replace(osi, next_waypoint=3, park_time=10, error_state="Sle"))  # (P: 1 or 2 is right)
     assert len(msgs) == 3 and all(c == "RH-OUT-4" for c, _ in msgs)
     assert "park time P10" in msgs[2][1]
     # each finding says the field it is about (the judge's blame reads it, never the message)

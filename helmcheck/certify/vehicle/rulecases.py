@@ -80,11 +80,11 @@ RULE_CASES: tuple[Case, ...] = (
        Send("OMSTART,0,0,0,0,sub/../{mission},", expect="$ACK,3,1,30"), Poll(mode="S")),
     _c("V-84", "RH-OMW-3", "An $OMW keyword ends every remote control",
        "the keyword alone ends A, M and mP as it ends W, and the mission resumes (RH-RD-4); CLEAR with a "
-       "waypoint clears the queue, then queues that waypoint (W)", "N",
+       "waypoint (the first of omw_clear_keywords) clears the queue, then queues that waypoint (W)", "N",
        Send(OMS), Poll(mode="A"), Send("OMW,{kw_a}", expect="$ACK,16,0,0"), Poll(mode="N|P"),
        Send(OMP_LONG), Send("OMW,{kw_b}", expect="$ACK,16,0,0"), Poll(mode="N|P"),
        Send("OPK,{lat},{lon},5,{speed}"), Send("OMW,{kw_c}", expect="$ACK,16,0,0"), Poll(mode="N|P"),
-       Send(FAR_OMW), Send("OMW,CLEAR,{near_lat},{near_lon},2,,15,{speed},0,", expect="$ACK,16,0,0"),
+       Send(FAR_OMW), Send("OMW,{kw_a},{near_lat},{near_lon},2,,15,{speed},0,", expect="$ACK,16,0,0"),
        Poll(mode="W"), Send("OMW,{kw_a}"), Poll(mode="N|P")),
     _c("V-85", "RH-SAF-1", "In the lockout the refusal comes first",
        "commands with bad fields written right after the violation are refused with 26, not their own error "

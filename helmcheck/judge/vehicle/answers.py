@@ -457,6 +457,10 @@ class Answers:
         # the report shows the state the instant it was sent (RH-OUT-4), which its arrival bounds
         # less its own transmit time (RH-RD-15: the $OSD is processed as its ACK goes out)
         t_from = max(p.t, t - transmit_time(len(evd.text) + 2, self.baud))
+        if not self.faults.clean and t - p.t > self.profile.ack_window_s:
+            # later than any answer of a conforming vehicle: a stall of the line may have held it, so it
+            # may show the state from any moment since the poll was sent
+            t_from = p.t
         self._bound_oxflt(p, t_from)
         res = self.beliefs.osi(osi, self.v(t_from), self.v(t), self.slack_v())
         if self.held is not None:
