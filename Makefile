@@ -68,7 +68,7 @@ explore-reach: $(STAMP)
 # clause the traceability table books its reading on), the three timing faults at the time scale
 # --precision nominal picks (tests/test_vehicle3_mutants.py, about 45 minutes more).
 matrix: $(STAMP)
-	HELMCHECK_MATRIX=1 $(PY) -m pytest -n 2 tests/test_line_budget.py tests/test_slow_line.py tests/test_unplugged.py tests/test_bad_line.py tests/test_third_party_vehicle.py::test_its_own_missions_with_oxflt_certify tests/test_explore_replays.py tests/test_vehicle3.py tests/test_readings.py tests/test_certify_backseat_realtime.py tests/test_vehicle3_mutants.py
+	HELMCHECK_MATRIX=1 $(PY) -m pytest -n 2 tests/test_line_budget.py tests/test_slow_line.py tests/test_unplugged.py tests/test_bad_line.py tests/test_third_party_vehicle.py::test_its_own_missions_with_oxflt_certify tests/test_third_party_vehicle.py::test_a_violation_it_raises_by_itself_is_judged_like_any_other tests/test_third_party_vehicle.py::test_the_pytest_plugin_certifies_it tests/test_explore_replays.py tests/test_vehicle3.py tests/test_readings.py tests/test_certify_backseat_realtime.py tests/test_vehicle3_mutants.py
 
 # Not run by CI (several minutes): every --help example, the slow ones and those that need a
 # vehicle too (run against the emulator on their port); make test runs the others.

@@ -129,6 +129,8 @@ def test_its_mission_rule_trips_the_lockout_and_certifies(tmp_path):
     assert "$OXFLT" not in (tmp_path / "run" / "wire.log").read_text().replace("not tested", "")
 
 
+@pytest.mark.skipif(not MATRIX, reason="make matrix (HELMCHECK_MATRIX=1): make test's budget (the mission rule is judged "
+                                        "in test_its_mission_rule_trips_the_lockout_and_certifies)")
 def test_a_violation_it_raises_by_itself_is_judged_like_any_other(tmp_path):
     """No trigger declared (RH-SAF-5: the lockout clauses are judged only if a violation happens
     by itself): every mission trips Sfp 100 vehicle seconds after its start, inside the long cases."""
@@ -159,6 +161,8 @@ def test_a_profile_claiming_five_commands_gets_none_of_the_others(tmp_path):
     assert code in (0, 2), text  # 2: the vehicle cannot be verified as stopped without $OMSTOP
 
 
+@pytest.mark.skipif(not MATRIX, reason="make matrix (HELMCHECK_MATRIX=1): make test's budget (the plugin is certified "
+                                        "against the emulator in tests/test_pytest_plugin.py)")
 def test_the_pytest_plugin_certifies_it(tmp_path, pytester):
     """Through the pytest plugin every clause is a passing item (an INCONCLUSIVE would be a
     failed one)."""
