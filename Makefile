@@ -50,9 +50,13 @@ explore-reach: $(STAMP)
 # backseat device and a monitored side that never come back (tests/test_unplugged.py); the
 # emulator, the independent simulator and the example backseat behind every line fault, and every
 # faulty vehicle behind light damage (tests/test_bad_line.py); the independent simulator's own
-# missions at x5 and two exploration findings replayed (make test's budget keeps x20 and one replay).
+# missions at x5 and two exploration findings replayed (make test's budget keeps x20 and one replay);
+# the exploration alone against every single fault of the third vehicle we did not write
+# (../shared/third-party/vehicle3, tests/test_explore_vehicle3.py, benchmarks/explore_reach.py
+# --families vehicle3: about 40 minutes of it, its timing faults at the time scale --precision
+# nominal names).
 matrix: $(STAMP)
-	HELMCHECK_MATRIX=1 $(PY) -m pytest -n 2 tests/test_line_budget.py tests/test_slow_line.py tests/test_unplugged.py tests/test_bad_line.py tests/test_third_party_vehicle.py::test_its_own_missions_with_oxflt_certify tests/test_explore_replays.py
+	HELMCHECK_MATRIX=1 $(PY) -m pytest -n 2 tests/test_line_budget.py tests/test_slow_line.py tests/test_unplugged.py tests/test_bad_line.py tests/test_third_party_vehicle.py::test_its_own_missions_with_oxflt_certify tests/test_explore_replays.py tests/test_explore_vehicle3.py
 
 # Not run by CI (several minutes): every --help example, the slow ones and those that need a
 # vehicle too (run against the emulator on their port); make test runs the others.
