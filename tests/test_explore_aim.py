@@ -5,7 +5,8 @@ there. On the reference emulator in virtual time, behind the certifier's own lin
 session (no port, no wall time spent waiting): every way leads where it says; the targets listed
 for a fresh run, driven one after another, reach what they say they reach; the model coverage
 counts the rows time fires (a timer run out between two reports) as well as those commands meet;
-and every template the targets use is one the sequences' context fills.
+every template the targets use is one the sequences' context fills; and the legs of the
+vehicle's own mission are read off its reports.
 """
 
 from __future__ import annotations
@@ -121,3 +122,23 @@ def test_the_targets_of_a_fresh_run_reach_what_they_list():
     assert len(got) >= 0.9 * len(rows), sorted(rows - got)
     assert len(ses.cover.rows) >= 0.75 * len(ses.cover.rows_all), sorted(ses.cover.rows_all - ses.cover.rows)
     assert TABLE  # the table the rows are of
+
+
+def test_the_mission_survey_reads_the_legs_off_the_reports():
+    """A leg's time is the longest distance to its waypoint reported in ``N`` at the speed reported
+    (a leg not seen yet is guessed at 60 s): the cost of a target that follows the vehicle's own
+    mission is the vehicle's, not a guess about it."""
+    from helmcheck.grammar import decode
+    from helmcheck.model.geo import KNOT_MPS
+    profile = emulator_profile()
+    survey = MissionSurvey(4)
+    for wp, dist, mode in ((0, 30.0, "N"), (0, 25.0, "N"), (1, 100.0, "N"), (2, 999.0, "A")):
+        body = (f"OSI,8080808080,{mode},{wp},41.5,-71.3,2.0,{dist:.1f},N,10.0,P0,-14.2,conformance,0.0,90.0,"
+                "0.0,90.0,False,IVER,a,b,c")
+        osi = decode(frame(body), profile).sentence
+        assert osi is not None, body
+        survey.seen(osi)
+    mps = 2.0 * KNOT_MPS
+    assert abs(survey.leg_v(0) - 30.0 / mps) < 1e-6 and abs(survey.leg_v(1) - 100.0 / mps) < 1e-6
+    assert survey.leg_v(2) == 60.0  # seen only under remote control: not a leg of the mission
+    assert abs(survey.to_v(1) - 130.0 / mps) < 1e-6

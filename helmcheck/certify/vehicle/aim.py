@@ -188,12 +188,11 @@ class Target:
 @dataclass
 class MissionSurvey:
     """The vehicle's own mission as its reports describe it (module docstring): per waypoint the
-    longest distance to it reported and the speed, the remaining time it reports (field 13)."""
+    longest distance to it reported in ``N``, and the highest speed reported there."""
 
     waypoints: int
     legs_m: dict = field(default_factory=dict)  #: waypoint -> the longest distance to it seen (m)
     speed_mps: float = 0.0  #: the highest mission speed seen
-    remaining_s: Optional[float] = None
 
     def seen(self, osi) -> None:
         """One report (``$OSI``)."""
@@ -203,8 +202,6 @@ class MissionSurvey:
             wp, dist = int(osi.next_waypoint), float(osi.distance or 0)
             self.legs_m[wp] = max(self.legs_m.get(wp, 0.0), dist)
             self.speed_mps = max(self.speed_mps, float(osi.speed or 0) * KNOT_MPS)
-            if osi.remaining_time is not None and float(osi.remaining_time) > 0:
-                self.remaining_s = float(osi.remaining_time)
         except (TypeError, ValueError):
             return
 
