@@ -41,7 +41,7 @@ fuzz: $(STAMP)
 explore-reach: $(STAMP)
 	HELMCHECK_REACH=1 $(PY) -m pytest -q tests/test_explore_reach.py
 
-# Not run by CI (about 75 minutes on two cores; the line-fault grid alone 6 minutes): the slow-line grid — every case on the reference and
+# Not run by CI (about two hours on two cores; the line-fault grid alone 6 minutes): the slow-line grid — every case on the reference and
 # every faulty vehicle over lines in virtual time (time scales 1-40, replies 3 ms-0.9 s, 9600-115200
 # baud, the timing freedoms at their bounds), and whole certifications on real ptys of the emulator
 # at each line-timing freedom's bound at x5, x20 and x40 and of the independent simulator behind a
