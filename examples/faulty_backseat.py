@@ -7,7 +7,7 @@ for three seconds. A conforming vehicle refuses every such ``$OMS`` (``$ACK,9,1,
 backseat never gets servo control; ``helmcheck certify backseat`` fails it on RH-BS-2 ("every
 field is within the ranges of §4–6"), with the offending lines as evidence:
 
-    helmcheck certify backseat --time-scale 10 --duration 20 \\
+    helmcheck certify backseat --time-scale 10 \\
         --exec 'python3 examples/faulty_backseat.py --port {port} --time-scale {time_scale}'
 
 Everything else is the example backseat's: the same options, the same loop.

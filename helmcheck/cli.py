@@ -65,8 +65,8 @@ helmcheck — the formal model and conformance suite for the Iver3 remote helm p
 
 typical use:
   helmcheck emulate --port pty --time-scale 20 &     # a reference vehicle; prints port: /dev/pts/N
-  helmcheck certify vehicle --port /dev/pts/N --time-scale 20 --profile helmcheck/profiles/emulator.toml
-  helmcheck certify backseat --duration 10 --time-scale 10 \\
+  helmcheck certify vehicle --port /dev/pts/N --time-scale 20 --profile examples/emulator.toml
+  helmcheck certify backseat --time-scale 10 \\
       --exec 'python3 examples/backseat.py --port {port} --time-scale {time_scale}'
   helmcheck check-log reports/vehicle/wire.log      # judge a recorded log as the run that wrote it did
   helmcheck monitor --tap /dev/ttyUSB0 /dev/ttyUSB1  # judge a live session from a Y-cable, live

@@ -2,10 +2,13 @@
 
 ``python -m helmcheck.demo [--out DIR]`` starts ``helmcheck emulate`` on a pty at time scale 40
 as a subprocess, runs ``helmcheck certify vehicle`` against it with the emulator's own profile
-(``helmcheck/profiles/emulator.toml``: the ``$OXFLT`` test extension, so the lockout clauses
-are judged too, and the missions it ships for RH-MSN-4 and the SRP branch of RH-SAF-4), writes
+(the package's ``helmcheck/profiles/emulator.toml``; the recorded command names
+``examples/emulator.toml``, the same claims with every key written out: the ``$OXFLT`` test
+extension, so the lockout clauses are judged too, and the missions it ships for RH-MSN-4 and the
+SRP branch of RH-SAF-4), writes
 ``DIR/{results.json, wire.log, profile.toml, report.html, junit.xml, report.md}`` and the
-emulator's own log beside them, stops the emulator, and prints the one-line verdict, the
+emulator's own log beside them, stops the emulator, and prints the verdict line ``certify
+vehicle`` prints (the scope, the reason, what coarse timing means), the
 report's path (``report: DIR/report.html``) and how to run ``helmcheck`` from the virtual
 environment. Exit status is the certification's.
 
@@ -25,8 +28,9 @@ from pathlib import Path
 
 from .certify.vehicle.runner import Options, certify
 from .emulator.process import EmulatorProcess
-from .profile import EMULATOR_PROFILE, emulator_profile
+from .profile import emulator_profile
 from .reports.identity import source_revision
+from .reports.scope import exploration_note, headline, precision_note, what_to_change
 
 TIME_SCALE = 40.0
 BAUD = 115200
@@ -67,11 +71,13 @@ def main(argv: list[str] | None = None) -> int:
         res = certify(Options(port=emu.port, profile=profile, time_scale=TIME_SCALE, report_dir=out,
                               examples=10, seed=1, progress=True,
                               command=f"helmcheck certify vehicle --port {emu.port} --time-scale {TIME_SCALE:g} "
-                                      f"--baud {BAUD} --profile helmcheck/{EMULATOR_PROFILE} --examples 10 --seed 1 "
+                                      f"--baud {BAUD} --profile examples/emulator.toml --examples 10 --seed 1 "
                                       f"--report-dir {out}"))
     finally:
         emu.stop()
-    print(f"{res.verdict.upper()}: {res.reason}")
+    notes = [x for x in (what_to_change(res.results), precision_note(res.results), exploration_note(res.results))
+             if x]
+    print(f"{headline(res.results)}. {res.reason}{''.join(' ' + x for x in notes)}")  # as certify vehicle says it
     print(f"report: {out / 'report.html'}")
     print(f"demo: also {out}/results.json, wire.log, profile.toml, junit.xml, report.md; "
           f"helmcheck verify {out} re-judges it")

@@ -71,8 +71,9 @@ def pytest_addoption(parser: pytest.Parser) -> None:
     g.addoption("--helm-strict", action="store_true", help="a SHOULD not met (NON-STRICT) fails its item")
     g.addoption("--helm-inconclusive", choices=("fail", "skip"), default="fail",
                 help="what an INCONCLUSIVE clause does to its item (default: fail)")
-    g.addoption("--helm-duration", type=float, metavar="S", default=60.0,
-                help="backseat: seconds of judged run (default 60)")
+    g.addoption("--helm-duration", type=float, metavar="S", default=None,
+                help="backseat: seconds of judged run (default: what the scenarios need at the time scale "
+                     "and baud, as helmcheck certify backseat --plan prints)")
     g.addoption("--helm-scenario", action="append", metavar="NAME",
                 help="backseat: run only these scenarios (repeatable)")
     g.addoption("--helm-examples", type=int, metavar="N",

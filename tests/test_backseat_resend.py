@@ -172,7 +172,7 @@ def test_RH_BS_5_a_first_copy_within_a_timestamp_step_of_the_known_time_is_incon
     have been the one sent before it was known; one logged at 0.5 s certainly was not."""
     assert abs(known(0.0) - 0.26) < 0.01
     r = Run(resolution=0.1).bs(0.0).veh(0.0).bs(0.3).close(3.0)
-    assert r.verdict == "inconclusive" and "before the rejection could be known" in \
+    assert r.verdict == "inconclusive" and "before the refusal could be known" in \
         r.ledger.verdict("RH-BS-5").reason
     r = Run(resolution=0.1).bs(0.0).veh(0.0).bs(0.5).close(3.0)
     assert r.verdict == "non-strict"

@@ -84,7 +84,7 @@ def _assert_no_fail_and_named(out_dir: Path, results: dict, line, stall: bool = 
 
 def _certify_vehicle(port: str, profile, k: float, out: Path, select=FRAMING_ACK, examples=0):
     return certify(Options(port=port, profile=profile.replace(time_scale=k), time_scale=k, report_dir=out,
-                           select=select, examples=examples, progress=False, render=False, seed=1))
+                           select=select, examples=examples, progress=False, render=False, seed=1, line="noisy"))
 
 
 def _sim_profile(tmp: Path):
@@ -149,7 +149,9 @@ def test_a_vehicle_we_did_not_write_behind_lost_bytes_noise_and_a_stall_is_never
 
 def run_backseat(tmp_path: Path, faults: str, k: float, duration: float, program: list) -> tuple[dict, object]:
     """``certify backseat`` on a new pty, the relay (a process of its own) between it and
-    ``program`` (argv after the interpreter; ``{port}`` is the relay's backseat-side port)."""
+    ``program`` (argv after the interpreter; ``{port}`` is the relay's backseat-side port). The
+    certifier's own port is a pty it made, which cannot damage a byte; the relay behind it can,
+    so the run says so: ``--line noisy`` (``line="noisy"``)."""
     from helmcheck.certify.backseat.certifier import Options as BOptions, certify as bcertify
     from helmcheck.line.faultline import RelayProcess
     from helmcheck.profile import DEFAULT
@@ -164,7 +166,7 @@ def run_backseat(tmp_path: Path, faults: str, k: float, duration: float, program
 
     try:
         bcertify(BOptions(profile=DEFAULT, report_dir=tmp_path / "r", time_scale=k, duration=duration,
-                          connect_timeout=20.0, progress=False, render=False, on_port=on_port))
+                          connect_timeout=20.0, progress=False, render=False, on_port=on_port, line="noisy"))
     finally:
         for p in procs:
             p.terminate()
@@ -179,9 +181,12 @@ def run_backseat(tmp_path: Path, faults: str, k: float, duration: float, program
 
 
 def test_the_example_backseat_behind_flipped_bits_is_never_failed(tmp_path):
+    """Behind ``helmcheck relay`` flipping bits, run with ``--line noisy`` (the relay, not
+    helmcheck's pty, is the link): the example backseat is not failed for the relay's damage."""
     results, line = run_backseat(tmp_path, "baud=19200,flip=3e-4,seed=2", 10.0, 15.0,
                                  [str(EXAMPLE_BACKSEAT), "--port", "{port}", "--time-scale", "10"])
     assert line is not None and _injected(line), "no fault was injected: the test tests nothing"
+    assert results["line_model"]["kind"] == "noisy" and results["line_model"]["why"] == "--line noisy given"
     failed, unnamed = _problems(results)
     assert not failed and not unnamed, (failed, unnamed)
     _relay_judged_exactly(tmp_path / "relay.log", "backseat", 10.0, emulator_profile())
@@ -241,7 +246,8 @@ def test_a_faulty_vehicle_behind_light_damage_still_fails_on_its_own_clause(muta
             impaired_line(port, f"{LIGHT},seed=1", link=tmp_path / "vehicle", process=True,
                           wire_log=tmp_path / "relay.log") as line:
         out = certify(Options(port=str(line.port), profile=profile, time_scale=k, report_dir=tmp_path / "r",
-                              select=list(mutant.select), examples=0, progress=False, render=False, seed=1))
+                              select=list(mutant.select), examples=0, progress=False, render=False, seed=1,
+                              line="noisy"))
     failed = {c["id"]: c["reason"] for c in out.results["clauses"] if c["verdict"] == "fail"}
     assert mutant.clause in failed, (failed, out.reason)
     assert out.exit_code == 1

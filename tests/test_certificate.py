@@ -338,3 +338,116 @@ def test_a_vehicle_name_on_the_wire_that_differs_from_the_profile_is_flagged(tmp
     assert "(differs from the profile&#x27;s vehicle_name)</td>" in cell and 'class="missing"' in cell
     assert "<img" not in cell
     assert "differs from the profile's vehicle\\_name)**" in md
+
+
+# --------------------------------------------------------------------------- the banner
+
+def _banner_html(html: str) -> str:
+    return html.split('id="verdict"', 1)[1].split('id="certificate"', 1)[0]
+
+
+def _banner_md(md: str) -> str:
+    return md.split("| What was tested |", 1)[0]
+
+
+@pytest.mark.unverifiable  # a hand-made results fixture, not a run
+def test_the_banner_leads_with_what_failed_and_its_reason_then_what_was_not_judged(tmp_path):
+    """Issue 43: under "FAIL — partial", the failed clauses with their reasons come first, then
+    the clauses not judged, in the HTML banner and the Markdown summary alike."""
+    d = copy_run(tmp_path, "fail_run")
+    finish_run(load_results(d), d, DEFAULT)
+    html, md, _ = _render(d)
+    for banner, reason, gap in (
+            (_banner_html(html), "$ACK,10 came 1.400 s after $OMP", "RH-FRM-9 not tested: Serial settings"),
+            (_banner_md(md), "\\$ACK,10 came 1.400 s after \\$OMP", "RH-FRM-9 not tested: Serial settings")):
+        failed = banner.index("RH-ACK-2")
+        assert banner.index("RH-FRM-4") < failed < banner.index("RH-SRV-4"), banner  # profile order
+        assert banner.index(reason) > failed
+        assert failed < banner.index("Not judged:") < banner.index(gap), banner
+        assert banner.index("RH-TIM-1 inconclusive") > banner.index("Not judged:")
+    assert '<a href="#finding-RH-ACK-2"><b>RH-ACK-2</b></a> failed: $ACK,10 came' in html
+    assert md.index("- RH-FRM-4 failed: ") < md.index("Not judged:") < md.index("- RH-FRM-9 not tested")
+
+
+def test_a_passing_certificate_has_no_failure_or_gap_lines_in_its_banner(tmp_path):
+    d = tmp_path / "clean"
+    write_results_atomic(d, vehicle_results())
+    html, md, _ = _render(d)
+    assert 'id="failed"' not in html and "Not judged:" not in html and "Not judged:" not in md
+    assert " failed: " not in _banner_md(md)
+
+
+@pytest.mark.unverifiable  # hand-made results, not a run
+def test_the_banner_lists_four_failures_then_says_how_many_more(tmp_path):
+    d = tmp_path / "many"
+    failing = VEHICLE_IDS[:7]
+    write_results_atomic(d, vehicle_results({cid: "fail" for cid in failing}))
+    html, md, _ = _render(d)
+    banner = _banner_md(md)
+    assert all(f"- {cid} failed: V-00: fail by construction" in banner for cid in failing[:4])
+    assert f"- and 3 more: {id_ranges(failing[4:])}" in banner and f"- {failing[4]} failed" not in banner
+    assert html.count("</li>", 0, html.index('id="certificate"')) == 5
+
+
+def _with_process(d: Path, command: str) -> None:
+    r = load_results(d)
+    r["process"] = {"command": command, "pid": 4242, "exit_code": None, "signal": "SIGTERM",
+                    "ended_at_s": 12.0, "ended_early": False, "output_tail": ["steering"]}
+    write_results_atomic(d, r)
+
+
+@pytest.mark.unverifiable  # a hand-made results fixture, not a run
+def test_a_backseat_report_names_the_backseat_by_its_exec_command_never_the_vehicle_helmcheck_played(tmp_path):
+    """Issue 43: no --implementation, started with --exec: every place a report names the
+    implementation names the command; the $OSI name of the vehicle helmcheck played is nowhere
+    among them."""
+    d = copy_run(tmp_path, "backseat_run")  # its $OSI (helmcheck's vehicle) says IVER3-EMU
+    _with_process(d, "python3 ./my_backseat.py --serial /dev/pts/5")
+    finish_run(load_results(d), d, DEFAULT)
+    html, md, junit = _render(d)
+    command = "python3 ./my_backseat.py --serial /dev/pts/5"
+    first = html.split('id="contents"')[0]
+    assert f"<h1>helmcheck backseat certificate — {command}</h1>" in first
+    assert f"{command} (the command --exec ran; --implementation NAME@VERSION names it)" in first
+    implementation = html.split('id="implementation"', 1)[1].split("</details>", 1)[0]
+    assert f"backseat: {command}" in implementation and "IVER3-EMU" not in implementation
+    assert "IVER3-EMU" not in first
+    line = next(ln for ln in md.splitlines() if ln.startswith("Backseat: "))
+    assert line.startswith(f"Backseat: `{command}` (the command --exec ran) on /dev/pts/5")
+    assert "IVER3-EMU" not in md.split("| PASS |")[0] and "Implementation:" not in md
+    assert ("identity.backseat", f"{command} (the command --exec ran; --implementation NAME@VERSION names it)") \
+        in _props(junit)
+
+
+@pytest.mark.unverifiable  # a hand-made results fixture, not a run
+def test_a_backseat_named_with_implementation_is_named_so_even_when_started_with_exec(tmp_path):
+    d = copy_run(tmp_path, "backseat_run")
+    _with_process(d, "./pHelmBridge --port=/dev/pts/5")
+    finish_run(load_results(d), d, DEFAULT,
+               RunDeclaration(Declared(implementation_name="moos-ivp-helm", implementation_version="2.1.0")))
+    html, md, _ = _render(d)
+    assert "<h1>helmcheck backseat certificate — moos-ivp-helm@2.1.0</h1>" in html
+    assert "Backseat: moos-ivp-helm@2.1.0 on /dev/pts/5" in md
+    assert "--exec ran" not in html.split('id="contents"')[0] and "IVER3-EMU" not in md.split("| PASS |")[0]
+
+
+@pytest.mark.unverifiable  # hand-made results, not a run
+def test_the_precision_remark_says_what_it_means_in_the_html_banner_and_the_markdown(tmp_path):
+    """Issue 43: one sentence — the timing faults that could pass at this scale, and the time
+    scale that judges timing to the profile's tolerance — in every rendering's banner."""
+    from helmcheck.judge.linebudget import LineBudget
+
+    r = vehicle_results()
+    budget = LineBudget(k=20.0, baud=19200, latency_s=0.02, measured=True)
+    r["settings"]["line_budget"] = budget.as_dict()
+    for c in r["clauses"]:
+        if c["id"] == "RH-SRV-4":
+            c["precision"] = {"nominal_s": 0.65, "widened_s": 6.21, "time_scale": 20.0}
+    d = tmp_path / "coarse"
+    write_results_atomic(d, r)
+    html, md, _ = _render(d)
+    sentence = (f"Timing faults up to ±6.2 s could pass at ×20 (1 timing clause(s) judged coarser than "
+                f"RH-TIM-1's tolerance; RH-SRV-4 within ±6.2 s, nominal ±0.65 s); for timing at the "
+                f"profile's tolerance run at ×{budget.nominal_scale():g}.")
+    assert f'<p class="precision" id="precision">{sentence.replace(chr(39), "&#x27;")}</p>' in _banner_html(html)
+    assert sentence.replace("'", "'") in _banner_md(md).replace("\\", "")

@@ -144,3 +144,37 @@ def test_RH_SAF_5_operator_trigger_without_a_terminal_is_not_tested(tmp_path):
     for c in SAF:
         assert v[c]["verdict"] == "not-tested", (c, v[c])
         assert "terminal" in v[c]["reason"], v[c]["reason"]
+
+
+#: A surface mission whose Maximum Operation Time trips 15 s after its start: while V-60's servo
+#: dive is under way (the vehicle is under servo control and going down, not yet at the case's depth).
+DIVING_MIS = """helmcheck-mission 1
+# Its Maximum Operation Time trips (Stl) 15 s after its start, on a surface leg.
+max_time_s 15
+41.522698   -71.320000    0.0      2.0       0
+41.522698   -71.317300    0.0      2.0       0
+41.520000   -71.317300    0.0      2.0       0
+41.520000   -71.320000    0.0      2.0       0
+"""
+
+
+def test_RH_SAF_1_to_4_a_rule_that_trips_while_the_vehicle_dives_under_servo(tmp_path):
+    """The vehicle's own rule trips whatever the case is doing: 15 s after the start, while the servo
+    dive that brings the vehicle under water for RH-SAF-3 (V-60) is under way. The cases take the
+    violation where it comes (the approach ends there) and judge the lockout, the ascent and the
+    surface from it: RH-SAF-1..4 PASS, nothing INCONCLUSIVE (×20, 115200 baud)."""
+    missions = tmp_path / "missions"
+    missions.mkdir()
+    (missions / "timed.mis").write_text(DIVING_MIS)
+    prof = tmp_path / "tester.toml"
+    prof.write_text('baud = 115200\nviolation_trigger = "mission-rule"\nviolation_mission = "timed.mis"\n'
+                    'violation_after_s = 15.0\nend_mission = "short.mis"\nsrp_mission = "srp.mis"\n')
+    out = tmp_path / "r"
+    with EmulatorProcess(["--missions", str(missions)], time_scale=20.0, baud=115200) as emu:
+        argv = _argv(emu.port, prof, out)
+        argv[argv.index("--time-scale") + 1] = "20"
+        p = subprocess.run(argv, capture_output=True, text=True, timeout=240, stdin=subprocess.DEVNULL)
+    v = _verdicts(out)
+    assert {c: v[c]["verdict"] for c in SAF + ["RH-SAF-5"]} == {c: "pass" for c in SAF + ["RH-SAF-5"]}, \
+        {c: v[c]["reason"] for c in SAF + ["RH-SAF-5"]}
+    assert p.returncode == 0, p.stdout

@@ -353,3 +353,40 @@ def test_socat_fraction_unit_detected_from_data_property(tmp_path_factory, encod
         return
     assert meta.time_unit == ("ns" if encoding == "ns-9" else "us")
     assert [c.t for c in chunks] == pytest.approx(truth, abs=1e-9)
+
+
+# ============================================================================ the line model
+
+def _judged(name: str, line=None) -> dict:
+    out = check_log(HERE / name, role="vehicle", line=line)
+    return {c["id"]: c for c in out.clauses}
+
+
+def test_a_capture_of_a_vehicle_every_answer_late_fails_RH_ACK_2_judged_clean():
+    """``late_v.log``: the emulator with every line processed 2.5 s after it came (socat -v between
+    ptys): told the link was clean, every late ``$ACK`` is the vehicle's (RH-ACK-2 FAIL); told
+    nothing, the same lateness on every answer in a row is the vehicle's too (no line repeats it)."""
+    assert _judged("late_v.log", "clean")["RH-ACK-2"]["verdict"] == "fail"
+    assert _judged("late_v.log")["RH-ACK-2"]["verdict"] in ("fail", "inconclusive")
+
+
+def test_a_capture_of_one_broken_line_fails_judged_clean_and_names_line_clean_otherwise(tmp_path):
+    """``once_bad_v.log``: one ``$OSI`` with its checksum one bit off, once, on a pty (its vehicle:
+    ``once_bad_vehicle.py``). Judged clean: RH-FRM-2 FAIL. Judged as the capture says (nothing: a
+    line that can damage bytes): given to the line, and the verdict line says to run with
+    ``--line clean`` if the link was a pty or TCP."""
+    import subprocess
+    import sys
+    assert _judged("once_bad_v.log", "clean")["RH-FRM-2"]["verdict"] == "fail"
+    assert _judged("once_bad_v.log")["RH-FRM-2"]["verdict"] != "fail"
+    run = subprocess.run([sys.executable, "-m", "helmcheck", "check-log", str(HERE / "once_bad_v.log"), "--role",
+                          "vehicle", "--report-dir", str(tmp_path / "r")], capture_output=True, text=True, timeout=120)
+    first = run.stdout.splitlines()[0]
+    assert "run with --line clean" in first and run.returncode == 0, (run.returncode, run.stdout, run.stderr)
+    run = subprocess.run([sys.executable, "-m", "helmcheck", "check-log", str(HERE / "once_bad_v.log"), "--role",
+                          "vehicle", "--line", "clean", "--report-dir", str(tmp_path / "c")],
+                         capture_output=True, text=True, timeout=120)
+    assert run.returncode == 1 and "RH-FRM-2" in run.stdout.splitlines()[0], run.stdout
+    import json
+    assert json.loads((tmp_path / "c" / "results.json").read_text())["line_model"] == {
+        "kind": "clean", "why": "--line clean given"}

@@ -12,7 +12,7 @@ The examples: every line of a help that runs helmcheck (``helmcheck …``, or a 
 * parsed by the real command line (no usage error), and every file or directory it reads must
   be in the working directory a user would have (:func:`sandbox`: a certification of the
   emulator in ``reports/vehicle`` and an earlier one in ``reports/previous``, a capture, an archive of logs, a profile, a replay file, the
-  checkout's ``helmcheck/`` and ``tests/``) or be written by an example before it in the same
+  checkout's ``helmcheck/``, ``tests/`` and ``examples/``) or be written by an example before it in the same
   help;
 * run, in a copy of that working directory, with ``bash`` and the virtual environment's
   ``helmcheck`` and ``python3`` first on the PATH (as after ``. .venv/bin/activate``) when it
@@ -213,6 +213,7 @@ def sandbox(tmp_path_factory) -> Path:
     d = tmp_path_factory.mktemp("help-sandbox")
     os.symlink(ROOT / "helmcheck", d / "helmcheck")
     os.symlink(ROOT / "tests", d / "tests")
+    os.symlink(ROOT / "examples", d / "examples")
     with EmulatorProcess(time_scale=20.0, baud=115200) as emu:
         code = cli_main(["certify", "vehicle", "--port", emu.port, "--time-scale", "20", "--baud", "115200",
                          "--profile", str(ROOT / "helmcheck" / "profiles" / "emulator.toml"), "--select",
@@ -242,6 +243,8 @@ def _kind(argv: list[str]) -> tuple[str, str]:
         return ("live" if RUN_ALL else "skip"), "it needs a vehicle on its port"
     if ("--exec" in argv and argv[:2] == ["certify", "backseat"]) or argv[:1] == ["diff"]:
         return ("run" if RUN_ALL else "skip"), "it takes more than a few seconds"
+    if argv[:2] == ["certify", "backseat"] and "--plan" in argv:
+        return "run", ""  # prints the plan and exits: no port
     if argv[:1] == ["emulate"] or (argv[:2] == ["certify", "backseat"] and "--exec" not in argv):
         return "serve", "it serves until stopped"
     return "run", ""

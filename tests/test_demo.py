@@ -74,3 +74,25 @@ def test_a_fresh_clone_is_clean_after_the_demo_and_its_certificate_is_not_dirty(
     res = json.loads((clone / "demo-out" / "results.json").read_text())
     revision = res["identity"]["tester"]["revision"]
     assert revision != "unknown" and not revision.endswith("-dirty"), revision
+
+
+@pytest.mark.skipif(os.environ.get("HELMCHECK_DEMO_CLONE") != "1", reason="set HELMCHECK_DEMO_CLONE=1 (two minutes)")
+@pytest.mark.skipif(not _checkout() or shutil.which("make") is None, reason="not a git checkout, or no make")
+def test_make_demo_in_a_fresh_clone_says_what_it_does_and_shows_no_warning_box(tmp_path):
+    """Issue 43: a newcomer's ``make demo`` — a new ``.venv``, the install, the certification —
+    says what it is doing while pip is quiet, shows no boxed warning, and its exploration line
+    says what the exploration did."""
+    clone = tmp_path / "clone"
+    assert _git("clone", "--quiet", str(ROOT), str(clone), cwd=tmp_path).returncode == 0
+    env = {k: v for k, v in os.environ.items() if k not in ("VIRTUAL_ENV", "PYTHONPATH")}
+    done = subprocess.run(["make", "demo", f"PYTHON={sys.executable}"], cwd=clone, capture_output=True, text=True,
+                          timeout=900, env=env)
+    shown = done.stdout + done.stderr
+    assert done.returncode == 0, shown
+    first = shown.splitlines()[:12]
+    assert first[0] == "setting up .venv/ (once, about a minute): a virtual environment for helmcheck", first
+    assert any(ln.strip().startswith("installing helmcheck from this checkout") for ln in first), first
+    assert "Warning" not in shown and "!!" not in shown and "*****" not in shown, shown[:3000]
+    explored = [ln for ln in shown.splitlines() if " exploration " in ln and ln.startswith("[")]
+    assert explored and " sequences and " in explored[-1] and " steps in " in explored[-1] \
+        and "budget of " in explored[-1], explored

@@ -71,8 +71,9 @@ def test_a_faulty_vehicle_diverges_from_the_emulator_and_its_replay_fails_again(
     with serve(lambda t: make_core(None, k, t)) as pa, serve(lambda t: make_core(m, k, t)) as pb:
         code, out, doc = run_diff(capsys, pa, pb, profile_file, rdir, k, budget, seed)
     assert code == 1, out
-    line = out.strip().splitlines()[-1]
+    *_, line, where = out.strip().splitlines()
     assert line.startswith("diff: DIVERGED at step "), line
+    assert where == f"report: {rdir / 'diff.json'}"  # like every command, where the report is
     assert "B also fails " in line and BOOKED[name] & set(line.split("B also fails ", 1)[1].split(", ")), line
     assert "A also fails" not in line
     div = doc["result"] == "diverged" and doc["divergence"]
@@ -118,7 +119,8 @@ def test_the_emulator_and_the_emulator_with_other_freedoms_do_not_diverge(profil
     with serve(lambda t: make_core(None, k, t)) as pa, serve(lambda t: free_core(k, t, OTHER_CHOICES)) as pb:
         code, out, doc = run_diff(capsys, pa, pb, profile_file, rdir, k, 10.0, 7)
     assert code == 0, out
-    assert out.strip().splitlines()[-1].startswith("diff: no divergence in "), out
+    assert out.strip().splitlines()[-2].startswith("diff: no divergence in "), out
+    assert out.strip().splitlines()[-1] == f"report: {rdir / 'diff.json'}"
     assert doc["result"] == "no divergence" and doc["divergence"] is None
     assert doc["stats"]["sequences"] >= 5 and time.monotonic() - t0 < 40
     assert doc["sides"]["A"]["findings"] == [] and doc["sides"]["B"]["findings"] == []

@@ -286,6 +286,70 @@ def test_output_queue_is_bounded():
     assert core.stats["dropped_out"] > 0
 
 
+@pytest.mark.parametrize("reading", ["queue", "drop"])
+def test_an_over_asked_line_queues_or_drops_as_its_overrun_reading_says(reading):
+    """Ten ``$OSD,G,C,S,P`` a second on 19200 baud ask for about 3.2 kB/s of replies on a 1.92 kB/s
+    line (RH-ACK-2's transmit time, 10 bits a byte). ``queue``: every request is answered, later
+    and later; ``drop``: a poll whose replies could not start within the ACK window goes
+    unanswered whole, every reply sent left about within it, and a command is still answered.
+    Either way the meter names the overrun."""
+    from helmcheck.emulator.freedoms import DEFAULT_SETTINGS
+    from helmcheck.emulator.outload import describe
+
+    core = make_core(k=1.0, baud=19200, settings=DEFAULT_SETTINGS.replace(overrun=reading))
+    sent_at: dict[bytes, list[float]] = {}
+    released: list[tuple[bytes, float, float]] = []
+    core.on_release = lambda raw, queued, now: released.append((raw, queued, now))
+    out = b""
+    now = 0.0
+    for i in range(200):  # 20 s of polls at 10 Hz, and a command every second
+        now = i * 0.1
+        out += core.feed(frame("OSD,G,C,S,P") + (frame("OPOS,41.52,-71.32,1.0,42,15") if i % 10 == 5 else b""), now)
+        for w in range(50):
+            nxt = core.next_wakeup()
+            if nxt is None or nxt > now + 0.1:
+                break
+            out += core.tick(max(now, nxt))
+    if reading == "drop":  # what was still queued goes out (the queue holds about a second)
+        for w in range(100):
+            nxt = core.next_wakeup()
+            if nxt is None or nxt > now + 2.0:
+                break
+            out += core.tick(nxt)
+    acks8 = [a for a in acks(out) if a[0] == 8]
+    lags = [now_ - queued for raw, queued, now_ in released]
+    summary = core.load.summary(ack_window_s=1.0)
+    assert summary is not None and summary["over_capacity"], summary
+    assert 2500 < summary["asked_Bps"] < 4000, summary  # about 3.2 kB/s asked of a 1.92 kB/s line
+    if reading == "queue":
+        assert core.stats["dropped_out"] == 0
+        assert max(lags) > 5.0  # behind by more every second
+        assert core.pending_output > 10_000
+    else:
+        assert core.stats["dropped_out"] > 0 and summary["dropped_bytes"] == core.stats["dropped_out"]
+        # once ten seconds of over-asking made it an overrun, no poll waits past the ACK window (and
+        # the replies of its own request on the line)
+        assert max(now_ - queued for raw, queued, now_ in released if queued > 12.0) <= 1.0 + 0.2
+        assert 100 < len(acks8) < 200  # some polls answered, not all
+        assert len([a for a in acks(out) if a[0] == 6]) == 20  # every command answered
+    text = describe(summary)
+    assert "$OSD polls asked for" in text and "1.92 kB/s line (19200 baud)" in text
+    assert ("were dropped" in text) == (reading == "drop")
+
+
+def test_a_burst_of_polls_is_queued_not_dropped_and_is_no_overrun():
+    """``overrun = "drop"`` sheds polls only while the requests of the last ten seconds ask for
+    more than the line carries: a burst (a backseat's buffered polls arriving at once, a stalled
+    reader) waits its turn, and the meter names no overrun for it."""
+    from helmcheck.emulator.freedoms import DEFAULT_SETTINGS
+
+    core = make_core(k=1.0, baud=19200, settings=DEFAULT_SETTINGS.replace(overrun="drop"))
+    for i in range(10):
+        core.feed(frame("OSD,G,C,S,P"), 5.0 + 0.001 * i)  # ten polls at once, after 5 s of nothing
+    assert core.stats["dropped_out"] == 0 and core.backlog_s(5.01) > 1.0
+    assert core.load.summary(ack_window_s=1.0) is None
+
+
 def test_model_lists_trimmed_for_bounded_memory():
     core = make_core()
     for i in range(2000):

@@ -92,10 +92,49 @@ def test_a_field_count_or_a_range_only_a_reading_sets_stays_RH_ACK_3(tmp_path, c
     assert verdict(v, "RH-ACK-3") == "fail", v["RH-ACK-3"]
 
 
+@pytest.mark.parametrize("control,mode", [("OMP,8080808080,00,60", "M"), ("OMS,90,2,20,0,60", "A")])
+def test_an_OJW_past_the_last_waypoint_accepted_under_remote_control_is_RH_JW_1(tmp_path, control, mode):
+    """The range of n is RH-JW-1's, whatever control the $OJW meets (the row under M is RH-JW-2's:
+    it ends remote control): a data check's clause, not the row's (the traceability table)."""
+    ack = {"M": "ACK,10,0,0", "A": "ACK,9,0,0"}[mode]
+    rec = start() + send(0.5, control, ack) + poll(0.7, mode=mode, dist=150.0, speed=1.0)
+    v = judge(tmp_path, rec + send(1.0, "OJW,4", "ACK,7,0,0") + poll(1.5, mode="N", wp=3, dist=150.0, speed=1.0))
+    assert verdict(v, "RH-JW-1") == "fail", v["RH-JW-1"]
+    assert verdict(v, "RH-JW-2") != "fail", v["RH-JW-2"]
+
+
+@pytest.mark.parametrize("labels,mission,cmd,ack_type,clause", [
+    ("", False, "OLOGL,1,2,3,4,5,6,7,8,9,10,11,12,13", 5, "RH-LOG-1"),   # 13 labels: RH-LOG-1's 1–12
+    ("", False, "OLOGL,a,,b", 5, "RH-LOG-1"),                              # an empty label (RH-RD-9)
+    ("OLOGL,1,2,3,4,5,6,7,8,9,10,11,12", True, "OLOGD,1,2,3,4,5,6,7,8,9,10,11,12,13", 4, "RH-LOG-2"),
+])
+def test_a_count_a_clause_states_accepted_is_booked_on_that_clause(tmp_path, labels, mission, cmd, ack_type,
+                                                                   clause):
+    """A count the grammar refuses where a clause states it (``$OLOGL`` 1–12 labels, ``$OLOGD`` 12
+    values) is that clause's rule broken, not only RH-ACK-3's "wrong number of fields" (the
+    traceability table); a conforming refusal passes it."""
+    rec = poll(0.0, mode="S")
+    if labels:
+        rec += send(0.1, labels, "ACK,5,0,0")
+    rec += (send(0.2, "OMSTART,0,0,0,0,conformance.mis,", "ACK,3,0,0") + poll(0.3, mode="N", dist=150.0, speed=2.0)
+            if mission else [])
+    bad = rec + send(1.0, cmd, f"ACK,{ack_type},0,0") + poll(1.5, mode="N" if mission else "S", dist=150.0)
+    v = judge(tmp_path, bad)
+    assert verdict(v, clause) == "fail", v[clause]
+    assert verdict(v, "RH-ACK-3") != "fail", v["RH-ACK-3"]
+    assert "(related: RH-ACK-3)" in v[clause]["reason"], v[clause]["reason"]  # named, not booked
+    ok = rec + send(1.0, cmd, f"ACK,{ack_type},1,{24 if ack_type == 5 else 25}") + poll(1.5, mode="N" if mission else "S",
+                                                                                     dist=150.0)
+    (tmp_path / "ok").mkdir()
+    v = judge(tmp_path / "ok", ok)
+    assert verdict(v, clause) != "fail", v[clause]
+
+
 @pytest.mark.parametrize("cmd,answer,clause", [
     ("OMSTART,0,0,0,0,sub/../../conformance.mis,", "ACK,3,1,1", "RH-MSN-1"),   # followed out: not found
     ("OMSTART,0,0,0,0,../conformance.mis,", "ACK,3,0,0", "RH-MSN-1"),        # accepted
-    ("OMSTART,0,0,0,0,conformance.mis,../x.srp", "ACK,3,1,31", "RH-MSN-1"),   # the SRP name too
+    ("OMSTART,0,0,0,0,conformance.mis,../srp.mis", "ACK,3,0,0", "RH-MSN-1"),  # the SRP name too (30 or 31:
+    # both readings, helmcheck/model/readings.py srp_bad_path; accepted is neither)
     ("OMLOAD,sub/../../x.mis,0", "ACK,2,1,1", "RH-MSN-1"),
     ("OMLOAD,../conformance.mis,0", "ACK,2,0,0", "RH-MSN-1"),
     ("OMLOAD,/etc/x.mis,0", "ACK,2,1,30", "RH-ACK-3"),    # a wrong number only: RH-ACK-3, as elsewhere
@@ -103,10 +142,11 @@ def test_a_field_count_or_a_range_only_a_reading_sets_stays_RH_ACK_3(tmp_path, c
 ])
 def test_an_OMSTART_name_or_flag_the_reading_RH_RD_6_rules_out_is_booked_on_the_clause_it_reads(
         tmp_path, cmd, answer, clause):
-    """RH-RD-6 spells out the rh5 ``$OMSTART``: its names follow RH-MSN-1's path rules (err 30), its
-    flags are RH-MSN-2's. A reading is not booked; the clause it reads is, not only RH-ACK-3. A name
-    the path rules reject, answered with a look-up's error (1, 31), was looked up, not rejected:
-    RH-MSN-1; any other wrong number is RH-ACK-3's, as for every command."""
+    """RH-RD-6 spells out the rh5 ``$OMSTART``: its mission name follows RH-MSN-1's path rules (err
+    30), its flags are RH-MSN-2's; an SRP name outside the directory may be refused with 30 or 31
+    (the readings table), never accepted. A reading is not booked; the clause it reads is, not only
+    RH-ACK-3. A name the path rules reject, answered with a look-up's error (1), was looked up, not
+    rejected: RH-MSN-1; any other wrong number is RH-ACK-3's, as for every command."""
     rec = poll(0.0, mode="S") + send(0.1, cmd, answer) + poll(0.5, mode="S")
     v = judge(tmp_path, rec)
     assert verdict(v, clause) == "fail", v[clause]
@@ -455,3 +495,27 @@ def test_RH_OMW_3_an_OMW_with_an_empty_depth_2_refused_is_RH_OMW_3_s(tmp_path):
                                                                                     speed=2.0)
     v = judge(tmp_path, rec)
     assert failed(v) == {"RH-OMW-3"}, {c: v[c]["reason"] for c in failed(v)}
+
+
+# ===================================== a lockout's after-effect: RH-SAF-2's, also inside RH-SAF-1's case
+
+@pytest.mark.parametrize("replayed", [True, False])
+def test_a_command_refused_in_the_lockout_carried_out_after_it_is_RH_SAF_2_even_in_the_lockout_s_case(
+        tmp_path, replayed):
+    """Inside the lockout's own case (V-58, RH-SAF-1) a servo control that comes back after the
+    lockout — the $OMS the lockout refused, carried out when it ended — broke RH-SAF-2's rule ("a
+    command sent during the lockout has no effect even after the lockout ends"; the traceability
+    table): booked there, RH-SAF-1 named as related, not failed. A vehicle that stays in N passes."""
+    rec = start() + [(0.5, "!", "case V-58 RH-SAF-1: The lockout refuses everything but $OSD for lockout_s")]
+    rec += poll(1.0, mode="N", err="Sfp", dist=150.0)  # a violation the vehicle raised by itself
+    rec += [(1.5, ">", "OMS,90,2,20,0.5,60"), (1.51, "<", "ACK,9,1,26")]
+    rec += poll(2.0, mode="N", err="Sfp", dist=150.0)
+    rec += poll(30.0, mode="A" if replayed else "N", err="Sfp", dist=150.0, speed=0.5)  # the lockout over
+    v = judge(tmp_path, rec)
+    if replayed:
+        assert verdict(v, "RH-SAF-2") == "fail", v["RH-SAF-2"]
+        assert verdict(v, "RH-SAF-1") != "fail", v["RH-SAF-1"]
+        related = v["RH-SAF-2"]["reason"].rpartition("(related: ")[2]
+        assert "RH-SAF-1" in related, v["RH-SAF-2"]["reason"]
+    else:
+        assert not failed(v), {c: v[c]["reason"] for c in failed(v)}

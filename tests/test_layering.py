@@ -66,6 +66,7 @@ TOP_LEVEL = {
     "spelling": "foundation",  # did you mean …: the closest known words; standard library only
     "clauses": "foundation",  # the clause catalogue; standard library and the spec package data
     "reference_docs": "foundation",  # the site's generated reference pages; imports profile*, clauses
+    "rules": "foundation",  # the traceability table (spec/rules.toml) and its page; imports clauses
     "outputs": "reports",  # report directories and output files; imports failures, reports.atomic
     "demo": "certify",  # `python -m helmcheck.demo`; imports the emulator and the vehicle certifier
     "pytest_plugin": "commands",  # the pytest11 entry point; runs the certifiers through their library entries

@@ -83,15 +83,21 @@ def test_the_emulator_profile_names_what_the_emulator_ships():
 
 
 def test_empty_end_or_srp_mission_makes_its_case_not_tested():
+    """No srp_mission: its case is NOT-TESTED before it runs. No end_mission: RH-MSN-4's case runs the
+    test mission in rh5 (the vehicle's remaining time, ``$OSI`` field 13, says whether its end can be
+    waited for; NOT-TESTED in the case otherwise), and is NOT-TESTED before it runs where the ``$OSI``
+    shows no remaining time (rh4, rh3)."""
     from helmcheck.certify.vehicle.catalogue import CASES, unmet_need
     from helmcheck.profile import emulator_profile
     end = next(c for c in CASES if c.subject == "RH-MSN-4")
     srp = next(c for c in CASES if c.subject == "RH-SAF-4" and "srp_mission" in c.needs)
     emu = emulator_profile()
     assert unmet_need(end, emu) is None and unmet_need(srp, emu) is None
-    assert "end_mission" in unmet_need(end, emu.replace(end_mission=""))
+    assert unmet_need(end, emu.replace(end_mission="")) is None
+    assert "end_mission" in unmet_need(end, emu.replace(end_mission="", protocol="rh4", depth_unit="ft",
+                                                        osi_fields=17))
     assert "srp_mission" in unmet_need(srp, emu.replace(srp_mission=""))
-    assert "end_mission" in unmet_need(end, DEFAULT) and "srp_mission" in unmet_need(srp, DEFAULT.replace(
+    assert unmet_need(end, DEFAULT) is None and "srp_mission" in unmet_need(srp, DEFAULT.replace(
         fault_injection="oxflt"))
 
 

@@ -20,7 +20,7 @@ import pytest
 from hypothesis import given, strategies as st
 
 from helmcheck.certify.backseat.progress import BAR_WIDTH as BS_BAR, PLAIN_EVERY_S as BS_EVERY, Progress as BSProgress
-from helmcheck.certify.vehicle.progress import BAR_WIDTH, PLAIN_EVERY_S, Progress, budget_text
+from helmcheck.certify.vehicle.progress import BAR_WIDTH, PLAIN_EVERY_S, Progress, budget_text, explored_text
 from helmcheck.monitor.view import STATUS_EVERY_S, StatusLines
 
 BAR_CHARS = "━╸╺"
@@ -139,10 +139,30 @@ def test_the_exploration_off_a_terminal_is_a_line_at_its_start_then_every_10_s()
     p.start(3)
     for n in range(1, 40):
         clock.t += 1.0
-        p.explore(n, float(n), 30.0, 20.0 * n, 1500.0)
+        p.explore(n, float(n), 30.0, 20.0 * n, 1500.0, steps=12 * n)
     lines = [ln for ln in out.getvalue().splitlines() if ln.startswith("exploration:")]
     assert len(lines) == 1 + (39 - 1) // int(PLAIN_EVERY_S)
-    assert lines[0] == "exploration: 3 % of the budget (1 of 30 s wall), 1 sequence so far"
+    assert lines[0] == "exploration: 1 sequence and 12 steps run so far, 3 % of the budget (1 of 30 s wall)"
+
+
+def test_the_exploration_says_what_it_did_when_it_ends():
+    """Issue 43: a short exploration (all its examples run long before its budget) must not read
+    as skipped: its last line says the sequences and steps it ran, in how long, and its budget."""
+    stats = {"examples": 10, "ran": 10, "steps": 214, "failures": 0, "budget_s": 30.0, "budget_vehicle_s": 1500.0,
+             "budget_spent": False, "wall_s": 6.846, "vehicle_s": 274.5, "outcome": "pass"}
+    out = io.StringIO()
+    p = Progress(stream=out)
+    p.start(1)
+    p.step("exploration", explored_text(stats))
+    assert out.getvalue().splitlines()[-1] == (
+        "[1/1] exploration 10 sequences and 214 steps in 6.8 s; all 10 examples asked, within its budget of "
+        "30 s wall or 1500 s vehicle time")
+    spent = dict(stats, ran=120, steps=2400, failures=1, budget_spent=True, wall_s=30.2, examples=400)
+    assert explored_text(spent) == ("120 sequences and 2400 steps in 30.2 s; its budget (30 s wall or 1500 s "
+                                    "vehicle time, whichever ends first) spent before the 400 examples asked; "
+                                    "1 failing sequence")
+    assert explored_text({"examples": 0, "ran": 0, "outcome": "not run (no $OMSTOP claimed)"}) == \
+        "not run (no $OMSTOP claimed)"
 
 
 @given(ran=st.integers(0, 10_000), wall=st.floats(0, 100), wall_budget=st.floats(1, 1000),

@@ -9,9 +9,13 @@ so the clone's code and data are what run. A command whose last line ends ``# �
 must exit with N and print TEXT: every ``…``-separated fragment of it, the first at the start of
 a line or after ``: ``.
 
+Every journey runs twice in the same clone, the second time over what the first left in
+``out/``: a block a newcomer runs again must still print what the README says (the commands
+pass ``--overwrite`` where an earlier run is in the way).
+
 Blocks marked ``slow`` (the whole vehicle certification, about two minutes at ×20) run only with
 ``HELMCHECK_WALKTHROUGH=all`` (the ``vehicle-full`` journey); the others run in the suite, each
-journey a test of its own (10 to 45 s, mostly waiting on scaled time).
+journey a test of its own (25 to 65 s for both runs, mostly waiting on scaled time).
 """
 
 from __future__ import annotations
@@ -145,30 +149,50 @@ def _environment(clone: Path) -> dict[str, str]:
     return env
 
 
-@pytest.mark.parametrize(("journey", "blocks"), PARAMS)
-def test_the_readme_walkthrough_runs_as_written(journey, blocks, clone, tmp_path):
-    results = tmp_path / "results"
-    results.mkdir()
-    text = script(blocks, results)
+def run_twice(journey: str, blocks: list[Block], clone: Path, tmp_path: Path, timeout: float) -> list[str]:
+    """The journey, then the same journey again in the same clone (its ``out/`` as the first run
+    left it); what a checked command did otherwise than the README says, run by run."""
     checked = [c for b in blocks for c in b.commands if c.rc is not None]
     assert checked, f"journey {journey}: no command says what it shows (# → TEXT, exit N)"
-    log = tmp_path / "journey.log"
-    timeout = 600 if journey == "vehicle-full" else 240
-    with open(log, "wb") as f:
-        p = subprocess.Popen(["bash", "-c", text], cwd=clone, env=_environment(clone), stdin=subprocess.DEVNULL,
-                             stdout=f, stderr=subprocess.STDOUT, start_new_session=True)
-        try:
-            p.wait(timeout=timeout)
-        except subprocess.TimeoutExpired:
-            os.killpg(p.pid, signal.SIGKILL)
-            p.wait()
-            pytest.fail(f"journey {journey} still running after {timeout} s:\n{log.read_text(errors='replace')}")
-    for n, c in enumerate(checked):
-        shown = " ".join(line.strip() for line in c.lines)
-        out = (results / f"{n}.out").read_text(errors="replace")
-        rc = int((results / f"{n}.rc").read_text())
-        assert rc == c.rc and shows(out, c.text), (
-            f"README: `{shown}`\nsays it shows {c.text!r} and exits {c.rc}; it exited {rc} and printed:\n{out[-3000:]}")
+    wrong = []
+    for run in ("first", "again"):
+        results = tmp_path / f"results-{run}"
+        results.mkdir()
+        log = tmp_path / f"journey-{run}.log"
+        with open(log, "wb") as f:
+            p = subprocess.Popen(["bash", "-c", script(blocks, results)], cwd=clone, env=_environment(clone),
+                                 stdin=subprocess.DEVNULL, stdout=f, stderr=subprocess.STDOUT, start_new_session=True)
+            try:
+                p.wait(timeout=timeout)
+            except subprocess.TimeoutExpired:
+                os.killpg(p.pid, signal.SIGKILL)
+                p.wait()
+                pytest.fail(f"journey {journey} ({run}) still running after {timeout} s:\n"
+                            f"{log.read_text(errors='replace')}")
+        for n, c in enumerate(checked):
+            shown = " ".join(line.strip() for line in c.lines)
+            out = (results / f"{n}.out").read_text(errors="replace")
+            rc = int((results / f"{n}.rc").read_text())
+            if rc != c.rc or not shows(out, c.text):
+                wrong.append(f"README, run {run}: `{shown}`\nsays it shows {c.text!r} and exits {c.rc}; it exited "
+                             f"{rc} and printed:\n{out[-3000:]}")
+    return wrong
+
+
+@pytest.mark.parametrize(("journey", "blocks"), PARAMS)
+def test_the_readme_walkthrough_runs_as_written(journey, blocks, clone, tmp_path):
+    """Twice: a newcomer retrying a step gets what the README says, not a refusal."""
+    wrong = run_twice(journey, blocks, clone, tmp_path, 600 if journey == "vehicle-full" else 240)
+    assert not wrong, "\n\n".join(wrong)
+
+
+def test_a_block_that_cannot_run_again_is_caught(tmp_path):
+    """The second run is judged too: a block that works once only fails it."""
+    blocks = walkthroughs("<!-- walkthrough: x -->\n```sh\n"
+                          "mkdir -p out && mkdir out/once && echo made: once     # → made: once, exit 0\n```\n")
+    (tmp_path / "clone").mkdir()
+    wrong = run_twice("x", blocks, tmp_path / "clone", tmp_path, 30)
+    assert len(wrong) == 1 and wrong[0].startswith("README, run again: `mkdir"), wrong
 
 
 def test_every_journey_of_the_readme_is_a_walkthrough():

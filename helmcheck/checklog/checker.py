@@ -42,9 +42,10 @@ from pathlib import Path
 from typing import BinaryIO, Callable, Optional
 
 from ..clauses import vehicle_clauses
-from ..grammar.wirelog import FROM_VEHICLE, HEADER_LINES, TO_VEHICLE
+from ..grammar.wirelog import FROM_VEHICLE, HEADER_LINES, TO_VEHICLE, WireEvent
 from ..judge.backseat import BS_CLAUSES, BackseatObserver
 from ..judge.ledger import Evidence as LedgerEvidence, Ledger
+from ..judge.linemodel import PREFIX as LINE_PREFIX, given, line_note
 from ..judge.runfacts import RunFacts
 from ..judge.vehicle import VehicleObserver
 from ..judge.wire import Decodings
@@ -97,7 +98,7 @@ class CheckOutcome:
 def check_log(path: Path | str, *, profile: Profile = DEFAULT, role: Optional[str] = "both",
               catalog: Optional[MissionCatalog] = None, time_scale: Optional[float] = None,
               swap: bool = False, progress: Optional[Callable[[int], None]] = None,
-              parallel: Optional[bool] = None) -> CheckOutcome:
+              parallel: Optional[bool] = None, line: Optional[str] = None) -> CheckOutcome:
     """Check one log file. ``OSError`` if it cannot be read, :class:`LogFormatError` if it is
     no known log format.
 
@@ -107,6 +108,10 @@ def check_log(path: Path | str, *, profile: Profile = DEFAULT, role: Optional[st
 
     ``role=None``: the role the run that wrote the log tested, as its header names it
     (:mod:`.origin`), else both.
+
+    ``line``: ``clean`` or ``noisy`` (``--line``) overrides the log's ``line model:`` note; None
+    takes the log's, and a log without one (a ``socat -v`` capture) is noisy
+    (:mod:`helmcheck.judge.linemodel`).
 
     The file is judged as it was when the check began: a log still being written is checked up
     to the size it had then (in both processes alike)."""
@@ -125,7 +130,7 @@ def check_log(path: Path | str, *, profile: Profile = DEFAULT, role: Optional[st
         baud = meta.baud or profile.baud
         if parallel is None:
             parallel = role == "both" and sum(sizes) >= PARALLEL_BYTES and cores() > 1
-        job = ([str(p) for p in session.files], fmt, profile, scale, meta.resolution, baud, swap, sizes)
+        job = ([str(p) for p in session.files], fmt, profile, scale, meta.resolution, baud, swap, sizes, line)
         side = None
         if parallel and role == "both":
             try:
@@ -134,7 +139,7 @@ def check_log(path: Path | str, *, profile: Profile = DEFAULT, role: Optional[st
                 side = None
         try:
             checker = SessionJudge(profile, role, catalog, scale, meta.resolution, baud,
-                               judge_backseat=side is None)
+                                   judge_backseat=side is None, line=line)
             sha = _feed(files, sizes, checker, fmt, meta, swap, progress, session.missing)
             if side is not None:
                 try:
@@ -197,7 +202,7 @@ def _feed(files: list[BinaryIO], sizes: list[int], checker: "SessionJudge", fmt:
 
 
 def _backseat_entries(paths: list[str], fmt: str, profile: Profile, scale: float, resolution: float, baud: int,
-                      swap: bool, sizes: list[int]) -> tuple[list, str]:
+                      swap: bool, sizes: list[int], line: Optional[str] = None) -> tuple[list, str]:
     """The backseat role of a check on its own (the side job of a parallel check) over the first
     ``sizes[i]`` bytes of each segment: its ledger entries, and the SHA-256 of the bytes it read."""
     with ExitStack() as stack:
@@ -205,7 +210,7 @@ def _backseat_entries(paths: list[str], fmt: str, profile: Profile, scale: float
         fmt2, meta = _head(files[0], Path(paths[0]), sizes[0])
         if fmt2 != fmt:
             raise LogFormatError(f"{paths[0]}: the file changed while it was being checked")
-        checker = SessionJudge(profile, "backseat", None, scale, resolution, baud)
+        checker = SessionJudge(profile, "backseat", None, scale, resolution, baud, line=line)
         sha = _feed(files, sizes, checker, fmt, meta, swap, None)
     return checker.backseat.ledger.entries(), sha  # type: ignore[union-attr]
 
@@ -341,7 +346,7 @@ class SessionJudge:
     a live session as they are written — the same judges, the same verdicts."""
 
     def __init__(self, profile: Profile, role: str, catalog, scale: float, resolution: float, baud: int,
-                 judge_backseat: bool = True):
+                 judge_backseat: bool = True, line: Optional[str] = None):
         self.profile = profile
         self.role = role
         lines = Decodings(profile)  # each line read once, whichever roles read it
@@ -363,6 +368,10 @@ class SessionJudge:
         self._records = {TO_VEHICLE: 0, FROM_VEHICLE: 0, NOTE: 0, UNREADABLE: 0}  #: per direction
         self._bytes = {TO_VEHICLE: 0, FROM_VEHICLE: 0}
         self.last_t = 0.0
+        #: ``--line`` given: its note goes first, and the log's own ``line model:`` notes are not read
+        self.line_given = line is not None
+        if line is not None:
+            self._note(WireEvent(0.0, NOTE, b"", line_note(given(line)), 0))
 
     @property
     def stats(self) -> dict:
@@ -389,6 +398,11 @@ class SessionJudge:
             for side in self.sides:
                 side.unreadable(c)  # type: ignore[arg-type]
             return
+        if self.line_given and c.note.startswith(LINE_PREFIX):
+            return  # the user's --line stands (its note went first)
+        self._note(c)
+
+    def _note(self, c) -> None:
         for feed in self.feeds:
             feed(c)
         self.facts.feed(c)

@@ -64,13 +64,14 @@ class Options:
     strict: bool = False
     render: bool = True
     force: bool = False
+    line: Optional[str] = None  #: ``--line clean|noisy`` (None: each log's own note, else noisy)
     profile_arg: Optional[str] = None  #: --profile as given (for the recorded command)
     version: str = helmcheck.__version__  #: the helmcheck that planned the run
     revision: str = "unknown"
 
     def key_options(self) -> dict[str, Any]:
         return {"role": self.role, "time_scale": self.time_scale, "missions_sha256": self.missions_sha256,
-                "swap_directions": self.swap, "strict": self.strict, "render": self.render}
+                "swap_directions": self.swap, "strict": self.strict, "render": self.render, "line": self.line}
 
     def command(self, path: str) -> str:
         """``helmcheck check-log`` of this one file with these options."""
@@ -82,6 +83,7 @@ class Options:
         if self.time_scale is not None:
             words += ["--time-scale", f"{self.time_scale:g}"]
         words += ["--swap-directions"] * self.swap + ["--strict"] * self.strict + ["--no-render"] * (not self.render)
+        words += ["--line", self.line] if self.line else []
         return " ".join(shlex.quote(w) for w in words)
 
 
@@ -214,7 +216,7 @@ def judge_file(task: FileTask, opts: Options) -> dict[str, Any]:
             from ..emulator.missionfile import DirectoryCatalog
             catalog = DirectoryCatalog(list(how.missions))
         outcome = check_log(path, profile=how.profile, role=how.role, catalog=catalog,
-                            time_scale=opts.time_scale, swap=opts.swap, parallel=False)
+                            time_scale=opts.time_scale, swap=opts.swap, parallel=False, line=opts.line)
     except (OSError, LogFormatError) as e:
         why = f"cannot read: {e.strerror or e}" if isinstance(e, OSError) else str(e)
         return _entry(task, "unreadable", message=why)
@@ -224,6 +226,8 @@ def judge_file(task: FileTask, opts: Options) -> dict[str, Any]:
         (out / KEY_NAME).unlink(missing_ok=True)
         prepare_report_dir(out, overwrite=True)
         settings: dict[str, Any] = {"swap_directions": opts.swap}
+        if opts.line:
+            settings["line"] = opts.line
         if how.missions:
             settings["missions"] = [str(Path(d).resolve()) for d in how.missions]
         res = write_report_dir(out, outcome, how.profile, opts.command(task.path), strict=opts.strict,

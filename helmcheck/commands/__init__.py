@@ -12,7 +12,8 @@
 ``certify`` dispatches again, by role, to :mod:`.certify_vehicle_cmd` and
 :mod:`.certify_backseat_cmd`; :mod:`.ports` (opening the port a command names) and
 :mod:`.certificate_opts` (``--sign-key``, ``--operator``, ``--site``, ``--implementation``) are
-shared by the commands, and :mod:`.messages` the message forms they share (``report: PATH``).
+shared by the commands, :mod:`.lineopt` the ``--line clean|noisy`` option every command that reads
+a line takes, and :mod:`.messages` the message forms they share (``report: PATH``).
 This is the top layer: a command may import the drivers (:mod:`helmcheck.line`,
 :mod:`helmcheck.emulator`, :mod:`helmcheck.checklog`, :mod:`helmcheck.certify`) and the reports,
 and nothing below imports a command.

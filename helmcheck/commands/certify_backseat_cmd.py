@@ -16,7 +16,10 @@ earlier run without ``--overwrite``). Progress goes to standard error.
 
 With ``--exec CMD`` helmcheck starts the backseat itself once the port is open and stops it at
 the end (:mod:`helmcheck.certify.backseat.process`); a backseat that exits or dies before
-the end fails the run.
+the end fails the run. ``--plan`` prints each scenario's length at the time scale and baud, and
+why (:func:`~helmcheck.certify.backseat.certifier.plan_for`), and exits 0 without opening a port;
+the default ``--duration`` is that plan's. ``--overrun drop|queue`` chooses what the vehicle does
+with requests that ask for more replies than its line carries.
 
 This module turns the arguments into :class:`helmcheck.certify.backseat.certifier.Options`,
 checks every path and opens the port before anything runs, and calls
@@ -34,16 +37,31 @@ from typing import Callable, Optional
 
 from ..certify.backseat.scenarios import SCENARIOS
 from ..failures import UsageError
+from .lineopt import add_line_argument
 
 __all__ = ["add_arguments", "run", "EPILOG"]
 
 EPILOG = """\
-scenarios (default: all, in this order, over --duration):
+scenarios (default: all, in this order; --plan prints how long each lasts and why):
   nominal      the vehicle answers as the reference model does
   reject       every command but $OSD is refused with its "incorrect values" $ACK
-  lockout      a safety violation: 20 s (vehicle time) of err 26 for all but $OSD
+  lockout      a safety violation: 20 s (vehicle time) of err 26 for all but $OSD, then the ascent
   mission-end  the running mission ends on the vehicle ($OSI reports S)
   silence      the vehicle neither reads nor answers for a while
+
+how long: each scenario lasts what it must show needs at the time scale and on the line (a
+20 s lockout lasts 20 s of wall time at x1, 2 s at x10; a report reaches the backseat after the
+ACK window and its transmit time at the baud), and is held open until its moment has reached
+the backseat (the lockout's start and end, the mission's end, a staged refusal, a silence
+outlasting the backseat's own timeout), by at most a stated limit; a moment that never reached
+it leaves that scenario's observations unclaimed, and the run is not a certificate. The default
+--duration is the plan's; a shorter one is named before the run starts and the plan is kept.
+
+the vehicle's line: its replies leave at the baud (10 bits a byte). Requests that ask for more
+replies than that (ten $OSD,G,C,S,P a second on 19200 baud) overrun it: with --overrun drop
+(default) a request whose replies could not start within the ACK window goes unanswered; with
+--overrun queue every reply waits its turn, later and later. Either way the verdict names the
+overrun (a remark beside RH-BS-4, which bounds only what the backseat sends).
 
 judged (reference profile §9): RH-BS-1 framing and checksum, RH-BS-2 field ranges,
 RH-BS-3 preconditions, RH-BS-4 line budget (baud/10 bytes in any second), RH-BS-5 reaction
@@ -72,7 +90,8 @@ certificate: --implementation names the backseat in every report; --sign-key sig
 
 examples:
   helmcheck certify backseat                          # pty: prints 'port: /dev/pts/N', waits for a backseat
-  helmcheck certify backseat --duration 10 --time-scale 10 \\
+  helmcheck certify backseat --plan --time-scale 1    # how long each scenario lasts at x1, and why
+  helmcheck certify backseat --time-scale 10 \\
       --exec 'python3 examples/backseat.py --port {port} --time-scale {time_scale}'
   helmcheck certify backseat --port socket://127.0.0.1:0 --scenario lockout   # a TCP server; prints its port
   helmcheck certify backseat --port /dev/ttyUSB0 --profile iver3.toml --strict
@@ -89,8 +108,16 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--port", default="pty", metavar="PORT",
                    help="pty (default; prints 'port: /dev/pts/N' first), a device path, or socket://HOST:PORT")
     p.add_argument("--profile", metavar="FILE", help="TOML profile (default: rh5)")
-    p.add_argument("--duration", type=float, default=60.0, metavar="S",
-                   help="seconds of judged run after the backseat's first byte, split across the scenarios (default 60)")
+    p.add_argument("--duration", type=float, default=None, metavar="S",
+                   help="seconds of judged run after the backseat's first byte (default: what the scenarios need "
+                        "at this time scale and baud, --plan; longer shares the surplus, shorter is named and "
+                        "the plan kept)")
+    p.add_argument("--plan", action="store_true",
+                   help="print each scenario's length at this time scale and baud, and why, then exit")
+    p.add_argument("--overrun", choices=("drop", "queue"), default="drop",
+                   help="requests asking for more replies than the line carries: drop (default; a request whose "
+                        "replies could not start within the ACK window goes unanswered) or queue (every reply "
+                        "waits its turn)")
     p.add_argument("--time-scale", type=float, metavar="K",
                    help="the vehicle clock runs K times faster (RH-TIM-2; tell the backseat the same K; default: the profile's)")
     p.add_argument("--scenario", action="append", choices=SCENARIOS, metavar="NAME",
@@ -110,6 +137,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="start the backseat under test on the port ({port} is replaced, or the port appended)")
     p.add_argument("--exec-grace", type=float, default=5.0, metavar="S",
                    help="seconds between SIGTERM and SIGKILL when stopping it (default 5)")
+    add_line_argument(p, "guessed from the port: clean for helmcheck's pty and TCP served on loopback")
     p.add_argument("--no-progress", action="store_true",
                    help="no progress on standard error (by default: a bar on a terminal, else a line per "
                         "scenario and at least every 10 s)")
@@ -137,10 +165,16 @@ def run(args: argparse.Namespace, *, on_port: Optional[Callable[[str], None]] = 
                    connect_timeout=args.connect_timeout, exec_cmd=getattr(args, "exec_cmd", None),
                    reconnect_wait=(DEFAULT_WAIT_S if getattr(args, "reconnect_wait", None) is None
                                    else args.reconnect_wait),
-                   exec_grace_s=args.exec_grace, progress=not getattr(args, "no_progress", False))
+                   exec_grace_s=args.exec_grace, progress=not getattr(args, "no_progress", False),
+                   line=getattr(args, "line", None), overrun=getattr(args, "overrun", "drop"))
     wrong = problems(opts)
     if wrong:
         raise UsageError(wrong[0])
+    if getattr(args, "plan", False):
+        from ..certify.backseat.certifier import plan_for
+        for line in plan_for(opts).describe():
+            print(line)
+        return 0
     try:
         opts.certificate = declaration(args, "backseat")
     except DeclarationError as e:

@@ -26,8 +26,8 @@ ROLES = {
 
 EPILOG = """\
 examples:
-  helmcheck certify vehicle --port /dev/pts/N --time-scale 20 --profile helmcheck/profiles/emulator.toml
-  helmcheck certify backseat --duration 10 --time-scale 10 \\
+  helmcheck certify vehicle --port /dev/pts/N --time-scale 20 --profile examples/emulator.toml
+  helmcheck certify backseat --time-scale 10 \\
       --exec 'python3 examples/backseat.py --port {port} --time-scale {time_scale}'
 
 Run 'helmcheck certify vehicle --help' or 'helmcheck certify backseat --help' for each role's options.

@@ -22,6 +22,7 @@ from pathlib import Path
 
 from .. import exitcodes
 from ..failures import UsageError
+from .lineopt import add_line_argument
 
 __all__ = ["add_arguments", "run", "EPILOG"]
 
@@ -54,8 +55,9 @@ bench safety: unless the profile says [bench_safety] in_water = true, no $OMP mo
 
 --exec CMD starts the vehicle under test (a simulator, a firmware build on the host) on a new
 pty ({port} is its path; without {port} the path is appended), or with --port socket://HOST:0
-on a free TCP port ({port} is socket://HOST:N, {host} and {tcp_port} its halves); {time_scale}
-is K. Its output goes to DIR/vehicle.stdout.log and DIR/vehicle.stderr.log; at the end it gets
+on a free TCP port ({port} is socket://HOST:N, {host} and {tcp_port} its halves), or with
+--port announced on the port it makes itself and prints as a line 'port: URL' (a simulator with a
+pty of its own; it is given no port); {time_scale} is K. Its output goes to DIR/vehicle.stdout.log and DIR/vehicle.stderr.log; at the end it gets
 SIGTERM, then SIGKILL after --exec-grace. A vehicle that exits or dies before the end fails the
 run (results.json "process", its last output quoted).
 
@@ -91,9 +93,9 @@ results: DIR/results.json (schema 1), DIR/wire.log, DIR/profile.toml, DIR/signat
 
 examples:
   helmcheck emulate --port pty --time-scale 20 &        # a vehicle to certify; prints port: /dev/pts/N
-  helmcheck certify vehicle --port /dev/pts/N --time-scale 20 --profile helmcheck/profiles/emulator.toml
+  helmcheck certify vehicle --port /dev/pts/N --time-scale 20 --profile examples/emulator.toml
   helmcheck certify vehicle --exec 'helmcheck emulate --port {port} --time-scale {time_scale}' \\
-      --time-scale 20 --profile helmcheck/profiles/emulator.toml --select 'RH-SRV-*' --examples 0 \\
+      --time-scale 20 --profile examples/emulator.toml --select 'RH-SRV-*' --examples 0 \\
       --report-dir reports/servo                        # start the vehicle too; four clauses, no exploration
   helmcheck certify vehicle --plan --time-scale 1 --profile iver3.toml   # how long a run takes; no port
   helmcheck certify vehicle --port /dev/ttyUSB0 --profile iver3.toml --hypothesis-profile patient
@@ -112,7 +114,8 @@ exit status: 0 pass (or non-strict without --strict), 1 fail, 2 inconclusive, li
 def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--port", metavar="URL",
                    help="what pyserial opens: /dev/ttyUSB0, /dev/pts/N, socket://HOST:PORT, rfc2217://… "
-                        "(required unless --exec; with --exec: pty, the default, or socket://HOST:0)")
+                        "(required unless --exec; with --exec: pty, the default, socket://HOST:0, or "
+                        "announced: the vehicle makes its own port and prints 'port: URL')")
     p.add_argument("--profile", metavar="FILE", help="TOML profile (the ICS; default: rh5)")
     p.add_argument("--time-scale", type=float, metavar="K",
                    help="the vehicle's clock runs K times faster than wall time (RH-TIM-2; default: the profile's)")
@@ -133,7 +136,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--no-progress", action="store_true", help="no progress display")
     p.add_argument("--exec", dest="exec_cmd", metavar="CMD",
                    help="start the vehicle under test on the port: CMD is split like a shell line, run "
-                        "without a shell; {port} is replaced by the port (appended if absent)")
+                        "without a shell; {port} is replaced by the port (appended if absent; with --port "
+                        "announced none is given), {time_scale} by K")
     p.add_argument("--exec-grace", type=float, default=5.0, metavar="S",
                    help="seconds between SIGTERM and SIGKILL when stopping it (default 5)")
     p.add_argument("--exec-ready", type=float, default=30.0, metavar="S",
@@ -150,6 +154,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                         "is measured first, and a vehicle started with --exec is run at the time scale that "
                         "gives it, else the run stops (exit 2) naming that time scale. any (default): judge "
                         "with what the line gives; timing clauses judged coarser say how coarse")
+    add_line_argument(p)
     p.add_argument("--no-clock-check", dest="clock_check", action="store_false",
                    help="do not measure the vehicle's clock rate ($GPRMC times) against --time-scale at start "
                         "(for a vehicle whose $GPRMC time is not its own clock)")
@@ -209,6 +214,9 @@ def run(args: argparse.Namespace) -> int:  # noqa: C901 - argument checks, then 
     if spec.kind == "pty" and args.exec_cmd is None:
         raise UsageError("--port pty creates a new pseudo-terminal; give the vehicle's port (e.g. /dev/pts/N) "
                          "or --exec CMD to start the vehicle on it")
+    if spec.kind == "announced" and args.exec_cmd is None:
+        raise UsageError("--port announced takes the port the vehicle --exec starts prints ('port: URL'); "
+                         "without --exec give the vehicle's port")
     select = _selection(args)
     wait = _reconnect_wait(args)
     from .certificate_opts import DeclarationError, declaration
@@ -246,7 +254,7 @@ def run(args: argparse.Namespace) -> int:  # noqa: C901 - argument checks, then 
                        link=link, log_opener=open_wire_log, exec_cmd=args.exec_cmd,
                        exec_grace_s=args.exec_grace, exec_ready_s=args.exec_ready, certificate=cert,
                        operator=_at_a_terminal(), resume=resume, clock_check=args.clock_check,
-                       precision=args.precision, reconnect_wait_s=wait,
+                       precision=args.precision, reconnect_wait_s=wait, line=args.line,
                        resume_command=resume_command(args, report_dir))
         out = certify(opts)
         if out.nominal_time_scale is not None and args.exec_cmd is not None:
@@ -335,7 +343,7 @@ def _reconnect_wait(args: argparse.Namespace) -> float:
 
 
 #: Options of this invocation a resumed run is given again (each: attribute, flag, takes a value).
-_RESUME_AGAIN = (("reconnect_wait", "--reconnect-wait", True), ("precision", "--precision", True),
+_RESUME_AGAIN = (("reconnect_wait", "--reconnect-wait", True), ("precision", "--precision", True), ("line", "--line", True),
                  ("clock_check", "--no-clock-check", False), ("no_progress", "--no-progress", False),
                  ("sign_key", "--sign-key", True), ("operator", "--operator", True),
                  ("site", "--site", True), ("implementation", "--implementation", True))

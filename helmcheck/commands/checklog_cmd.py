@@ -23,6 +23,7 @@ from pathlib import Path
 
 from .. import exitcodes
 from ..failures import UsageError
+from .lineopt import add_line_argument
 from .messages import report_line
 
 EPILOG = """\
@@ -99,6 +100,7 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p.add_argument("--swap-directions", action="store_true",
                    help="socat's '>' is vehicle→backseat (socat started with the vehicle side first)")
     p.add_argument("--strict", action="store_true", help="a SHOULD not met fails the run")
+    add_line_argument(p, "the log's own line model note; a log without one (socat -v) is noisy")
     p.add_argument("--no-render", action="store_true", help="write results.json only")
     p.add_argument("--overwrite", action="store_true",
                    help="replace an earlier check in the report directory (its results, log copy and "
@@ -176,14 +178,17 @@ def run(args: argparse.Namespace) -> int:  # noqa: C901 - argument checks, then 
                 catalog = DirectoryCatalog(how.missions)
             with _progress(f, args.progress) as prog:
                 out = check_log(f, profile=how.profile, role=how.role, catalog=catalog,
-                                time_scale=how.time_scale, swap=args.swap_directions, progress=prog)
+                                time_scale=how.time_scale, swap=args.swap_directions, progress=prog,
+                                line=args.line)
         except LogFormatError as e:
             raise PathError(str(e)) from None
         except OSError as e:
             raise PathError(f"cannot read {f}: {e.strerror or e}") from None
         prepare_report_dir(rdir, args.overwrite)
         args.current_report_dir = str(rdir)
-        settings = {"swap_directions": bool(args.swap_directions)}
+        settings: dict = {"swap_directions": bool(args.swap_directions)}
+        if args.line:
+            settings["line"] = args.line
         if how.missions:
             settings["missions"] = [str(Path(d).resolve()) for d in how.missions]
         try:
@@ -206,7 +211,7 @@ def _summary(f: Path, out, res: dict, rdir: Path, how, rendered: bool = True) ->
     counts: dict[str, int] = {}
     for c in res["clauses"]:
         counts[c["verdict"]] = counts.get(c["verdict"], 0) + 1
-    print(f"{f}: {res['verdict'].upper()} — {res['verdict_reason']}")
+    print(f"{f}: {res['verdict'].upper()} — {res['verdict_reason']}{_line_hint(res)}")
     print(f"  {how.describe()}")
     if how.lacking:
         print(f"  note: {how.lacking}")
@@ -220,6 +225,24 @@ def _summary(f: Path, out, res: dict, rdir: Path, how, rendered: bool = True) ->
             lines = ", ".join(map(str, c.get("lines", [])[:8]))
             print(f"  {c['id']} {c['verdict']}: lines {lines}")
     print(report_line(rdir, rendered))
+
+
+#: Words of a reason that gave something to a faulty line (held, or made again and dismissed).
+_LINE_WORDS = ("faulty line", "the line may have", "the line, not the implementation")
+
+
+def _line_hint(res: dict) -> str:
+    """What to do when a log that does not say what its link was had errors given to a faulty line
+    (INCONCLUSIVE, or made again and not judged): on a pty or TCP the line cannot have made them
+    (:mod:`helmcheck.judge.linemodel`)."""
+    from ..judge.linemodel import UNKNOWN
+    if (res.get("line_model") or {}).get("why") != UNKNOWN.why:
+        return ""
+    if not any(w in c.get("reason", "") for c in res["clauses"] for w in _LINE_WORDS
+               if c["verdict"] in ("inconclusive", "pass", "non-strict")):
+        return ""
+    return (" This log does not say what its link was, so errors a faulty line could have made were given to "
+            "the line: if this capture's link was a pty or TCP, run with --line clean")
 
 
 #: From this size on a check shows its progress without --progress.

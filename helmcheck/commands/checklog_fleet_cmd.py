@@ -131,7 +131,7 @@ def _options(args: argparse.Namespace):
             raise PathError(f"--missions: cannot read {e.filename or missions}: {e.strerror or e}") from None
     return Options(profile=profile, profile_sha256=profile_sha256(profile), role=args.role, missions=missions,
                    missions_sha256=missions_sha, time_scale=args.time_scale, swap=args.swap_directions,
-                   strict=args.strict, render=not args.no_render, force=args.force,
+                   strict=args.strict, render=not args.no_render, force=args.force, line=args.line,
                    profile_arg=None if args.profile is None else str(Path(args.profile).resolve()),
                    revision=source_revision())
 

@@ -18,6 +18,8 @@ from pathlib import Path
 
 from .. import exitcodes
 from ..failures import UsageError
+from .lineopt import add_line_argument
+from .messages import report_line_for
 
 __all__ = ["add_parser", "run", "EPILOG"]
 
@@ -48,7 +50,7 @@ examples:
       --time-scale 20 --budget 10 --seed 1            # two vehicles helmcheck starts itself
   helmcheck diff --port /dev/ttyUSB0 --profile iver3.toml --time-scale 1 \\
       --exec 'helmcheck emulate --port {port} --time-scale {time_scale}' \\
-      --profile-b helmcheck/profiles/emulator.toml --time-scale-b 20   # a vehicle against the emulator
+      --profile-b examples/emulator.toml --time-scale-b 20   # a vehicle against the emulator
 
 exit status: 0 no divergence within the budget, 1 a divergence, 2 inconclusive (link fault,
   a clock not at its time scale, nothing ran) or tester error, 64 usage.
@@ -89,6 +91,7 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
                    help="where diff.json, the wire logs and the replays go (default reports/diff; an earlier "
                         "diff there is replaced)")
     p.add_argument("--no-progress", action="store_true", help="no progress lines on standard error")
+    add_line_argument(p)
     p.set_defaults(func=run)
     return p
 
@@ -129,13 +132,13 @@ def _specs(args: argparse.Namespace) -> list:
             why = check_command(value)
             if why:
                 raise UsageError(f"--exec ({name}): {why}")
-            specs.append(SideSpec(name, "pty", p, float(k), exec_cmd=value))
+            specs.append(SideSpec(name, "pty", p, float(k), exec_cmd=value, line=args.line))
         else:
             spec = port_spec(value)
             if spec.kind == "pty":
                 raise UsageError("--port pty creates a new pseudo-terminal; give the vehicle's port (e.g. "
                                  "/dev/pts/N) or --exec CMD to start it on one")
-            specs.append(SideSpec(name, value, p, float(k)))
+            specs.append(SideSpec(name, value, p, float(k), line=args.line))
     return specs
 
 
@@ -184,6 +187,7 @@ def run(args: argparse.Namespace) -> int:
         for link in opened:
             link.close()
     print(out.line)
+    print(report_line_for(out.report_dir / "diff.json"))  # like every command: where to look next
     sys.stdout.flush()
     for w in wire:
         w.check()  # a wire log lost on the way: exit 2, after the result line

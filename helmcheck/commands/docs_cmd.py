@@ -5,9 +5,12 @@ The grammar reference comes from ``remote_helm.lark``, and so do the fast path's
 table and state diagram come from ``helmcheck/model/transitions.py``; the documentation site's
 reference pages (every profile key, the clause catalogue, the reference profile:
 ``docs/reference/``, :mod:`helmcheck.reference_docs`) from the ``Profile`` dataclass and the
-shipped reference profile; the line-fault relay's page (``docs/line-faults.md``) from
+shipped reference profile; the rules of the profile and the steps that fail each
+(``docs/reference/rules.md``) from the traceability table (:mod:`helmcheck.rules`); the
+line-fault relay's page (``docs/line-faults.md``) from
 :mod:`helmcheck.line.faultdocs`; ``examples/emulator.toml`` is what ``helmcheck profile init
---emulator`` writes. The other pages of ``docs/`` are written by hand. Each file is written
+--emulator`` writes; ``docs/readings.md`` is the readings table (:mod:`helmcheck.model.readings`).
+The other pages of ``docs/`` are written by hand. Each file is written
 atomically; one that cannot be written is exit 2 naming it. ``--check`` exits 1 when a
 checked-in copy is stale.
 """
@@ -21,6 +24,8 @@ from .. import exitcodes
 
 #: The emulator's profile written out in full, as ``helmcheck profile init --emulator`` writes it.
 EMULATOR_EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "emulator.toml"
+#: The readings table's page (:mod:`helmcheck.model.readings`).
+READINGS_PAGE = Path(__file__).resolve().parents[2] / "docs" / "readings.md"
 
 
 EPILOG = """\
@@ -56,17 +61,20 @@ def emulator_example() -> str:
 
 def targets() -> dict[Path, str]:
     """Every generated file and its text."""
-    from .. import reference_docs
+    from .. import reference_docs, rules
     from ..grammar import derive
     from ..grammar import docs as grammar_docs
     from ..line import faultdocs as fault_docs
     from ..model import docs as model_docs
+    from ..model import readings
 
     out = {grammar_docs.DOCS_FILE: grammar_docs.render_markdown(), derive.TABLE_FILE: derive.render_table(),
            fault_docs.DOCS_FILE: fault_docs.render_markdown()}
     out.update({model_docs.DOCS_DIR / name: text for name, text in model_docs.render_all().items()})
     out.update(reference_docs.render_all())
+    out[rules.DOCS_FILE] = rules.render_markdown()
     out[EMULATOR_EXAMPLE] = emulator_example()
+    out[READINGS_PAGE] = readings.markdown()
     return out
 
 

@@ -47,7 +47,7 @@ examples:
   helmcheck emulate --port socket://127.0.0.1:0       # a serial server on a free TCP port, one client
   helmcheck emulate --port /dev/ttyUSB0 --baud 19200  # a real serial line, 8N1
   helmcheck emulate --tui                             # live view: traffic, fins, mode, timers
-  helmcheck emulate --profile helmcheck/profiles/emulator.toml --time-scale 20 &   # in the background
+  helmcheck emulate --profile examples/emulator.toml --time-scale 20 &   # in the background
   kill %1                                             # … and stopped (SIGTERM: exit 0)
 
 exit status: 0 stopped (Ctrl-C, SIGTERM or SIGHUP), 2 the link failed or a log could not be written,

@@ -18,6 +18,7 @@ from datetime import datetime, timedelta
 from pathlib import Path
 
 from ..failures import UsageError
+from .lineopt import add_line_argument
 
 EPILOG = """\
 two ways onto the line:
@@ -88,6 +89,7 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p.add_argument("--rotate-mb", type=float, default=64.0, metavar="MB",
                    help="start a new wire-log segment every MB megabytes (default 64)")
     p.add_argument("--strict", action="store_true", help="a SHOULD not met fails the session")
+    add_line_argument(p, "clean when both sides are (ptys, TCP to this host), else noisy")
     p.add_argument("--no-tui", action="store_true",
                    help="plain lines even on a terminal: each finding, and a status line every 10 s")
     p.add_argument("--no-realtime", action="store_true",
@@ -191,7 +193,7 @@ def run(args: argparse.Namespace) -> int:
                           rotate_bytes=int(args.rotate_mb * 1024 * 1024), strict=bool(args.strict),
                           command=command, certificate=cert, on_finding=on_finding, on_port=on_port,
                           view=screen, links=links, realtime=not args.no_realtime, on_relay=on_relay,
-                          reconnect_wait=float(wait), on_gap=on_gap))
+                          reconnect_wait=float(wait), on_gap=on_gap, line=args.line))
     from .messages import report_line
     print(f"{headline(out.results)}. {out.reason} ({out.ended}; {out.findings} finding(s))")
     print(report_line(out.report_dir), flush=True)

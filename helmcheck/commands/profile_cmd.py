@@ -1,5 +1,6 @@
 """``helmcheck profile init [PATH]``: write a commented profile for a real vehicle to fill in;
-``helmcheck profile keys``: list every key.
+``helmcheck profile keys``: list every key; ``helmcheck profile readings``: the readings table
+(:mod:`helmcheck.model.readings`).
 
 The text is :func:`helmcheck.profile_template.render` — every key of
 :class:`~helmcheck.profile.Profile` with its documentation, allowed values and a safe starting
@@ -49,6 +50,7 @@ PROFILE_EPILOG = """\
 examples:
   helmcheck profile init my-vehicle.toml            # a commented profile to fill in
   helmcheck profile keys                            # every key, one line each
+  helmcheck profile readings                        # every question the profile leaves open
 
 exit status: 0 written or listed, 64 usage, 2 a write that failed.
 """
@@ -97,6 +99,16 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
                                         "clauses it serves and its rh5 default, one line each.",
                             epilog=KEYS_EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
     kp.set_defaults(func=run_keys)
+    rp = actions.add_parser("readings", help="list every question the profile leaves open, and every answer accepted",
+                            description="List the readings table: every question the reference profile's words "
+                                        "leave open (clause, question, the profile's words), every reading "
+                                        "helmcheck accepts, how the judge accepts each and the emulator setting "
+                                        "that takes each.",
+                            epilog="examples:\n  helmcheck profile readings\n  helmcheck profile readings --markdown"
+                                   "\n\nexit status: 0 listed.",
+                            formatter_class=argparse.RawDescriptionHelpFormatter)
+    rp.add_argument("--markdown", action="store_true", help="as the Markdown table of the docs site")
+    rp.set_defaults(func=run_readings)
     p.set_defaults(func=_no_action)
     return p
 
@@ -104,7 +116,7 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
 def _no_action(args: argparse.Namespace) -> int:
     from ..failures import UsageError
 
-    raise UsageError("choose an action: init or keys (see 'helmcheck profile --help')")
+    raise UsageError("choose an action: init, keys or readings (see 'helmcheck profile --help')")
 
 
 def _keys() -> dict[str, Any]:
@@ -154,6 +166,13 @@ def _emulator_values() -> dict[str, Any]:
         else:
             flat[k] = v
     return flat
+
+
+def run_readings(args: argparse.Namespace) -> int:
+    """``profile readings``: the readings table (:mod:`helmcheck.model.readings`)."""
+    from ..model import readings
+    print(readings.markdown() if args.markdown else readings.text(), end="")
+    return exitcodes.OK
 
 
 def run_keys(args: argparse.Namespace) -> int:  # noqa: ARG001 - the command's signature

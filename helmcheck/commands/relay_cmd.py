@@ -128,7 +128,9 @@ def run(args: argparse.Namespace) -> int:
         raise PathError(f"cannot open {e.filename}: {e.strerror or e}") from None
     print(f"helmcheck relay: backseat {relay.port_of('backseat')}, vehicle {relay.port_of('vehicle')}; impair "
           f"{faults.text or '(none)'!r}, seed {faults.seed}"
-          + (f"; wire log {args.wire_log}" if args.wire_log else ""), file=sys.stderr, flush=True)
+          + (f"; wire log {args.wire_log}" if args.wire_log else "")
+          + "; a tester on its ports judges a line that can damage bytes with --line noisy "
+            "(a pty looks clean)", file=sys.stderr, flush=True)
     ended = "the relay ended"
     try:
         ended = _wait(relay, args.duration)

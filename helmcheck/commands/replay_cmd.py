@@ -14,6 +14,7 @@ import math
 import sys
 
 from .. import exitcodes
+from .lineopt import add_line_argument
 
 EPILOG = """\
 A replay file is what certify vehicle writes into DIR/replays/ for each failure its exploration
@@ -39,6 +40,7 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     p.add_argument("--profile", metavar="FILE", help="TOML profile (default: the one stored in the replay)")
     p.add_argument("--time-scale", type=float, metavar="K", help="the vehicle's time scale (default: recorded)")
     p.add_argument("--wire-log", metavar="FILE", help="write the wire log of the re-drive here")
+    add_line_argument(p)
     p.set_defaults(func=run)
     return p
 
@@ -103,6 +105,9 @@ def run(args: argparse.Namespace) -> int:
                                   run_header(__version__, "replay", profile.name, more=f" {args.file}".replace(";", ","))],
                             [observer])
         link = TesterLink(raw, profile, recorder)
+        from ..judge.linemodel import line_note
+        from ..line.linekind import line_for
+        link.note(line_note(line_for(args.port, args.line)))
         session = Session(link, profile, k, observer)
         try:
             got = redrive(doc, session)

@@ -32,7 +32,7 @@ what is checked (in any results directory: certify vehicle, certify backseat, ch
 examples:
   helmcheck verify reports/vehicle
   helmcheck keygen --out lab                        # once: lab.key signs, lab.pub checks
-  helmcheck certify vehicle --port /dev/pts/N --time-scale 20 --profile helmcheck/profiles/emulator.toml \\
+  helmcheck certify vehicle --port /dev/pts/N --time-scale 20 --profile examples/emulator.toml \\
       --sign-key lab.key --report-dir reports/signed
   helmcheck verify reports/signed --public-key lab.pub   # the run must be signed by this key
 
@@ -76,7 +76,7 @@ def verify_run(directory: Path | str, public_key=None, *, public_key_name: str =
                 catalog = DirectoryCatalog(list(job.missions))
             try:
                 outcome = check_log(job.wire_path, profile=profile, role=job.role, time_scale=job.time_scale,
-                                    swap=job.swap, catalog=catalog)
+                                    swap=job.swap, catalog=catalog, line=job.line)
             except (LogFormatError, OSError, ValueError) as e:
                 out.add(job.wire_name, f"cannot be re-judged: {e}")
             else:

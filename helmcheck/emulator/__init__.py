@@ -4,7 +4,10 @@ Modules, one concern each:
 
 * :mod:`.core` — :class:`~.core.EmulatorCore`, the sans-IO core (model + plant + framer + logs).
 * :mod:`.timeline` — the core's clock: vehicle time, catching up, control ticks (RH-TIM-2).
-* :mod:`.outbox` — the core's output queue, capped and paced at the line's baud (RH-ACK-2).
+* :mod:`.outbox` — the core's output queue, capped and paced at the line's baud (RH-ACK-2), and
+  what it does when requests ask for more replies than the line carries (queue or drop).
+* :mod:`.outload` — the meter of that demand: how far the line was over-asked, how long replies
+  waited, what was dropped.
 * :mod:`.logs` — the main log CSV (RH-LOG-2) and the live view's history entries.
 * :mod:`.settingsfile` — the ``$ORWSET`` settings kept across runs (RH-SET-2).
 * :mod:`.plant` — plant dynamics (motion, depth, battery) that feed the model's plant events.

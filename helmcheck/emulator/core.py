@@ -69,9 +69,10 @@ from ..model.plant import SafetyViolation
 from ..model.vehicle import VehicleModel
 from ..profile import SAFETY_CODES, Profile
 from ..line.transport import LinePacer
-from .freedoms import DEFAULT_SETTINGS, EmulatorSettings, ReplyDelay, ReplyShaper, SkewedTimers
+from .freedoms import DEFAULT_SETTINGS, EmulatorSettings, ReplyDelay, ReplyShaper, SkewedTimers, model_readings
 from .logs import HistoryEntry, MainLog, event_text
 from .outbox import MAX_OUTBOX_BYTES, Outbox
+from .outload import OutputLoad
 from .plant import Plant, PlantParams
 from .rules import OperationTimeRule
 from .settingsfile import load_settings, save_settings
@@ -112,6 +113,7 @@ class EmulatorCore(Timeline, Outbox):
         self.utc0 = utc0
         self.plant = Plant(profile, params or plant_params(st))
         self.model = model_factory(profile, missions)
+        self.model.readings = model_readings(st)  # the profile's open questions, as this vehicle reads them
         if st.timer_factor != 1.0 or st.timer_offset_s != 0.0:  # RH-TIM-1: a vehicle's own clock
             self.model.timers = SkewedTimers(st.timer_factor, st.timer_offset_s)
         for name, state, values in st.factory_settings:  # the vehicle's own settings (RH-SET-2)
@@ -131,8 +133,9 @@ class EmulatorCore(Timeline, Outbox):
         self.settings_path = settings_path
         self.history: deque[HistoryEntry] = deque(maxlen=history)
         self.v = 0.0  #: vehicle time the model and plant have reached
-        self._out: deque[bytes] = deque()
+        self._out: deque[tuple[bytes, float]] = deque()  #: (sentence, wall time it was queued)
         self._out_bytes = 0
+        self.load = OutputLoad(self.pacer.baud)  #: what the requests asked of the line (:mod:`.outload`)
         self._on_error = on_error
         self.stats = {"lines_in": 0, "commands": 0, "answered_errors": 0, "discarded": 0,
                       "sentences_out": 0, "bytes_in": 0, "bytes_out": 0, "dropped_out": 0,
@@ -150,7 +153,8 @@ class EmulatorCore(Timeline, Outbox):
         self.stats["bytes_in"] += len(data)
         v = self._catch_up(now)
         for ev in self.framer.feed(data):
-            if self._delay.active or self._burst:  # processed later, in arrival order (RH-ACK-2, RH-ACK-6)
+            if self._delay.active or self._burst or self.settings.process_when_idle:
+                # processed later, in arrival order (RH-ACK-2, RH-ACK-6)
                 self._inbox.append((self._due(ev, now), ev))
             elif isinstance(ev, Discard):
                 self._discard(ev, now)
@@ -179,7 +183,10 @@ class EmulatorCore(Timeline, Outbox):
 
     def _process_inbox(self, now: float) -> None:
         """Lines whose processing time has come (``reply_delay_s``), oldest first."""
+        idle_first = self.settings.process_when_idle
         while self._inbox and self._inbox[0][0] <= now:
+            if idle_first and (self._out or (self.pacer.baud and self.pacer.free_at > now + 1e-9)):
+                break  # processed once the replies before it have left: its ACK goes out at once
             _, ev = self._inbox.popleft()
             v = self._catch_up(now)
             if isinstance(ev, Discard):
@@ -218,7 +225,7 @@ class EmulatorCore(Timeline, Outbox):
         """Send ``reply`` in the vehicle's place, behind the replies already waiting and paced
         like them (RH-ACK-2's transmit time, RH-ACK-6's order); returns bytes to send now."""
         self._catch_up(now)
-        self._send(format_sentence(reply), now)
+        self._send_set([format_sentence(reply)], now)
         return self._release(now)
 
     @property
@@ -245,6 +252,7 @@ class EmulatorCore(Timeline, Outbox):
         if self._out:
             self._note(now, f"link: {len(self._out)} unsent sentences dropped")
             self.stats["dropped_out"] += self._out_bytes
+            self.load.dropped(now - self.start, self._out_bytes)
         self._out.clear()
         self._out_bytes = 0
         self.pacer.reset(now)
@@ -329,8 +337,7 @@ class EmulatorCore(Timeline, Outbox):
                 self._save_settings(self.settings_path)
         if self._shaper.active:
             replies = [self._shaper.shape(r, self._idle_distance(), m.snapshot.utc) for r in replies]
-        for r in replies:
-            self._send(format_sentence(r), now)
+        self._send_set([format_sentence(r) for r in replies], now, getattr(item, "ID", None) or getattr(item, "sentence_id", None) or "")
         self._after_model(now)
         return next((r for r in reversed(replies) if isinstance(r, s.ACK)), None)
 

@@ -17,17 +17,26 @@ Settings (wall seconds where the line is concerned, vehicle seconds otherwise; R
 * the line (RH-ACK-2): ``reply_delay_s`` ``[lo, hi]`` — each command is processed (its ACK goes
   out, RH-RD-15) a delay drawn uniformly from ``[lo, hi]`` after it arrived, in arrival order
   (RH-ACK-6); ``pacing`` ``"baud"`` (each sentence waits for the previous one's transmit time) or
-  ``"burst"`` (everything at once); ``burst_interval_s`` — with ``"burst"``, a serial loop that
+  ``"burst"`` (everything at once); ``process_when_idle`` — a line (a poll too) is processed only
+  once the replies before it have left the line, so its ACK goes out the instant it is processed
+  and its durations start there (a serial loop that answers one line at a time);
+  ``burst_interval_s`` — with ``"burst"``, a serial loop that
   turns every this many wall seconds: the lines that arrived are processed at its next turn and
   their replies written at once (the instant the ACK goes out is the instant of processing,
   RH-RD-15); ``seed`` for the draws. ``$OXFLT`` raises its violation at once (RH-SAF-5): it
-  waits only for the lines that came before it.
+  waits only for the lines that came before it. ``overrun`` — what the vehicle does when requests
+  ask for more replies than the line carries (the profile leaves it open): ``"queue"`` (every reply
+  waits its turn: queue and lag) or ``"drop"`` (a poll whose replies could not start within the
+  ACK window is not answered, its replies dropped whole; commands are always answered; :mod:`.outbox`).
 * the clock (RH-TIM-1): ``control_tick_s`` — the control loop runs every this many vehicle
   seconds: timer expiries and plant events take effect on the next tick, sensors are sampled on
   ticks; ``timer_factor`` and ``timer_offset_s`` — every protocol duration the vehicle times
   (``$OMS``/``$OMP``/``$ODVL`` timeouts, parks, the lockout) really lasts
   ``duration × factor + offset`` (:class:`SkewedTimers`); its ``$OSI`` park countdown runs on
   the same clock.
+* the profile's open questions (the readings table, :mod:`helmcheck.model.readings`, where each
+  is explained; every row with a setting is one here): ``srp_bad_path``, ``ascent_refusal_order``,
+  ``omw_pitch_speed``, ``stop_unloads`` (the model answers by them), ``resumed_park`` and ``idle_distance`` (below);
 * the mission: ``resumed_park`` — a mission park resumed after remote control (RH-INT-2) counts
   ``"at once"`` from the release, wherever the vehicle is (the reference model), or, ``"on
   station"``, only once the vehicle is back within ``on_station_m`` of the park's waypoint, which
@@ -61,11 +70,13 @@ from typing import Any, Optional
 
 from ..grammar import sentences as s
 from ..grammar.wirelog import transmit_time
+from ..model.readings import BY_KEY as READINGS_BY_KEY, DEFAULTS as READING_DEFAULTS, READINGS
 from ..model.timers import Timers, tolerance
 from ..profile import SAFETY_CODES, Profile
 
 __all__ = ["EmulatorSettings", "SettingsError", "settings_from_dict", "parse_assignment", "nonconforming",
-           "SkewedTimers", "ReplyShaper", "ReplyDelay", "DEFAULT_SETTINGS", "DECIMAL_FIELDS", "skew_allowance"]
+           "SkewedTimers", "ReplyShaper", "ReplyDelay", "DEFAULT_SETTINGS", "DECIMAL_FIELDS", "skew_allowance",
+           "model_readings", "MODEL_READINGS"]
 
 #: Field names ``decimals`` may name: every Decimal field of a data sentence, and ``battery``.
 DECIMAL_FIELDS = ("lat", "lon", "speed", "distance", "altimeter", "declination", "remaining_time",
@@ -77,6 +88,11 @@ _HEADINGS = ("heading", "true_heading")
 
 class SettingsError(ValueError):
     """An ``[emulator]`` setting that cannot be used; the message names it."""
+
+
+def _reading_doc(key: str) -> str:
+    r = READINGS_BY_KEY[key]
+    return f"{r.question} " + "; ".join(f"{c.value}: {c.means}" for c in r.choices)
 
 
 def _s(default: Any, doc: str, clause: str = "", *, factory: Any = None) -> Any:
@@ -99,6 +115,12 @@ class EmulatorSettings:
     burst_interval_s: float = _s(0.0, "with pacing burst: the serial loop's period, wall seconds (lines are "
                                  "processed at its next turn, replies written at once)", "RH-ACK-2, RH-RD-15")
     seed: int = _s(0, "seed of the reply-delay draws")
+    process_when_idle: bool = _s(False, "a line is processed (its state change and replies together) only once "
+                                 "the replies before it have left the line, so its ACK goes out the instant "
+                                 "it is processed and every duration starts there", "RH-ACK-6, RH-RD-15")
+    overrun: str = _s("queue", "requests asking for more replies than the line carries: queue (every reply waits "
+                      "its turn) or drop (a poll whose replies could not start within the ACK window is "
+                      "not answered; commands always are)", "RH-ACK-1, RH-ACK-2, RH-BS-4")
     # --- the clock
     control_tick_s: float = _s(0.0, "vehicle seconds between control-loop ticks (0: continuous)", "RH-TIM-1")
     timer_factor: float = _s(1.0, "every timed duration lasts duration × factor + offset", "RH-TIM-1")
@@ -127,6 +149,15 @@ class EmulatorSettings:
     gprmc_time_decimals: int = _s(2, "decimals of the $GPRMC time", "RH-OUT-2")
     factory_settings: tuple[tuple[str, int, tuple[str, ...]], ...] = _s(
         (), "$ORWSET safety-rule settings at start: name → [state, values…]", "RH-SET-2")
+    # --- the profile's open questions the model answers (the readings table, helmcheck.model.readings)
+    srp_bad_path: str = _s(READING_DEFAULTS["srp_bad_path"], _reading_doc("srp_bad_path"), "RH-RD-6")
+    ascent_refusal_order: str = _s(READING_DEFAULTS["ascent_refusal_order"], _reading_doc("ascent_refusal_order"),
+                                   "RH-RD-12")
+    omw_pitch_speed: str = _s(READING_DEFAULTS["omw_pitch_speed"], _reading_doc("omw_pitch_speed"), "RH-RD-9")
+    stop_unloads: str = _s(READING_DEFAULTS["stop_unloads"], _reading_doc("stop_unloads"), "RH-RD-6")
+    opos_ctd: str = _s(READING_DEFAULTS["opos_ctd"], _reading_doc("opos_ctd"), "RH-POS-2")
+    park_waypoint: str = _s(READING_DEFAULTS["park_waypoint"], _reading_doc("park_waypoint"), "RH-OUT-1")
+    omload_flag: str = _s(READING_DEFAULTS["omload_flag"], _reading_doc("omload_flag"), "RH-MSN-1")
 
     @property
     def is_default(self) -> bool:
@@ -170,7 +201,16 @@ class EmulatorSettings:
 
 DEFAULT_SETTINGS = EmulatorSettings()
 
-_CHOICES = {"pacing": ("baud", "burst"), "idle_distance": ("zero", "last"), "resumed_park": ("at once", "on station")}
+#: settings that take one of a few words: the readings table's (every reading of its rows) and the line's
+_CHOICES = {"pacing": ("baud", "burst"), "overrun": ("queue", "drop"), **{r.setting: r.values for r in READINGS
+                                            if r.setting and isinstance(getattr(DEFAULT_SETTINGS, r.setting), str)}}
+#: the readings the model itself answers by (the rest the emulator or the judge takes care of)
+MODEL_READINGS = tuple(r.key for r in READINGS if r.in_model)
+
+
+def model_readings(st: "EmulatorSettings") -> dict[str, str]:
+    """The model's ``readings`` for these settings (:mod:`helmcheck.model.readings`)."""
+    return {**READING_DEFAULTS, **{k: getattr(st, k) for k in MODEL_READINGS}}
 _POSITIVE = ("timer_factor", "speed_factor", "turn_rate_dps", "dive_pitch_deg", "ascent_mps",
              "buoyancy_rise_mps", "water_depth_m")
 _COMPASS_LETTERS = ("M", "Mx", "My", "Mz", "A", "Ax", "Ay", "Az")
@@ -197,6 +237,8 @@ def settings_from_dict(data: dict[str, Any], where: str = "[emulator]",
             return SettingsError(f"{where}: emulator setting {key!r}: {why} (got {value!r})")
 
         if key in _CHOICES:
+            if isinstance(value, int) and not isinstance(value, bool):
+                value = str(value)  # an error number as a word (--set srp_bad_path=31)
             if value not in _CHOICES[key]:
                 raise bad("must be one of " + ", ".join(map(repr, _CHOICES[key])))
             kw[key] = value
@@ -209,6 +251,10 @@ def settings_from_dict(data: dict[str, Any], where: str = "[emulator]",
             if not 0 <= lo <= hi:
                 raise bad("must be 0 <= lo <= hi")
             kw[key] = (lo, hi)
+        elif key == "process_when_idle":
+            if not isinstance(value, bool):
+                raise bad("must be true or false")
+            kw[key] = value
         elif key in ("seed", "gprmc_time_decimals"):
             if isinstance(value, bool) or not isinstance(value, int) or value < 0:
                 raise bad("must be a non-negative integer")

@@ -47,6 +47,8 @@ class Timeline:
             best = w if best is None else min(best, w)
         if self._inbox:
             w = self._inbox[0][0]
+            if self.settings.process_when_idle:  # it also waits for the line to be idle
+                w = max(w, self.pacer.free_at)
             best = w if best is None else min(best, w)
         return best
 

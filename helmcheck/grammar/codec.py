@@ -245,7 +245,7 @@ def decode(line: bytes | str, profile: Profile = DEFAULT, engine: str = "fast") 
     if not bad:
         return Decoded(raw, sentence, None, tuple(findings), sid, term)
     partial = replace(sentence, **{e.field: None for e in bad if e.field in names})
-    return Decoded(raw, None, bad[0], tuple(findings), sid, term, partial, tuple(bad))
+    return Decoded(raw, None, replace(bad[0], partial=partial), tuple(findings), sid, term, partial, tuple(bad))
 
 
 def parse(line: bytes | str, profile: Profile = DEFAULT, engine: str = "fast") -> S.Sentence:

@@ -7,13 +7,15 @@ and — for a well-framed command of a known type — which ``$ACK`` a vehicle a
 
 ``kind`` sorts errors for the backseat judge: ``framing`` (RH-BS-1), ``syntax`` and ``range``
 (RH-BS-2). A :class:`Finding` is a SHOULD-level remark (lower-case checksum hex, bare LF) that
-does not make a line invalid.
+does not make a line invalid. A field error of a command whose fields could be told apart carries
+the command read with its bad fields left out (``partial``), for a reader that takes a field the
+profile leaves open another way (:mod:`helmcheck.model.readings`).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from typing import Optional
+from dataclasses import dataclass, field as _field
+from typing import Any, Optional
 
 __all__ = ["SentenceError", "Finding", "FRAMING", "SYNTAX", "RANGE"]
 
@@ -35,6 +37,8 @@ class SentenceError(Exception):
     ack_type: Optional[int] = None  #: the $ACK type a vehicle answers with, None = silent discard
     ack_err: Optional[int] = None  #: the error number in that $ACK
     value: Optional[str] = None  #: the field's text as sent, for a field error (``field`` names it)
+    #: the command read with its bad fields as None (a field error only; not part of equality)
+    partial: Any = _field(default=None, compare=False, hash=False, repr=False)
 
     def __str__(self) -> str:
         where = f" at column {self.column}" if self.column is not None else ""

@@ -16,6 +16,7 @@ reads them. Modules:
 * a faulty line: :mod:`~helmcheck.judge.spoil` — the form of a broken line a line fault gives;
   :mod:`~helmcheck.judge.streaks` — observations it may have spoilt, held until made again
   (the repetition rule); :mod:`~helmcheck.judge.linefaults` — a line-fault relay's notes;
+  :mod:`~helmcheck.judge.linemodel` — whether the link can damage bytes at all (clean or noisy);
 * :mod:`~helmcheck.judge.vehicle` — the vehicle observer (§1–8);
 * :mod:`~helmcheck.judge.backseat` — the backseat observer (§9).
 

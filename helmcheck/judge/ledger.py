@@ -17,7 +17,12 @@ observation of one clause:
 * ``withdraw`` — the clause is outside what the run judged (a ``--select`` run that did not
   select it; a backseat whose exit cut short the scenarios exercising it): NOT-TESTED with that
   reason whatever was observed, except a violation, which stands (a run fact,
-  :mod:`helmcheck.judge.runfacts`).
+  :mod:`helmcheck.judge.runfacts`);
+* ``unclaim`` — the clause's observations in one case (a backseat scenario whose moment did not
+  reach the backseat in time) are not claimed: the verdict is made from the other cases'
+  findings, a violation in it still standing, and says so; with nothing left, NOT-TESTED with
+  that reason. It needs the findings kept per case (:meth:`Ledger.track_cases`, which the backseat
+  observer turns on: a handful of scenarios, so a handful of entries per clause).
 
 The one combining rule (TTCN-3, "first fail wins"): ``fail``/``non-strict`` > ``inconclusive`` >
 ``pass`` > ``not-tested``. The reason shown is the first one at the winning level, with the
@@ -125,15 +130,56 @@ class Ledger:
         self._serial = 0
         #: violations waiting for their confirmation (:meth:`hold`), or None when none is awaited
         self._held: Optional[list[tuple[str, str, list, str]]] = None
+        #: clause -> case -> kind -> its findings there (:meth:`track_cases`; None: not kept)
+        self._by_case: Optional[dict[str, dict[str, dict[str, _Level]]]] = None
+        #: clause -> case -> why its observations there are not claimed (:meth:`unclaim`)
+        self._unclaimed: dict[str, dict[str, str]] = {}
 
     def __contains__(self, cid: str) -> bool:
         return cid in self._e
+
+    # ------------------------------------------------------------------ per case
+    def track_cases(self) -> None:
+        """Keep every finding per case too, so that a case's observations can be left out of the
+        claim later (:meth:`unclaim`). Turn it on before the first finding."""
+        if self._by_case is None:
+            self._by_case = {}
+
+    def _track(self, cid: str, kind: str, reason: Reason, evidence, case: str) -> None:
+        lv = self._by_case.setdefault(cid, {}).setdefault(case, {}).get(kind)  # type: ignore[union-attr]
+        if lv is None:
+            lv = self._by_case[cid][case][kind] = _Level()  # type: ignore[index]
+        lv.count += 1
+        if lv.full:
+            return
+        if not lv.reason and reason:
+            lv.reason = reason() if callable(reason) else reason
+        ev = list(evidence)
+        if ev and len(lv.lines) < MAX_LINES and ev[-1].lineno and ev[-1].lineno not in lv.lines:
+            lv.lines.append(ev[-1].lineno)
+        if not lv.evidence and ev:
+            lv.evidence = ev[:MAX_EVIDENCE]
+        lv.full = bool(lv.evidence and lv.reason and len(lv.lines) >= MAX_LINES)
+
+    def unclaim(self, cid: str, case: str, reason: str) -> None:
+        """The clause's observations in ``case`` are not claimed (module docstring); the first
+        reason for a case holds."""
+        if cid in self._e:
+            self._unclaimed.setdefault(cid, {}).setdefault(case, reason)
+
+    def unclaimed(self, cid: str) -> dict[str, str]:
+        """Case -> why the clause's observations there are not claimed."""
+        return dict(self._unclaimed.get(cid, {}))
 
     # ------------------------------------------------------------------ findings
     def _add(self, cid: str, kind: str, reason: Reason, evidence: Iterable[Evidence], case: str) -> None:
         e = self._e.get(cid)
         if e is None:
             return  # a clause outside this ledger (not selected, or the other role)
+        if self._by_case is not None:
+            if type(evidence) not in (tuple, list):
+                evidence = list(evidence)
+            self._track(cid, kind, reason, evidence, case)
         lv = e.levels[kind]
         lv.count += 1
         if lv.full and (not case or case in e.cases):
@@ -171,6 +217,9 @@ class Ledger:
         if e is None:
             return
         lv = e.levels[PASS]
+        if self._by_case is not None:
+            self._add(cid, PASS, reason, evidence, case)  # kept per case too: the full path
+            return
         if lv.full and (not case or case in e.cases):
             lv.count += 1  # the common, repeated pass: only the count changes
             return
@@ -189,7 +238,7 @@ class Ledger:
             if e is None:
                 continue
             lv = e.levels[PASS]
-            if lv.full and (not case or case in e.cases):
+            if lv.full and (not case or case in e.cases) and self._by_case is None:
                 lv.count += 1
             else:
                 self._add(cid, PASS, reason, evidence, case)
@@ -320,13 +369,36 @@ class Ledger:
         e = self._e[cid]
         return {k: lv.count for k, lv in e.levels.items()}
 
+    def _claimed_levels(self, cid: str, e: _Entry) -> tuple[dict, tuple[str, ...], str]:
+        """The findings the verdict is made from: every one, or (:meth:`unclaim`) those of the
+        cases claimed and every violation; the cases they come from; what was left out, in words."""
+        out = self._unclaimed.get(cid)
+        if not out or self._by_case is None:
+            return e.levels, tuple(e.cases), ""
+        per = self._by_case.get(cid, {})
+        levels = {k: _Level() for k in (PASS, FAIL, INCONCLUSIVE, NOT_TESTED)}
+        cases: list[str] = []
+        for case, kinds in per.items():
+            for kind, got in kinds.items():
+                if case in out and kind != FAIL:
+                    continue
+                lv = levels[kind]
+                lv.count += got.count
+                lv.reason = lv.reason or got.reason
+                if not lv.evidence:
+                    lv.evidence = list(got.evidence)
+                lv.lines += [n for n in got.lines if n not in lv.lines][:max(0, MAX_LINES - len(lv.lines))]
+                if case and case not in cases and (kind != NOT_TESTED):
+                    cases.append(case)
+        said = "; ".join(f"observations in {case} not claimed: {why}" for case, why in out.items())
+        return levels, tuple(cases), said
+
     def verdict(self, cid: str) -> ClauseVerdict:
         """The combined verdict of one clause (the module's one rule)."""
         e = self._e[cid]
         level = self._level[cid]
-        lv = e.levels
+        lv, cases, unclaimed = self._claimed_levels(cid, e)
         judged = lv[PASS].count + lv[FAIL].count + lv[INCONCLUSIVE].count
-        cases = tuple(e.cases)
         if lv[FAIL].count:
             f = lv[FAIL]
             verdict = FAIL if level == "MUST" else NON_STRICT
@@ -347,7 +419,14 @@ class Ledger:
         else:
             n = lv[NOT_TESTED]
             reason = n.reason or "no occasion to exercise this clause"
+            if unclaimed:
+                reason = unclaimed[:1].upper() + unclaimed[1:] + "."
+                unclaimed = ""
             out = ClauseVerdict(cid, NOT_TESTED, reason, level, cases, (), (), 0, 0)
+        if unclaimed:
+            out = ClauseVerdict(out.id, out.verdict, out.reason + f" ({unclaimed[:1].upper()}{unclaimed[1:]}.)",
+                                out.level, out.cases, out.evidence, out.lines, out.offending_count,
+                                out.observations, out.precision)
         if e.spoiled:
             said = (f" {e.spoiled} observation(s) a faulty line may have spoilt were not judged: each was made "
                     f"again (first: {e.spoiled_reason}).")

@@ -12,8 +12,9 @@ reading such a record (``check-log`` of the relay's log) need not guess from a b
 * :meth:`LineFaults.held_between` — a stall or a cut of the line overlapping a span of time (an
   answer late or lost across it);
 * :attr:`LineFaults.instrumented` — the record carries a relay's notes (its start note, or any
-  fault note): what no note touched, the line did not do (a receiver at another baud,
-  ``reframe``, touches every byte of its direction).
+  fault note), or states a clean link (:mod:`.linemodel`, :meth:`LineFaults.clean_link`): what no
+  note touched, the line did not do (a receiver at another baud, ``reframe``, touches every byte
+  of its direction).
 
 In a relay's log the bytes each way are what the *receiver* got: a fault in the direction a
 sender sent excuses what that sender's line became, and is exactly what the receiver was given
@@ -38,6 +39,9 @@ class LineFaults:
 
     def __init__(self):
         self.instrumented = False
+        #: the record states a clean link (no relay): nothing on it damages or delays bytes, but
+        #: the implementation shares this host's CPU, whose stalls can still make an answer late
+        self.clean = False
         self._pending: dict[str, list[str]] = {TO_VEHICLE: [], FROM_VEHICLE: []}
         self._reframed: dict[str, str] = {}
         self._open: dict[tuple[str, str], float] = {}  #: (kind, direction) -> start
@@ -45,6 +49,12 @@ class LineFaults:
 
     def relay_started(self) -> None:
         self.instrumented = True
+
+    def clean_link(self) -> None:
+        """The record states a link that cannot damage bytes (a pty, TCP on this host): nothing
+        the line did goes unnoted, because it does nothing (:mod:`.linemodel`)."""
+        self.instrumented = True
+        self.clean = True
 
     def note(self, t: float, fault: FaultNote) -> None:
         """A line-fault note at ``t``."""

@@ -23,6 +23,17 @@ are part of the wire-log format, ``docs/contracts.md``):
                                             certify a pass
 ``run resumed: <what>``                     an interrupted run goes on: the ``run partial`` and
                                             ``process`` facts before it no longer hold
+``line model: clean|noisy — <why>``         whether the link could damage bytes
+                                            (:mod:`.linemodel`); the last one holds; none:
+                                            noisy, "the record does not say"
+``not claimed RH-X,RH-Y in CASE: <reason>``  these clauses' observations in that case (a
+                                            backseat scenario whose moment did not reach the
+                                            backseat in time) are left out of the claim: the
+                                            verdict is made from the rest, a violation in it
+                                            standing (:meth:`.Ledger.unclaim`)
+``line overrun: <what>``                    the backseat's requests asked for more replies than
+                                            the line carries: a remark the run verdict's reason
+                                            ends with (it changes no verdict; the last holds)
 ==========================================  ===================================================
 
 (Bench safety refusing a step is a ``not tested RH-X: …`` note of :mod:`.wire`, booked by the
@@ -44,9 +55,10 @@ from pathlib import Path
 from typing import Any, Iterable, Mapping, Optional
 
 from ..grammar.wirelog import NOTE, read_wire_log
+from .linemodel import UNKNOWN, LineModel, read_line_note
 
-__all__ = ["RunFacts", "selection_note", "not_judged_note", "process_note", "partial_note",
-           "NOT_SELECTED", "NOT_SELECTED_OBSERVED"]
+__all__ = ["RunFacts", "selection_note", "not_judged_note", "process_note", "partial_note", "not_claimed_note",
+           "overrun_note", "NOT_SELECTED", "NOT_SELECTED_OBSERVED", "OVERRUN", "UNEXERCISED"]
 
 NOT_SELECTED = "not selected (--select)"
 NOT_SELECTED_OBSERVED = "not selected, but observed: "
@@ -56,6 +68,11 @@ _PROCESS = "process: "
 _PARTIAL = "run partial: "
 _RESUMED = "run resumed: "
 _NOT_JUDGED = re.compile(r"^not judged ((?:RH-[A-Z]+-\d+,?)+): (.*)$")
+_NOT_CLAIMED = re.compile(r"^not claimed ((?:RH-[A-Z]+-\d+,?)+) in (\S+): (.*)$")
+OVERRUN = "line overrun: "
+#: How a ``run partial`` reason begins when the run was not cut short but a scenario's moment did
+#: not reach the backseat (its observations not claimed): the run finished, it is not a certificate.
+UNEXERCISED = "not every scenario was exercised: "
 
 
 def selection_note(patterns: Iterable[str]) -> str:
@@ -74,6 +91,14 @@ def partial_note(reason: str) -> str:
     return (_PARTIAL + reason).replace("\n", " ")
 
 
+def not_claimed_note(clauses: Iterable[str], case: str, reason: str) -> str:
+    return f"not claimed {','.join(clauses)} in {case}: {reason}".replace("\n", " ")
+
+
+def overrun_note(text: str) -> str:
+    return (OVERRUN + text).replace("\n", " ")
+
+
 @dataclass
 class RunFacts:
     """The run facts of one record (module docstring)."""
@@ -83,6 +108,10 @@ class RunFacts:
     process: Optional[dict] = None  #: the ``process`` object, when helmcheck started the implementation
     partial: Optional[str] = None  #: why the run was cut short, or None
     unreadable: list[str] = field(default_factory=list)  #: fact notes that could not be read
+    line_model: LineModel = UNKNOWN  #: whether the link could damage bytes (:mod:`.linemodel`)
+    #: (clause, case) -> why its observations there are not claimed (the first note holds)
+    not_claimed: dict[tuple[str, str], str] = field(default_factory=dict)
+    overrun: Optional[str] = None  #: the line overrun, in words (``line overrun:``), or None
 
     # ------------------------------------------------------------------ reading
     def feed(self, ev: Any) -> None:
@@ -108,6 +137,10 @@ class RunFacts:
         if text.startswith(_PARTIAL):
             self.partial = text[len(_PARTIAL):]
             return True
+        model = read_line_note(text)
+        if model is not None:
+            self.line_model = model
+            return True
         if text.startswith(_RESUMED):
             self.partial = None
             self.process = None
@@ -116,6 +149,14 @@ class RunFacts:
         if m:
             for cid in filter(None, m.group(1).split(",")):
                 self.not_judged.setdefault(cid, m.group(2))
+            return True
+        m = _NOT_CLAIMED.match(text)
+        if m:
+            for cid in filter(None, m.group(1).split(",")):
+                self.not_claimed.setdefault((cid, m.group(2)), m.group(3))
+            return True
+        if text.startswith(OVERRUN):
+            self.overrun = text[len(OVERRUN):]
             return True
         return False
 
@@ -135,6 +176,11 @@ class RunFacts:
         return not self.select or any(fnmatchcase(cid, p) for p in self.select)
 
     @property
+    def interrupted(self) -> bool:
+        """The run was cut short (not merely a scenario left unexercised, :data:`UNEXERCISED`)."""
+        return self.partial is not None and not self.partial.startswith(UNEXERCISED)
+
+    @property
     def ended_early(self) -> bool:
         return isinstance(self.process, dict) and self.process.get("ended_early") is True
 
@@ -146,3 +192,5 @@ class RunFacts:
                 ledger.withdraw(cid, NOT_SELECTED, NOT_SELECTED_OBSERVED)
             elif cid in self.not_judged:
                 ledger.withdraw(cid, self.not_judged[cid])
+        for (cid, case), why in self.not_claimed.items():
+            ledger.unclaim(cid, case, why)

@@ -57,6 +57,13 @@ wire-log format (``docs/contracts.md``):
                                             (:mod:`.linefaults`)
 ``relay started: …``                        the record is a line-fault relay's: what no
                                             ``line fault`` note touched, the line did not do
+``line model: clean|noisy — <why>``         whether the link can damage bytes
+                                            (:mod:`.linemodel`); clean: every broken line,
+                                            lost byte or missing answer is the
+                                            implementation's; none stated: noisy
+``line overrun: <what>``                    the backseat's requests asked for more replies
+                                            than the line carries (``certify backseat``): a
+                                            remark on RH-BS-4, never a verdict
 ``re-run …``                                the tester makes a spoilt observation again
                                             (evidence only: the judge's repetition rule,
                                             :mod:`.streaks`, reads the lines themselves)
@@ -75,6 +82,7 @@ from ..grammar.faultnote import PREFIX as FAULT_PREFIX, read_fault_note
 from ..grammar.wirelog import FROM_VEHICLE, NOTE, TO_VEHICLE, WireEvent
 from ..profile import SAFETY_CODES
 from .linebudget import parse_budget
+from .linemodel import read_line_note
 
 #: Lines a judge's per-line caches keep (decoded sentences, classifications, evidence text, by
 #: the line's bytes): enough for the lines a session repeats (polls, acknowledgements), small
@@ -113,7 +121,7 @@ class Note:
 
     kind: str  #: case | case-end | not-tested | inconclusive | link | budget | plant | fault | lockout |
     #: lockout-end | scenario | silence | silence-end | reject | reject-end | operator | aborted |
-    #: resumed | line-fault | relay
+    #: resumed | line-fault | relay | line-model | overrun
     case: str = ""
     clauses: tuple[str, ...] = ()
     text: str = ""
@@ -150,6 +158,9 @@ def parse_note(text: str) -> Optional[Note]:
         return Note("line-fault", value=fault, text=text) if fault is not None else None
     if text.startswith("relay started: "):
         return Note("relay", text=text)
+    model = read_line_note(text)
+    if model is not None:
+        return Note("line-model", value=model, text=model.why)
     m = _CASE.match(text)
     if m:
         return Note("case", case=m.group(1), clauses=tuple((m.group(2) or "").split()), text=m.group(3))
@@ -204,6 +215,8 @@ def parse_note(text: str) -> Optional[Note]:
         return Note(m.group(1), clauses=tuple(c for c in (m.group(2) or "").split(",") if c), text=m.group(3))
     if text.startswith("run resumed: "):
         return Note("resumed", text=text[13:])
+    if text.startswith("line overrun: "):
+        return Note("overrun", text=text[14:])
     return None
 
 

@@ -3,6 +3,7 @@
 * :mod:`.transport` — opening a byte link (pty, serial device, TCP serial server, any pyserial
   URL) from a port spec; it re-exports the names of the modules below:
 * :mod:`.port_spec` — parsing a ``--port`` value, the baud rates;
+* :mod:`.linekind` — the line model a port gets (a pty or TCP on this host: clean; a UART: noisy);
 * :mod:`.link` — the :class:`~helmcheck.line.link.Link` interface: polling, writing, blocking
   helpers;
 * :mod:`.pty_link`, :mod:`.serial_link`, :mod:`.tcp_link` — the pseudo-terminal, the serial
@@ -18,6 +19,8 @@
   :class:`~.relay.Relay` with the schedule as its stage: ``helmcheck relay``) and
   :mod:`.faultline` (:func:`~.faultline.impaired_line`, a vehicle behind a bad line for a test);
   :mod:`.faultdocs` makes its page, ``docs/line-faults.md``;
+* :mod:`.linekind` — which line model a port gets (a pty, TCP to this host: clean; a UART, a
+  serial server elsewhere: noisy);
 * :mod:`.baudguess` — which common baud rate would make a garbled capture sentences (sans-IO);
 * :mod:`.counters` — a serial port's error counters from the kernel (``TIOCGICOUNT``), or why
   there are none (a pty, a socket);

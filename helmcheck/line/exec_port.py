@@ -12,6 +12,9 @@ port. :func:`open_for_child` opens helmcheck's end, starts the child on the othe
 * ``socket://HOST:PORT`` — the child listens, helmcheck connects. Port 0 means a free port is
   chosen (bound and released just before the child starts). Connection attempts are repeated
   every 0.1 s until one succeeds.
+* ``announced`` — the child makes its own port (a simulator that opens a pty of its own) and prints
+  ``port: URL`` on a line of its standard output; it is given no port, and helmcheck opens the one
+  it printed (:meth:`~.launcher.Launcher.announced`);
 * a device path or another pyserial URL — the child is told the port as given (it is the
   caller's business what the child does with it) and helmcheck opens the port itself at once.
 
@@ -131,5 +134,17 @@ def open_for_child(port: str, launcher: Launcher, *, baud: int, time_scale: floa
                 raise ChildNotReady(f"the {launcher.subject} under test did not listen on {url} "
                                     f"within {ready_s:g} s")
             time.sleep(0.1)
+    if spec.kind == "announced":
+        launcher.start("", time_scale=time_scale)
+        while (said := launcher.announced()) is None:
+            if launcher.ended:
+                raise _ended(launcher, "printed its port (a line 'port: URL')")
+            if time.monotonic() >= deadline:
+                raise ChildNotReady(f"the {launcher.subject} under test did not print its port (a line "
+                                    f"'port: URL' on its standard output) within {ready_s:g} s")
+            time.sleep(_STEP_S)
+        link = open_link(parse_port_spec(said), role="client", baud=baud)
+        link.description = f"{said} (announced by the {launcher.subject} under test)"
+        return link
     launcher.start(spec.text, time_scale=time_scale)
     return open_link(spec, role="client", baud=baud)

@@ -31,7 +31,10 @@ relay` sits between two ports and gives both ends such a line, on purpose and re
 the same `--impair` text, seed and bytes give the same faults. It judges nothing; every fault
 it injects is a note in its wire log, with its time and direction, so whatever runs at either
 end (a backseat under development, `helmcheck certify`, `helmcheck monitor`) can be held
-against exactly what the line did.
+against exactly what the line did. The relay's own ports are ptys, which a tester takes for a
+link that cannot damage bytes: a judge at one end of the relay is told otherwise with `--line
+noisy` (`helmcheck certify vehicle --port /tmp/hc-vehicle --line noisy …`); the relay's wire log
+says so itself (`line model: noisy`).
 
 ```
 helmcheck relay --between pty /dev/ttyUSB0 --link /tmp/hc-vehicle \\

@@ -33,6 +33,7 @@ from typing import Callable, Optional
 
 from .. import __version__
 from ..grammar.faultnote import FaultNote, read_fault_note
+from ..judge.linemodel import NOISY, LineModel, line_note
 from .impair import ImpairedLine
 from .impair_spec import LineFaults, parse_impairment
 from .link import Link
@@ -180,6 +181,7 @@ class FaultRelay:
         self.log.note(self.t0, f"relay started: backseat {self._shown('backseat')}, vehicle {self._shown('vehicle')}; "
                                f"impair {self.faults.text or '(none)'!r}, seed {self.faults.seed}; "
                                f"a cut unplugs the {self.cut_side} side")
+        self.log.note(self.t0, line_note(LineModel(NOISY, "helmcheck relay damages the line (its notes say how)")))
         self.stage = ImpairedLine(self.faults, self.t0)
         self.relay = Relay(self.sides["backseat"], self.sides["vehicle"], forward=True, on_bytes=self.log.bytes,
                            on_event=self._event, clock=self.clock, name="helmcheck-fault-relay",

@@ -10,7 +10,10 @@ Decisions:
   placeholders ``{port}`` (what the child opens or serves: a pty path, ``socket://HOST:PORT``
   or the device given), ``{host}`` and ``{tcp_port}`` (the two halves of a TCP port; empty
   otherwise) and ``{time_scale}`` (the run's K, RH-TIM-2) are replaced; other braces are left
-  alone. A command without ``{port}`` gets the port appended as its last argument.
+  alone. A command without ``{port}`` gets the port appended as its last argument — unless the
+  child announces its own port (``--port announced``: no port is given to it, ``{port}`` is
+  empty, nothing is appended; it prints ``port: URL`` on a line of its standard output,
+  :meth:`Launcher.announced`).
 * The environment passes through, plus ``HELMCHECK_PORT`` (the port) and
   ``HELMCHECK_TIME_SCALE``. Standard input is ``/dev/null``; the working directory is the
   caller's.
@@ -76,7 +79,7 @@ def build_argv(command: str, values: dict[str, str]) -> list[str]:
         for name in PLACEHOLDERS:
             arg = arg.replace("{" + name + "}", str(values.get(name, "")))
         out.append(arg)
-    if not port_seen:
+    if not port_seen and values["port"]:
         out.append(str(values["port"]))
     return out
 
@@ -114,6 +117,7 @@ class Launcher:
         self.ended_at: Optional[float] = None
         self.stopping_at: Optional[float] = None  #: when :meth:`stop` began (None: never)
         self._tail: deque[str] = deque(maxlen=TAIL_LINES)
+        self._announced: Optional[str] = None  #: the port the child printed (``port: URL``)
         self._lock = threading.Lock()
         self._readers: list[threading.Thread] = []
 
@@ -176,7 +180,14 @@ class Launcher:
         with self._lock:
             for raw in lines:
                 text = raw.decode("utf-8", "replace").rstrip("\r")
+                if self._announced is None and text.startswith("port: ") and len(text.split()) == 2:
+                    self._announced = text.split()[1]
                 self._tail.append(text if len(text) <= TAIL_WIDTH else text[: TAIL_WIDTH - 1] + "…")
+
+    def announced(self) -> Optional[str]:
+        """The port the child printed on a line ``port: URL`` of its output (the first such), or None."""
+        with self._lock:
+            return self._announced
 
     # ------------------------------------------------------------------ watch
     @property

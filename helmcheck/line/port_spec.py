@@ -15,7 +15,8 @@ _URL_RE = re.compile(r"^[a-z][a-z0-9+.-]*://", re.I)
 
 @dataclass(frozen=True)
 class PortSpec:
-    """A parsed ``--port`` value. ``kind`` is ``pty``, ``socket``, ``device`` or ``url``."""
+    """A parsed ``--port`` value. ``kind`` is ``pty``, ``socket``, ``device``, ``url`` or
+    ``announced`` (with ``--exec``: the started implementation prints its own port)."""
 
     kind: str
     text: str
@@ -30,6 +31,8 @@ def parse_port_spec(text: str) -> PortSpec:
         raise ValueError("empty port")
     if text == "pty":
         return PortSpec("pty", text)
+    if text == "announced":  # with --exec: the implementation prints "port: URL" (launcher)
+        return PortSpec("announced", text)
     if text.lower().startswith("socket://"):
         m = _SOCKET_RE.match(text)
         if m is None:

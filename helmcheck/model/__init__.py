@@ -16,6 +16,8 @@ Modules, one concern each:
   :mod:`~helmcheck.model.plant` — plant snapshot and plant events; :mod:`~helmcheck.model.events`
   — events the model reports.
 * :mod:`~helmcheck.model.observe` — what a conforming vehicle may report at a time (RH-TIM-1).
+* :mod:`~helmcheck.model.readings` — the readings table: the profile's open questions and every
+  answer they allow (the model answers by its ``readings``; the judge accepts them all).
 * :mod:`~helmcheck.model.testing` — a test mission, a catalogue and command builders;
   :mod:`~helmcheck.model.coverage` — which clauses a body of tests names;
   :mod:`~helmcheck.model.geo` — great-circle distance.

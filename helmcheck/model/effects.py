@@ -99,6 +99,7 @@ class StateEffects:
                        srp: Optional[Mission] = None, as_srp: bool = False) -> None:
         """Mission state as ``$OMSTART`` leaves it (``mission`` given) or ``$OMSTOP`` (None):
         remote control and the queue ended, the safety episode over (RH-MSN-2/3, RH-RD-13)."""
+        self.stopped_loaded = mission is None and (self.mission is not None or self.stopped_loaded)
         self._end_remote()
         self.mission = mission
         self.mission_mode = "N"

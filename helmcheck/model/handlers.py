@@ -5,7 +5,8 @@ and phase*; the functions here do the rest: set-points, the queue, timers, missi
 settings and the replies. ``CHECKS`` are the data-dependent checks that run after the table has
 accepted a command and before anything changes (``$OJW`` index RH-JW-1, ``$OLOGD`` count
 RH-LOG-2, no mission loaded 17 and look-ups 1/3/31 RH-RD-6, ``$OPK`` distance 40 RH-PK-1);
-``APPLY`` maps each event to its effect; ``EXPIRE`` maps each timer to its expiry.
+``APPLY`` maps each event to its effect; ``EXPIRE`` maps each timer to its expiry;
+:func:`reading_field_error` is a field error as the vehicle's readings (:mod:`.readings`) have it.
 Each function names the clauses it implements in its docstring.
 """
 
@@ -13,7 +14,10 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Callable, Optional, Union
 
+import dataclasses
+
 from ..grammar import sentences as s
+from ..grammar.ranges import mission_name_problem
 from . import events as ev
 from .geo import distance_m
 from .missions import BadMission, Mission, MissingMission
@@ -23,7 +27,7 @@ from .transitions import STAY, Row
 if TYPE_CHECKING:  # pragma: no cover
     from .vehicle import VehicleModel
 
-__all__ = ["CHECKS", "APPLY", "EXPIRE", "ack"]
+__all__ = ["CHECKS", "APPLY", "EXPIRE", "ack", "reading_field_error", "reading_repair", "reading_flag_error"]
 
 _ACKS: dict[tuple[int, int, int], s.ACK] = {}
 
@@ -62,16 +66,67 @@ def _chk_omload(m: VehicleModel, c: s.OMLOAD) -> Optional[int]:
 
 def _chk_omstart(m: VehicleModel, c: Union[s.OMSTART, s.OMSTARTPaper]) -> Optional[int]:
     if isinstance(c, s.OMSTARTPaper):
-        return None if m.loaded is not None else 17
+        if m.loaded is None or (m.stopped_loaded and m.readings["stop_unloads"] == "unloaded"):
+            return 17
+        return None
     found = m._lookup(c.name)
     if isinstance(found, MissingMission):
         return 1
     if isinstance(found, BadMission):
         return 3
     if c.srp:
+        if mission_name_problem(c.srp) is not None:
+            return 31  # the path rules read as a look-up (reading srp_bad_path = 31): never opened
         if not isinstance(m._lookup(c.srp), Mission):
             return 31
     return None
+
+
+def reading_repair(m: VehicleModel, err) -> Optional[s.Command]:
+    """The command a line the grammar refuses for one field is, read as the vehicle's readings
+    read that field (``srp_bad_path = 31``: an SRP name that breaks the path rules;
+    ``omw_pitch_speed = unbounded``: an ``$OMW`` pitch or speed beyond ``$OMS``'s ranges), or None
+    (the line is refused for its field, as the grammar says)."""
+    part, name = err.partial, err.field
+    if part is None or not name or err.value is None:
+        return None
+    if any(getattr(part, f) is None for f in part.field_names() if f != name and f not in ("srp", "depth2")):
+        return None  # another field is bad too
+    r = m.readings
+    if type(part) is s.OMSTART and name == "srp" and r["srp_bad_path"] == "31":
+        return dataclasses.replace(part, srp=err.value)
+    if type(part) is s.OMW and name in ("max_pitch", "speed") and r["omw_pitch_speed"] == "unbounded":
+        from decimal import Decimal, InvalidOperation
+        try:
+            value = Decimal(err.value)
+        except (InvalidOperation, ValueError):
+            return None
+        return dataclasses.replace(part, **{name: value}) if value.is_finite() and value >= 0 else None
+    return None
+
+
+def reading_flag_error(m: VehicleModel, c: s.OMLOAD) -> Optional[int]:
+    """An ``$OMLOAD`` flag outside the flags the vehicle takes (``omload_flag``: any, 0-3 or 0): 29."""
+    allowed = {"0-3": (0, 1, 2, 3), "0": (0,)}.get(m.readings["omload_flag"])
+    return 29 if allowed is not None and int(c.flag) not in allowed else None
+
+
+def reading_field_error(m: VehicleModel, c: s.Command, err: int) -> Optional[int]:
+    """``err`` (the command's field error) as the vehicle's readings have it (:mod:`.readings`):
+    None where a reading takes the bad field elsewhere (an SRP name's path to the look-up,
+    ``srp_bad_path = 31``) or not as bad at all (``$OMW`` pitch and speed, ``omw_pitch_speed =
+    unbounded``), when no other field is bad."""
+    from .validate import field_error
+    r = m.readings
+    if type(c) is s.OMSTART and c.srp and r["srp_bad_path"] == "31" and mission_name_problem(c.srp) is not None:
+        return field_error(dataclasses.replace(c, srp="srp.mis"), m.profile)
+    if type(c) is s.OMW and r["omw_pitch_speed"] == "unbounded":
+        pitch = min(c.max_pitch, 45) if c.max_pitch >= 0 else c.max_pitch
+        top = m.profile.max_speed_kn
+        speed = min(c.speed, type(c.speed)(str(top))) if c.speed >= 0 else c.speed
+        if (pitch, speed) != (c.max_pitch, c.speed):
+            return field_error(dataclasses.replace(c, max_pitch=pitch, speed=speed), m.profile)
+    return err
 
 
 def _chk_opk(m: VehicleModel, c: s.OPK) -> Optional[int]:
@@ -165,6 +220,7 @@ def _do_omstop(m: VehicleModel, row: Row, c: s.OMSTOP, now: float) -> list[s.Rep
 def _do_omload(m: VehicleModel, row: Row, c: s.OMLOAD, now: float) -> list[s.Reply]:
     """RH-MSN-1: the mission becomes the loaded one."""
     m.loaded = m._lookup(c.name)  # type: ignore[assignment]
+    m.stopped_loaded = False
     return [_ack(2)]
 
 
@@ -183,9 +239,10 @@ def _do_omstart(m: VehicleModel, row: Row, c: Union[s.OMSTART, s.OMSTARTPaper],
 def _do_opos(m: VehicleModel, row: Row, c: s.OPOS, now: float) -> list[s.Reply]:
     """RH-POS-2, RH-RD-10: C and T always applied; position and speed only without a GPS fix."""
     changes: dict[str, float] = {}
-    if c.conductivity is not None and c.conductivity != "":
+    reported = m.readings["opos_ctd"] == "reported"  # else used inside, $OCTD its own sensor's
+    if reported and c.conductivity is not None and c.conductivity != "":
         changes["conductivity"] = float(c.conductivity)
-    if c.temperature is not None and c.temperature != "":
+    if reported and c.temperature is not None and c.temperature != "":
         changes["temperature"] = float(c.temperature)
     applied = not m.gps_fix
     if applied:
@@ -293,6 +350,7 @@ def _next_waypoint(m: VehicleModel, row: Row, now: float) -> None:
         m.mission_mode = "N"
         m.mission_wp = 0
         m.srp_active = False
+        m.stopped_loaded = True
         m._transition(row, now)
         m._pending.append(ev.MissionEnded(now))
     else:

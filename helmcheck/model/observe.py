@@ -92,10 +92,18 @@ class Acceptable:
         return _fits(osi, self.mode, self.waypoint, self.error_state, self.srp_active, self.park_lo, self.park_hi)
 
 
+def shown_waypoints(mode: str, waypoint: int) -> tuple[int, ...]:
+    """What ``$OSI`` field 3 may show for the model's ``waypoint`` in ``mode``: in a mission park (``P``)
+    the waypoint parked on or the one after it — RH-OUT-1's "next waypoint" is open there (RD-5 pins
+    field 3 in A, M, mP, W and S only; the readings table: ``park_waypoint``)."""
+    return (waypoint, waypoint + 1) if mode == "P" else (waypoint,)
+
+
 def _fits(osi: s.OSI, mode: str, waypoint: int, error_state: str, srp_active: bool, park_lo: int,
           park_hi: int) -> bool:
     """:meth:`Acceptable.matches` of the state with these fields."""
-    return (osi.mode == mode and osi.next_waypoint == waypoint and osi.error_state == error_state
+    return (osi.mode == mode and osi.next_waypoint in shown_waypoints(mode, waypoint)
+            and osi.error_state == error_state
             and park_lo <= osi.park_time <= park_hi
             and (osi.srp_active is None or osi.srp_active == ("True" if srp_active else "False")))
 
@@ -122,7 +130,7 @@ class Expectation:
         if not cands:
             return [Finding("RH-OUT-4", f"mode {osi.mode!r} {at}; a conforming vehicle reports "
                                         f"{' or '.join(self.modes)}", "mode")]
-        wp = [a for a in cands if a.waypoint == osi.next_waypoint]
+        wp = [a for a in cands if osi.next_waypoint in shown_waypoints(a.mode, a.waypoint)]
         if not wp:
             want = sorted({a.waypoint for a in cands})
             out.append(Finding("RH-OUT-4", f"next waypoint {osi.next_waypoint} in mode {osi.mode} {at}; "

@@ -108,8 +108,13 @@ class VehicleStatus:
 
     @property
     def osi_waypoint(self) -> int:
-        """``$OSI`` field 3: the (frozen) mission waypoint, 0 in ``S`` (RH-RD-5)."""
-        return self.mission_wp if self.mission is not None else 0
+        """``$OSI`` field 3: the (frozen) mission waypoint, 0 in ``S`` (RH-RD-5); in a mission park the
+        waypoint parked on, or the one after it (the readings table's ``park_waypoint``)."""
+        if self.mission is None:
+            return 0
+        if self.readings["park_waypoint"] == "next" and (self.mode == "P" or self.mission_mode == "P"):
+            return self.mission_wp + 1  # the index moved on at the arrival, also while the park is frozen
+        return self.mission_wp
 
     def state(self, now: Optional[float] = None) -> tuple[str, int, str, int, bool]:
         """(mode, field 3, error state, field 10 seconds, SRP active): the judged ``$OSI`` fields."""

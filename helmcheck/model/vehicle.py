@@ -78,11 +78,12 @@ from .missions import BadMission, InMemoryCatalog, Mission, MissingMission, Miss
 from .plant import (AtSurface, OnStation, PlantEvent, PlantSnapshot, QueueWaypointReached, SafetyViolation,
                     Submerged, WaypointReached)
 from .records import LogRow, OposRecord
-from .handlers import APPLY as _APPLY, CHECKS as _CHECKS, EXPIRE as _EXPIRE, ack as _ack
+from .handlers import APPLY as _APPLY, CHECKS as _CHECKS, EXPIRE as _EXPIRE, ack as _ack, reading_field_error, reading_flag_error, reading_repair
 from .settings import SettingsStore
 from .status import VehicleStatus
 from .timers import Timers
 from .transitions import ERRORS, EVENT_OF_ACK_TYPE, Row, rows_for, select
+from .readings import DEFAULTS as READINGS_DEFAULTS
 from .validate import field_error
 
 __all__ = ["VehicleModel", "LogRow", "OposRecord", "Item", "Step"]
@@ -126,6 +127,9 @@ class VehicleModel(VehicleStatus, StateEffects):
         self.phase = "none"
         # mission sub-state (frozen while remote control or a safety episode is active)
         self.loaded: Optional[Mission] = None
+        #: the loaded mission has run and was stopped (``$OMSTOP``) or ended since it was loaded or
+        #: started: whether it is still loaded then is a reading (``stop_unloads``, :mod:`.readings`)
+        self.stopped_loaded = False
         self.mission: Optional[Mission] = None
         self.mission_mode = "N"
         self.mission_wp = 0
@@ -170,6 +174,9 @@ class VehicleModel(VehicleStatus, StateEffects):
         self._firing: Optional[tuple[str, float]] = None
         self._snap = snapshot if snapshot is not None else PlantSnapshot()
         self._data = DataCache(profile, self._snap)
+        #: the profile's open questions as this vehicle answers them (:mod:`.readings`; never
+        #: changed in place: a clone shares it, a new reading replaces it)
+        self.readings: dict[str, str] = READINGS_DEFAULTS
 
     # ================================================================ guard atoms (table)
 
@@ -278,9 +285,13 @@ class VehicleModel(VehicleStatus, StateEffects):
         row = select(self.mode, self.phase, event, self)
         assert row is not None, (self.mode, self.phase, event)
         t = item.ACK_TYPE  # type: ignore[union-attr]
-        if row.error == 26:
+        if row.error == 26 and not (self.phase == "ascent" and self.readings["ascent_refusal_order"] != "first"):
             return [_ack(t, 26)]
         err = field_error(item, self.profile)  # type: ignore[arg-type]
+        if err is not None:
+            err = reading_field_error(self, item, err)
+        elif cls is s.OMLOAD and self.readings["omload_flag"] != "any":
+            err = reading_flag_error(self, item)
         if err is None:
             err = row.error
         if err is None:
@@ -402,11 +413,16 @@ class VehicleModel(VehicleStatus, StateEffects):
         t = err.ack_type
         if t is None:
             return []
+        if err.partial is not None and self.readings is not READINGS_DEFAULTS:
+            fixed = reading_repair(self, err)  # a field the vehicle's readings take otherwise
+            if fixed is not None:
+                return self.receive(fixed, self.now if self.now is not None else 0.0)
         event = EVENT_OF_ACK_TYPE.get(t)
         if event is None or event not in self._commands:
             return []
         rows = rows_for(self.mode, self.phase, event)
-        if rows and rows[0].error == 26:
+        if rows and rows[0].error == 26 and not (self.phase == "ascent"
+                                                 and self.readings["ascent_refusal_order"] != "first"):
             return [_ack(t, 26)]
         return [_ack(t, err.ack_err if err.ack_err else ERRORS[event])]
 

@@ -34,6 +34,8 @@ from typing import Any, Callable, Optional
 from .. import __version__
 from ..failures import describe_interrupt
 from ..grammar.wirelog import run_header
+from ..judge.linemodel import line_note
+from ..line.linekind import line_of_sides
 from ..line.link import Link
 from ..line.reopen import DEFAULT_WAIT_S, gap_event
 from ..line.transport import open_link, parse_port_spec
@@ -78,6 +80,8 @@ class Options:
     #: 0: gone for good at once), :mod:`.gaps`
     reconnect_wait: float = DEFAULT_WAIT_S
     on_gap: Optional[Callable[[str], None]] = None  #: told (from the main thread) a side is gone, back
+    #: ``--line clean|noisy`` (None: clean only when both sides are, :func:`helmcheck.line.linekind.line_of_sides`)
+    line: Optional[str] = None
 
 
 @dataclass
@@ -143,6 +147,8 @@ def monitor(opts: Options) -> Result:
                   on_event=on_event, clock=time.monotonic, realtime=opts.realtime,
                   reopen=gaps.reopen if gaps.any else None)
     slog.note(0.0, f"monitor started ({opts.mode}): backseat {b_link.name}, vehicle {v_link.name}")
+    slog.note(0.0, line_note(line_of_sides([(opts.backseat, roles["backseat"] == "server"),
+                                            (opts.vehicle, roles["vehicle"] == "server")], opts.line)))
     relay.start()
     slog.note(time.monotonic() - t0, f"monitor: relay priority {relay.started()}")
     if opts.on_relay is not None:

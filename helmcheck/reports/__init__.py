@@ -15,7 +15,8 @@ Modules, one concern each:
 * :mod:`~helmcheck.reports.rundir` — one read of a results directory (:class:`Run`).
 * :mod:`~helmcheck.reports.view` — clause rows joined with the profile, grouped and counted.
 * :mod:`~helmcheck.reports.text` — printable text, short titles.
-* :mod:`~helmcheck.reports.linecounters` — the port's line error counters of a run, in a sentence.
+* :mod:`~helmcheck.reports.linecounters` — the line a run was judged on, in a sentence each: its model
+  (clean or noisy, and why) and its port's error counters.
 * :mod:`~helmcheck.reports.timeline` — the mode timeline SVG.
 * :mod:`~helmcheck.reports.html`, :mod:`~helmcheck.reports.junit`,
   :mod:`~helmcheck.reports.markdown`, :mod:`~helmcheck.reports.compare` — the renderings.
@@ -24,7 +25,8 @@ Modules, one concern each:
   tables; :mod:`~helmcheck.reports.html_certificate` — the first page;
   :mod:`~helmcheck.reports.html_clauses` — clause matrix, findings, passing evidence;
   :mod:`~helmcheck.reports.html_run` — implementation, run, process, restore;
-  :mod:`~helmcheck.reports.html_coverage` — model coverage and the event table.
+  :mod:`~helmcheck.reports.html_coverage` — model coverage and the event table;
+  :mod:`~helmcheck.reports.html_scenarios` — a backseat run's scenarios, what each exercised.
 * :mod:`~helmcheck.reports.render` — :func:`render_all` (the command line is ``helmcheck report``).
 * :mod:`~helmcheck.reports.matrix` — several runs side by side (``helmcheck matrix``).
 

@@ -9,12 +9,15 @@
 * the verdict ledger of the role's observer (:class:`helmcheck.judge.ledger.Ledger`), or the
   entries of one (``check-log`` returns entries);
 * the run facts read from the wire log's notes (:class:`helmcheck.judge.runfacts.RunFacts`):
-  the selection, the clauses not judged, the implementation under test's end (``process``),
-  whether the run was cut short (``run partial``).
+  the selection, the clauses not judged, a backseat scenario's observations not claimed
+  (``not claimed``), the implementation under test's end (``process``), whether the run was cut
+  short or a scenario not exercised (``run partial``), the line model (``line model:``), a line
+  overrun (``line overrun:``, a remark the reason ends with).
 
 Its outputs (:class:`Assembly`): the clause entries of ``results.json`` (the facts booked into
 the ledger first: a clause not selected or not judged is NOT-TESTED unless a violation was
-observed), ``partial``, the ``process`` object, the run verdict
+observed), ``partial``, the ``process`` object, ``line_model`` (whether the link could damage
+bytes, and why: :mod:`helmcheck.judge.linemodel`), the run verdict
 (:func:`~.verdicts.run_verdict`: an implementation that ended early is FAIL), its reason
 (:func:`~.verdicts.describe_verdict`) and the scope (:func:`~.scope.scope_of`: the certificate
 flag). :func:`apply` writes an assembly into a results document; nothing changes a verdict after
@@ -42,6 +45,7 @@ class Assembly:
     clauses: list
     partial: bool
     process: Optional[dict]
+    line_model: dict
     verdict: str
     verdict_reason: str
     scope: Scope
@@ -76,11 +80,15 @@ def assemble(role: str, judged: Any, facts: Optional[RunFacts] = None, *, strict
     verdicts = [c["verdict"] for c in clauses]
     verdict = run_verdict(verdicts, strict=strict, partial=cut, process_failed=facts.ended_early)
     reason = describe_verdict(clauses, strict=strict, partial=cut, process=process,
-                              subject=role if role in ("vehicle", "backseat") else "implementation")
+                              subject=role if role in ("vehicle", "backseat") else "implementation",
+                              interrupted=partial is not None or facts.partial is None or facts.interrupted)
     if lead and not facts.ended_early:  # an implementation that ended early: its end is the reason
         reason = f"{lead[:1].upper()}{lead[1:]}. {reason}"
+    if facts.overrun:  # a remark: it changes no verdict (RH-BS-4 bounds what the backseat sends)
+        reason += (f" Line overrun (a remark beside RH-BS-4, which bounds only the bytes the backseat sends): "
+                   f"{facts.overrun}.")
     scope = scope_of({"role": role, "clauses": clauses, "partial": cut})
-    return Assembly(role, clauses, cut, process, verdict, reason, scope)
+    return Assembly(role, clauses, cut, process, facts.line_model.as_dict(), verdict, reason, scope)
 
 
 def apply(results: dict[str, Any], a: Assembly, *, final: bool = True, finished: Optional[str] = None,
@@ -94,6 +102,7 @@ def apply(results: dict[str, Any], a: Assembly, *, final: bool = True, finished:
         results["process"] = a.process
     else:
         results.pop("process", None)
+    results["line_model"] = a.line_model
     results["verdict"] = a.verdict
     results["verdict_reason"] = a.verdict_reason
     if final:

@@ -3,7 +3,8 @@
 Contents, top to bottom. The first screen (and, printed, the first page) is the certificate: a
 PARTIAL warning when the run was interrupted; the verdict banner, which leads with the scope
 (:func:`helmcheck.reports.scope.headline`, "PASS — partial: 4 of 60 claimed clauses judged; not
-a certificate") and lists why clauses were not judged; what was tested
+a certificate"), then what failed (each failed clause with its reason), then why clauses were not
+judged, then what timing judged coarser than nominal precision means; what was tested
 (:func:`helmcheck.reports.identity.identity_rows`: implementation, serial, version, name on the
 wire, operator, site, profile SHA-256, tester version and revision); the digest and the
 signature; clause counts. Under it a line of links to every section, then what needs attention:
@@ -11,7 +12,9 @@ one finding per non-pass clause (worst first) with its replay steps and wire exc
 helmcheck started the implementation (``--exec``) a "Process under test" section says how it
 ended, with its last output; a vehicle run says how the vehicle was restored. Then the clause
 matrix by section of the reference profile (requirement text from ``helmcheck.clauses``), each
-section folded unless a clause in it failed or was inconclusive. The rest is folded behind a title
+section folded unless a clause in it failed or was inconclusive; a backseat run's scenarios
+(:mod:`~helmcheck.reports.html_scenarios`: what each exercised and for how long, open when one is
+not claimed in full). The rest is folded behind a title
 and a one-line gist (:func:`~helmcheck.reports.html_markup._fold`): the evidence of every passing
 clause; the implementation as declared and as seen on the wire (first ``$OSI``, RH-OUT-1 field
 18); the run (command, times, settings); the profile; model coverage, with what it means for the
@@ -29,8 +32,9 @@ This module assembles the page (:func:`render_html`); the parts are
 :mod:`~helmcheck.reports.html_style` (CSS, CSP), :mod:`~helmcheck.reports.html_markup` (escaping,
 tables, folds), :mod:`~helmcheck.reports.html_certificate` (the first page),
 :mod:`~helmcheck.reports.html_clauses` (matrix, findings, evidence),
-:mod:`~helmcheck.reports.html_run` (implementation, run, process, restore) and
-:mod:`~helmcheck.reports.html_coverage` (coverage, events).
+:mod:`~helmcheck.reports.html_run` (implementation, run, process, restore),
+:mod:`~helmcheck.reports.html_coverage` (coverage, events) and
+:mod:`~helmcheck.reports.html_scenarios` (a backseat run's scenarios).
 """
 
 from __future__ import annotations
@@ -42,6 +46,8 @@ from .html_clauses import EVIDENCE_LIMIT, _findings, _has_finding, _matrix, _pas
 from .html_coverage import _coverage, _coverage_gist, _event_summary, _events_table
 from .html_markup import _e, _flatten, _fold, _kv_table, _section, md_inline
 from .html_run import _identity, _process, _restore, _run_facts, restore_headline
+from .identity import backseat_name
+from .html_scenarios import scenarios_section
 from .html_style import _CSP, _CSS
 from .rundir import Run
 from .scope import headline
@@ -68,6 +74,7 @@ def render_html(run: Run, comparison_html: str | None = None) -> str:
         *([_fold("restore", "Vehicle restored", _restore(run), _e(restore_headline(r["restore"])),
                  open_=not r["restore"].get("verified"))] if isinstance(r.get("restore"), Mapping) else []),
         _section("matrix", f"Clauses ({len(rows)})", _matrix(run)),
+        *([scenarios_section(run)] if scenarios_section(run) else []),
         _fold("evidence", "Evidence for passing clauses", _pass_evidence(run),
               _e(f"the wire evidence of {passed} passing clause(s)")),
         _fold("implementation", "Implementation", _identity(run), _implementation_gist(run),
@@ -106,7 +113,8 @@ def _contents(run: Run, findings: int, comparison: bool) -> str:
     links = [("findings", f"Findings ({findings})" if findings else "Findings"),
              *([("process", "Process")] if isinstance(r.get("process"), Mapping) else []),
              *([("restore", "Restore")] if isinstance(r.get("restore"), Mapping) else []),
-             ("matrix", "Clauses"), ("evidence", "Evidence"), ("implementation", "Implementation"),
+             ("matrix", "Clauses"), *([("scenarios", "Scenarios")] if scenarios_section(run) else []),
+             ("evidence", "Evidence"), ("implementation", "Implementation"),
              ("run", "Run"), ("profile", "Profile"), ("coverage", "Coverage"), ("timeline", "Timeline"),
              *([("comparison", "Comparison")] if comparison else [])]
     return ('<nav class="contents" id="contents">'
@@ -114,6 +122,8 @@ def _contents(run: Run, findings: int, comparison: bool) -> str:
 
 
 def _name_mismatch(run: Run) -> bool:
+    if run.results["role"] == "backseat":
+        return False  # the $OSI name is the vehicle helmcheck played
     declared, seen = run.results["implementation"].get("vehicle_name"), run.wire["osi_vehicle_name"]
     return bool(declared and seen is not None and declared != seen)
 
@@ -122,8 +132,12 @@ def _implementation_gist(run: Run) -> str:
     seen = run.wire["osi_vehicle_name"]
     if _name_mismatch(run):
         return ('<span class="warn">the vehicle name on the wire differs from the declared one</span>')
-    parts = [f"name on the wire: {seen}" if seen is not None else "",
-             f"{run.wire['records']} wire-log records" if run.wire["present"] else "no wire log"]
+    if run.results["role"] == "backseat":
+        name = backseat_name(run.results)[0]
+        first = f"backseat: {name}" if name else "backseat: not named (--implementation)"
+    else:
+        first = f"name on the wire: {seen}" if seen is not None else ""
+    parts = [first, f"{run.wire['records']} wire-log records" if run.wire["present"] else "no wire log"]
     return _e(" · ".join(p for p in parts if p))
 
 

@@ -1,24 +1,35 @@
-"""The HTML report's first page, the certificate: verdict banner and scope, what was tested, the
-digest and the signature, when and how the run ran (with the exploration's model coverage and
-what it means for the verdict), clause counts.
+"""The HTML report's first page, the certificate: the verdict banner — the scope, the verdict's
+reason, what failed (each failed clause with its reason, linked to its finding), what was not
+judged and why, what timing judged coarser than nominal precision means — then what was tested,
+the digest and the signature, when and how the run ran (with the exploration's model coverage
+and what it means for the verdict), clause counts. A backseat's page is headed with the backseat
+(``--implementation``, else the command ``--exec`` ran), never the vehicle helmcheck played.
 """
 
 from __future__ import annotations
 
+import re
 from typing import Mapping
 
 from ..judge.verdict import Verdict
 from .html_markup import _e
-from .identity import identity_rows
+from .identity import backseat_name, identity_rows
 from .rundir import Run
-from .scope import model_coverage, model_coverage_note, reach_text, scope_of
+from .scope import failures, model_coverage, model_coverage_note, precision_note, reach_text, scope_of
+
+_CLAUSE_ID = re.compile(r"RH-[A-Z]+-\d+[a-z]?")
 from .view import VERDICT_LABEL, counts
 
 
 def _banner(run: Run) -> str:
     r = run.results
     out = []
-    if r["partial"]:
+    if r["partial"] and scope_of(r).unexercised:
+        out.append('<div class="partial" id="partial">PARTIAL RUN — the run finished, but not every scenario '
+                   'was exercised: a moment it exists for did not reach the backseat in time, and its '
+                   'observations there are not claimed (<a href="#scenarios">Scenarios</a>); this is not a '
+                   "complete certificate.</div>")
+    elif r["partial"]:
         out.append('<div class="partial" id="partial">PARTIAL RUN — the run was interrupted before it '
                    "finished. Clauses it did not reach are missing or NOT-TESTED; this is not a "
                    "complete certificate.</div>")
@@ -31,13 +42,26 @@ def _banner(run: Run) -> str:
     partial_scope = not scope.certificate and r["verdict"] in (Verdict.PASS, Verdict.NON_STRICT)
     cls = (f'banner v-{_e(r["verdict"])}' + ("" if scope.certificate else " not-certificate")
            + (" scope-partial" if partial_scope else ""))
+    failed = "".join(f"<li>{_failed_item(line)}</li>" for line in failures(r))
     gaps = "".join(f"<li>{_e(line)}</li>" for line in scope.why())
+    precision = precision_note(r)
     out.append(f'<div class="{cls}" id="verdict" data-certificate="{str(scope.certificate).lower()}">'
                f'<div class="word" id="scope"><span class="vw v-{_e(r["verdict"])}">{_e(word)}</span> — '
                f'{_e(scope.statement)}{strict}</div>'
                f'<div class="why">{_e(r["verdict_reason"])}</div>'
-               + (f'<ul class="gaps" id="scope-gaps">{gaps}</ul>' if gaps else "") + "</div>")
+               + (f'<ul class="failed" id="failed">{failed}</ul>' if failed else "")
+               + (f'<div class="gaps-head">Not judged:</div><ul class="gaps" id="scope-gaps">{gaps}</ul>'
+                  if gaps else "")
+               + (f'<p class="precision" id="precision">{_e(precision)}</p>' if precision else "") + "</div>")
     return "\n".join(out)
+
+
+def _failed_item(line: str) -> str:
+    """A line of :func:`~helmcheck.reports.scope.failures`: its clause ID leads, linked to the finding."""
+    cid, _, rest = line.partition(" ")
+    if _CLAUSE_ID.fullmatch(cid):
+        return f'<a href="#finding-{_e(cid)}"><b>{_e(cid)}</b></a> {_e(rest)}'
+    return _e(line)
 
 
 def _identity_table(run: Run) -> str:
@@ -84,8 +108,11 @@ def _run_box(run: Run) -> str:
 def _certificate_page(run: Run) -> str:
     """Everything that belongs on the first page: verdict, scope, identity, digest, signature."""
     r = run.results
-    name = next((v for label, v, missing in identity_rows(r, run.wire["osi_vehicle_name"])
-                 if label in ("vehicle", "backseat") and not missing), None)
+    if r["role"] == "backseat":
+        name = backseat_name(r)[0]
+    else:
+        name = next((v for label, v, missing in identity_rows(r, run.wire["osi_vehicle_name"])
+                     if label == "vehicle" and not missing), None)
     kind = "certificate" if scope_of(r).certificate else "report"
     heading = f'helmcheck {r["role"]} {kind}' + (f" — {name}" if name else "")
     return "\n".join([

@@ -1,5 +1,5 @@
 """The HTML report's sections about the run: the implementation as declared and as seen on the
-wire, the run's facts (the port's line error counters among them), the process under test (``--exec``) and the vehicle's restore.
+wire (a backseat by its own name, never the vehicle helmcheck played), the run's facts (the line model and the port's line error counters among them), the process under test (``--exec``) and the vehicle's restore.
 """
 
 from __future__ import annotations
@@ -7,7 +7,8 @@ from __future__ import annotations
 from typing import Mapping
 
 from .html_markup import _e, _flatten, _kv_table
-from .linecounters import counters_summary
+from .identity import EXEC_NAMED, backseat_name
+from .linecounters import counters_summary, line_model_summary
 from .rundir import Run
 from .verdicts import describe_process
 
@@ -19,6 +20,9 @@ def _run_facts(run: Run) -> str:
             ("duration", None if r["duration_s"] is None else f'{r["duration_s"]:.3f} s'),
             ("seed", r["seed"]), ("results directory", str(run.directory))]
     rows += [(f"settings.{k}", v) for k, v in _flatten(r["settings"])]
+    model = line_model_summary(r)
+    if model is not None:
+        rows.append(("line model", model))
     counters = counters_summary(r)
     if counters is not None:
         rows.append(("line error counters", counters))
@@ -26,25 +30,36 @@ def _run_facts(run: Run) -> str:
 
 
 def _identity(run: Run) -> str:
+    """The implementation under test, as declared and as seen on the wire. A backseat is named by
+    its ``--implementation`` or the command ``--exec`` ran; what the vehicle helmcheck played
+    said of itself (its ``$OSI``) is not the implementation's and is not shown as such."""
     impl = run.results["implementation"]
     wire = run.wire
-    out = ["<h3>Declared</h3>", _kv_table(_flatten(impl))]
+    backseat = run.results["role"] == "backseat"
+    declared = _flatten(impl)
+    if backseat:  # its port and protocol; what else an older record holds is the vehicle helmcheck played
+        name, by_exec = backseat_name(run.results)
+        declared = [("backseat", None if name is None else f"{name} ({EXEC_NAMED})" if by_exec else name),
+                    *((k, v) for k, v in declared if k in ("port", "protocol"))]
+    out = ["<h3>Declared</h3>", _kv_table(declared)]
     out.append("<h3>As seen on the wire</h3>")
     if not wire["present"]:
         out.append('<p class="warn">No wire log.</p>')
         return "\n".join(out)
     by_dir = wire["by_dir"]
+    to_v, from_v = by_dir[">"] + by_dir[">~"], by_dir["<"] + by_dir["<~"]
+    records = (f'{to_v} from the backseat, {from_v} from the vehicle helmcheck played' if backseat
+               else f'{to_v} to the vehicle, {from_v} from the vehicle')
     rows = [
         ("wire log", run.results["wire_log"] + ("" if wire["format_ok"] else " (no wire-log 1 format tag)")),
         ("recorder header", " | ".join(wire["header"]) or None),
-        ("records", f'{wire["records"]} ({by_dir[">"] + by_dir[">~"]} to the vehicle, '
-                    f'{by_dir["<"] + by_dir["<~"]} from the vehicle, {by_dir["!"]} notes'
+        ("records", f'{wire["records"]} ({records}, {by_dir["!"]} notes'
                     f'{", " + str(wire["unparsed"]) + " unparsed" if wire["unparsed"] else ""})'),
         ("time span", None if wire["first_t"] is None else f'{wire["first_t"]:.6f} s – {wire["last_t"]:.6f} s'),
-        ("first $OSI from the vehicle", wire["first_osi"]),
-        ("$OSI field count", wire["osi_fields"]),
-        ("vehicle name ($OSI field 18)", wire["osi_vehicle_name"]),
     ]
+    if not backseat:
+        rows += [("first $OSI from the vehicle", wire["first_osi"]), ("$OSI field count", wire["osi_fields"]),
+                 ("vehicle name ($OSI field 18)", wire["osi_vehicle_name"])]
     out.append(_kv_table(rows))
     declared = impl.get("vehicle_name")
     seen = wire["osi_vehicle_name"]

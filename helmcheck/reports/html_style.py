@@ -97,6 +97,10 @@ footer{margin-top:32px;border-top:1px solid var(--line);padding-top:8px}
 background:repeating-linear-gradient(135deg,#f6f8fa,#f6f8fa 14px,#eaeef2 14px,#eaeef2 28px)}
 .banner .word .vw{border-radius:4px}.banner.not-certificate .word{font-size:22px}
 .banner ul.gaps{margin:6px 0 0;padding-left:20px;font-size:13.5px}.banner ul.gaps li{margin:1px 0}
+.banner ul.failed{margin:6px 0 0;padding-left:20px;font-size:14.5px;overflow-wrap:anywhere}
+.banner ul.failed li{margin:2px 0}.banner ul.failed a{color:inherit}
+.banner .gaps-head{margin-top:8px;font-size:13.5px;font-weight:600}
+.banner p.precision{margin:8px 0 0;font-size:13.5px}
 .cert{display:grid;grid-template-columns:minmax(0,1.15fr) minmax(0,1fr);gap:14px;align-items:start;margin:10px 0}
 .cert h2{font-size:15px;margin:0 0 4px;border:0;padding:0}
 table.ident{width:100%;min-width:0;margin:0;table-layout:fixed}table.ident th{width:12.5em;font-weight:600}

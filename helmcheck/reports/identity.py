@@ -10,8 +10,10 @@
 * A **vehicle** is named by its profile (``vehicle_name``, ``vehicle_serial``, ``uvc_version`` —
   what the owner declares; ``version`` is the UVC/firmware version) and by what it says itself:
   ``name_on_wire`` is field 18 of the first ``$OSI`` in the wire log (RH-OUT-1).
-* A **backseat** is named by ``certify backseat --implementation NAME[@VERSION]``; the vehicle
-  helmcheck played is not the implementation under test and is not named here.
+* A **backseat** is named by ``certify backseat --implementation NAME[@VERSION]``, else by the
+  command ``--exec`` ran (``process.command``, :func:`backseat_name`); the vehicle helmcheck
+  played is not the implementation under test and is named nowhere a report names the
+  implementation (its ``$OSI`` name is helmcheck's own).
 * ``operator`` and ``site`` are what ``--operator`` / ``--site`` said (``null`` when not given).
 * ``profile_sha256`` is the SHA-256 of ``profile.toml`` in the run directory (the resolved
   profile the judges used); ``profile_file`` the path and SHA-256 of the file given with
@@ -36,7 +38,8 @@ from typing import Any, Mapping, Optional
 
 import helmcheck
 
-__all__ = ["Declared", "parse_implementation", "source_revision", "build_identity", "identity_rows", "still_going"]
+__all__ = ["Declared", "parse_implementation", "source_revision", "build_identity", "identity_rows", "still_going",
+           "backseat_name", "EXEC_NAMED"]
 
 
 @dataclass(frozen=True)
@@ -111,6 +114,25 @@ def build_identity(results: Mapping[str, Any], profile, *, declared: Declared, p
 
 
 _NOT_GIVEN = "not given"
+#: Said after a backseat named by the command ``--exec`` ran (no ``--implementation``).
+EXEC_NAMED = "the command --exec ran; --implementation NAME@VERSION names it"
+
+
+def backseat_name(results: Mapping[str, Any]) -> tuple[Optional[str], bool]:
+    """The backseat under test as the reports name it, and whether that is the ``--exec``
+    command: its ``--implementation`` name (``NAME@VERSION``), else the command helmcheck
+    started it with, else ``(None, False)``."""
+    ident = results.get("identity") if isinstance(results.get("identity"), Mapping) else {}
+    impl = ident.get("implementation") or {}
+    name = impl.get("name") if isinstance(impl.get("name"), str) and impl.get("name") else None
+    if name:
+        version = impl.get("version")
+        return (f"{name}@{version}" if isinstance(version, str) and version else name), False
+    proc = results.get("process")
+    command = proc.get("command") if isinstance(proc, Mapping) else None
+    if isinstance(command, str) and command.strip():
+        return " ".join(command.split()), True
+    return None, False
 
 
 def still_going(results: Mapping[str, Any]) -> bool:
@@ -147,7 +169,8 @@ def identity_rows(results: Mapping[str, Any], wire_name: Optional[str] = None) -
     if ident is None:
         legacy = results.get("implementation") or {}
         if role == "backseat":
-            row("backseat", None)
+            name, by_exec = backseat_name(results)
+            row("backseat", f"{name} ({EXEC_NAMED})" if by_exec else name)
         else:
             row("vehicle", legacy.get("vehicle_name") or wire_name)
             row("name on the wire ($OSI 18)", wire_name)
@@ -158,7 +181,8 @@ def identity_rows(results: Mapping[str, Any], wire_name: Optional[str] = None) -
         return rows
     impl = ident.get("implementation") or {}
     if impl.get("role") == "backseat":
-        row("backseat", impl.get("name"))
+        name, by_exec = backseat_name(results)
+        row("backseat", f"{name} ({EXEC_NAMED})" if by_exec else impl.get("name"))
         row("backseat version", impl.get("version"))
     else:
         row("vehicle", impl.get("name"))

@@ -1,4 +1,7 @@
-"""The port's error counters of a vehicle run, in one sentence for a report.
+"""The line a run was judged on, in one sentence each for a report: its model and its port's error counters.
+
+:func:`line_model_summary` says whether the link could damage bytes and why (``results.json``
+``line_model``, :mod:`helmcheck.judge.linemodel`).
 
 ``results.json`` ``cases[].line_counters`` holds, per case, the kernel's per-port error counts
 read when the case started and ended (:mod:`helmcheck.certify.vehicle.casecounters`), or why
@@ -11,7 +14,17 @@ from __future__ import annotations
 
 from typing import Mapping, Optional
 
-__all__ = ["counters_summary"]
+from ..judge.linemodel import LineModel
+
+__all__ = ["counters_summary", "line_model_summary"]
+
+
+def line_model_summary(results: Mapping) -> Optional[str]:
+    """The run's line model in one sentence, or None for a document without one (an older run)."""
+    m = results.get("line_model")
+    if not isinstance(m, Mapping) or m.get("kind") not in ("clean", "noisy"):
+        return None
+    return LineModel(str(m["kind"]), str(m.get("why") or "")).describe()
 
 
 def counters_summary(results: Mapping) -> Optional[str]:

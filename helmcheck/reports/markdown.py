@@ -1,8 +1,12 @@
 """A short Markdown summary for pull requests and CI job pages.
 
 A headline that leads with the scope ("PASS — partial: 4 of 60 claimed clauses judged; not a
-certificate", :func:`helmcheck.reports.scope.headline`) and why clauses were not judged, a
-PARTIAL warning if the run was interrupted, what was tested (identity), the port's line error
+certificate", :func:`helmcheck.reports.scope.headline`), a PARTIAL warning if the run was
+interrupted, the verdict's reason, then what failed (each failed clause with its reason,
+:func:`~helmcheck.reports.scope.failures`), then why clauses were not judged, then what timing
+judged coarser than nominal precision means (:func:`~helmcheck.reports.scope.precision_note`);
+the implementation under test (a backseat by its ``--implementation``, else the command
+``--exec`` ran — never the vehicle helmcheck played), what was tested (identity), the port's line error
 counters (:mod:`helmcheck.reports.linecounters`), a counts table, the
 exploration's model coverage with what it means for the verdict, the clauses that did not pass
 with their reasons (worst first), every passing clause with its first evidence line, real ACK
@@ -16,10 +20,11 @@ from __future__ import annotations
 
 import re
 
-from .identity import identity_rows
-from .linecounters import counters_summary
+from .identity import backseat_name, identity_rows
+from .linecounters import counters_summary, line_model_summary
 from .rundir import Run
-from .scope import MODEL_DIMENSIONS, edge_gist, headline, model_coverage, model_coverage_note, reach_text, scope_of
+from .scope import (MODEL_DIMENSIONS, edge_gist, failures, headline, model_coverage, model_coverage_note,
+                    precision_note, reach_text, scope_of)
 from .text import printable
 from .timeline import event_counts
 from .verdicts import describe_process
@@ -67,32 +72,47 @@ def render_markdown(run: Run, comparison_md: str | None = None) -> str:
     impl = r["implementation"]
     scope = scope_of(r)
     out = [f"## helmcheck {md_escape(r['role'])} report: **{md_escape(headline(r))}**", ""]
-    out += [f"- {md_escape(line)}" for line in scope.why()]
-    if scope.gaps:
-        out.append("")
-    if r["partial"]:
+    if r["partial"] and scope.unexercised:
+        out += ["> **PARTIAL RUN**: the run finished, but not every scenario was exercised (a moment it "
+                "exists for did not reach the backseat in time); this is not a complete certificate.", ""]
+    elif r["partial"]:
         out += ["> **PARTIAL RUN**: the run was interrupted before it finished; "
                 "this is not a complete certificate.", ""]
     if not run.wire["present"]:
         out += [f"> **Wire log missing**: {md_escape(r['wire_log'])} is not in the results directory.", ""]
     strict = " (strict)" if run.strict else ""
     out += [f"**{word}**{strict}: {md_escape(r['verdict_reason'])}", ""]
+    failed = failures(r)
+    if failed:
+        out += [f"- {md_escape(line)}" for line in failed] + [""]
+    if scope.gaps:
+        out += ["Not judged:", ""] + [f"- {md_escape(line)}" for line in scope.why()] + [""]
+    precision = precision_note(r)
+    if precision:
+        out += [md_escape(precision), ""]
 
     facts = []
-    if impl.get("vehicle_name"):
-        facts.append(md_escape(impl["vehicle_name"]))
+    if r["role"] == "backseat":  # the backseat under test; the vehicle helmcheck played is not named
+        name, by_exec = backseat_name(r)
+        label = "Backseat"
+        if name:
+            facts.append(f"`{md_code(name)}` (the command --exec ran)" if by_exec else md_escape(name))
+    else:
+        label = "Implementation"
+        if impl.get("vehicle_name"):
+            facts.append(md_escape(impl["vehicle_name"]))
     if impl.get("port"):
         facts.append(f"on {md_escape(impl['port'])}")
     if impl.get("protocol"):
         facts.append(f"protocol {md_escape(impl['protocol'])}")
     seen = run.wire["osi_vehicle_name"]
-    if seen is not None and seen != impl.get("vehicle_name"):
+    if r["role"] != "backseat" and seen is not None and seen != impl.get("vehicle_name"):
         facts.append(f"(name on the wire: {md_escape(seen)})")
     when = f"started {md_escape(r['started'])}"
     if r["duration_s"] is not None:
         when += f", {r['duration_s']:.1f} s"
     seed = f", seed {md_escape(r['seed'])}" if r["seed"] is not None else ""
-    out += [f"Implementation: {' '.join(facts) or 'not recorded'}; {when}{seed}.", ""]
+    out += [f"{label}: {' '.join(facts) or 'not recorded'}; {when}{seed}.", ""]
     out += ["| What was tested | |", "|---|---|"]
     out += [f"| {md_escape(label)} | {'**' + md_escape(value) + '**' if missing else md_escape(value)} |"
             for label, value, missing in identity_rows(r, run.wire["osi_vehicle_name"])]
@@ -112,6 +132,9 @@ def render_markdown(run: Run, comparison_md: str | None = None) -> str:
             out += ["**Vehicle NOT verified as restored**: " + md_escape("; ".join(rec.get("problems") or []))
                     + ". Set by hand: " + md_escape("; ".join(rec.get("by_hand") or [])) + ".", ""]
 
+    model = line_model_summary(r)
+    if model is not None:
+        out += [f"Line model: {md_escape(model)}.", ""]
     counters = counters_summary(r)
     if counters is not None:
         out += [f"Line error counters: {md_escape(counters)}.", ""]

@@ -15,6 +15,9 @@ The optional ``process`` object describes an implementation under test that helm
 signal name or null), ``ended_at_s``, ``ended_early`` (a boolean: it ended before the run's
 end, which makes the run ``fail``) and ``output_tail`` (its last lines of output).
 
+The optional ``line_model`` object says whether the link could damage bytes: ``kind`` (``clean``
+or ``noisy``) and ``why`` (:mod:`helmcheck.judge.linemodel`).
+
 The certificate keys (:mod:`helmcheck.reports.certificate`) are optional, so documents written
 before them stay valid; when present they are checked: ``certificate`` must follow from the
 clause verdicts by the scope rule (:func:`helmcheck.reports.scope.scope_of`), ``digests`` map file
@@ -225,6 +228,10 @@ def validate(results: Any) -> list[str]:
         _check_process(ck, r("process"))
     if "restore" in results:
         _check_restore(ck, r("restore"))
+    if "line_model" in results and ck.obj("line_model", r("line_model")):
+        if r("line_model").get("kind") not in ("clean", "noisy"):
+            ck.err("line_model.kind", f"{_short(r('line_model').get('kind'))} is not clean or noisy")
+        ck.string("line_model.why", r("line_model").get("why"))
     _check_certificate_keys(ck, results)
 
     if not ck.errors:

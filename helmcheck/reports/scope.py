@@ -1,4 +1,7 @@
-"""Scope: whether a run is a certificate, and the one line every rendering leads with.
+"""Scope: whether a run is a certificate, and the one line every rendering leads with; then what
+every banner says under it, in this order: what failed (:func:`failures`, each clause with its
+reason), what was not judged (:meth:`Scope.why`), what timing judged coarser than nominal
+precision means for the user (:func:`precision_note`).
 
 A verdict says how the judged clauses went; the scope says how much was judged. The rule:
 
@@ -41,11 +44,11 @@ from typing import Any, Iterable, Mapping
 from helmcheck.clauses import backseat_clauses, catalogue, vehicle_clauses
 
 from ..judge.verdict import Verdict
-from .view import VERDICT_LABEL
+from .view import VERDICT_LABEL, non_pass_rows
 
 __all__ = ["JUDGED", "Gap", "Scope", "claimed_clauses", "scope_of", "headline", "id_ranges", "model_coverage_note",
-           "edge_coverage", "edge_gist", "what_to_change", "precision_note", "MODEL_DIMENSIONS", "reach_text",
-           "exploration_note", "model_coverage"]
+           "edge_coverage", "edge_gist", "what_to_change", "precision_note", "failures", "MODEL_DIMENSIONS",
+           "reach_text", "exploration_note", "model_coverage"]
 
 JUDGED = (Verdict.PASS, Verdict.NON_STRICT, Verdict.FAIL)
 _GAPS_SHOWN = 4
@@ -74,6 +77,9 @@ class Scope:
     judged: tuple[str, ...]
     gaps: tuple[Gap, ...]
     interrupted: bool
+    #: the run finished, but a scenario's moment did not reach the backseat (its observations not
+    #: claimed, ``coverage.scenarios``): partial without having been cut short
+    unexercised: bool = False
 
     @property
     def statement(self) -> str:
@@ -82,7 +88,8 @@ class Scope:
         n, k = len(self.claimed), len(self.judged)
         if self.certificate:
             return f"certificate: all {n} claimed clauses judged"
-        stopped = "the run was interrupted; " if self.interrupted else ""
+        stopped = ("not every scenario was exercised; " if self.unexercised
+                   else "the run was interrupted; " if self.interrupted else "")
         return f"partial: {stopped}{k} of {n} claimed clauses judged; not a certificate"
 
     def why(self, limit: int = _GAPS_SHOWN) -> list[str]:
@@ -128,7 +135,9 @@ def scope_of(results: Mapping[str, Any], verdicts: Mapping[str, str] | None = No
     gaps = tuple(Gap(tuple(ids), v, r) for (v, r), ids in groups.items())
     interrupted = bool(results.get("partial"))
     certificate = not interrupted and not gaps and bool(claimed)
-    return Scope(certificate, tuple(claimed), judged, gaps, interrupted)
+    run = results.get("run")
+    unexercised = interrupted and isinstance(run, Mapping) and run.get("status") == "complete"
+    return Scope(certificate, tuple(claimed), judged, gaps, interrupted, unexercised)
 
 
 def _plain_reason(reason: str) -> str:
@@ -141,6 +150,27 @@ def headline(results: Mapping[str, Any]) -> str:
     :attr:`Scope.statement`): the first line of every rendering."""
     verdict = results.get("verdict")
     return f"{VERDICT_LABEL.get(verdict, str(verdict).upper())} — {scope_of(results).statement}"
+
+
+_REASON_SHOWN = 280  # characters of a failed clause's reason in the banner; the finding has it whole
+
+
+def failures(results: Mapping[str, Any], limit: int = _GAPS_SHOWN) -> list[str]:
+    """What failed, first in every banner: one line per failed clause (a SHOULD missed too), its
+    ID and its reason in words (``RH-BS-2 failed: …``), worst first, the first *limit* of them,
+    then how many more and which."""
+    rows = [r for r in non_pass_rows(results) if r["verdict"] in (Verdict.FAIL, Verdict.NON_STRICT)]
+    lines = []
+    for row in rows[:limit]:
+        what = "failed" if row["verdict"] == Verdict.FAIL else "not met (a SHOULD: NON-STRICT)"
+        reason = " ".join(str(row.get("reason") or "").split())
+        if len(reason) > _REASON_SHOWN:
+            reason = reason[:_REASON_SHOWN - 1].rsplit(" ", 1)[0].rstrip(",;:") + " …"
+        lines.append(f"{row['id']} {what}" + (f": {reason}" if reason else ""))
+    rest = rows[limit:]
+    if rest:
+        lines.append(f"and {len(rest)} more: {id_ranges(r['id'] for r in rest)}")
+    return lines
 
 
 _RUN_AT = re.compile(r"run at (.+?)(?:$|\.\s)")
@@ -159,9 +189,13 @@ def what_to_change(results: Mapping[str, Any]) -> str:
 
 
 def precision_note(results: Mapping[str, Any]) -> str:
-    """How many timing clauses were judged coarser than nominal precision (their tolerance widened
-    by more than :data:`~helmcheck.judge.linebudget.NOMINAL_WIDENING_S` by what the observer could
-    not see), and the time scale at which this line would judge them to it; ``""`` when none was."""
+    """One sentence on what timing judged coarser than nominal precision (a tolerance widened by
+    more than :data:`~helmcheck.judge.linebudget.NOMINAL_WIDENING_S` by what the observer could
+    not see) means for the user: the timing faults that could pass at this time scale, and the
+    time scale at which this line would judge timing to the profile's tolerance; ``""`` when no
+    clause was judged coarser. ``Timing faults up to ±7.8 s could pass at ×40 (7 timing clause(s)
+    judged coarser than RH-TIM-1's tolerance; RH-OUT-4 within ±7.8 s, nominal ±1.6 s); for timing
+    at the profile's tolerance run at ×2.``"""
     from ..judge.linebudget import NOMINAL_WIDENING_S, from_settings
 
     coarse = []
@@ -175,15 +209,24 @@ def precision_note(results: Mapping[str, Any]) -> str:
     if not coarse:
         return ""
     worst = max(coarse, key=lambda x: x[1]["widened_s"] - x[1]["nominal_s"])
-    text = (f"{len(coarse)} timing clause(s) judged coarser than RH-TIM-1's tolerance at ×{k:g} "
-            f"({worst[0]} within ±{worst[1]['widened_s']:g} s, nominal ±{worst[1]['nominal_s']:g} s)")
+    widest = max(pr["widened_s"] for _, pr in coarse)
+    at = f" at ×{k:g}" if k else ""
+    text = (f"Timing faults up to ±{_secs(widest)} s could pass{at} ({len(coarse)} timing clause(s) judged "
+            f"coarser than RH-TIM-1's tolerance; {worst[0]} within ±{_secs(worst[1]['widened_s'])} s, "
+            f"nominal ±{_secs(worst[1]['nominal_s'])} s)")
     budget = from_settings(((results.get("settings") or {}).get("line_budget")) or {})
     nominal = budget.nominal_scale() if budget is not None else None
     if nominal is not None and nominal < (k or 0):
-        text += f": run at ×{nominal:g} for nominal precision on this line"
+        text += f"; for timing at the profile's tolerance run at ×{nominal:g}"
     elif budget is not None and nominal is None:
-        text += ": even at ×1 this line is coarser (a faster baud or a vehicle that answers sooner)"
+        text += ("; even at ×1 this line is coarser: timing at the profile's tolerance needs a faster baud "
+                 "or a vehicle that answers sooner")
     return text + "."
+
+
+def _secs(s: float) -> str:
+    """Seconds to two significant figures (``7.759`` → ``7.8``, ``0.65`` → ``0.65``, ``12.3`` → ``12``)."""
+    return f"{float(f'{s:.2g}'):g}"
 
 
 def model_coverage_note(results: Mapping[str, Any]) -> str:

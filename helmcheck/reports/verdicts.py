@@ -128,9 +128,11 @@ def describe_process(process: Mapping[str, Any], subject: str = "implementation"
 
 
 def describe_verdict(clauses: list[Mapping[str, Any]], *, strict: bool = False, partial: bool = False,
-                     process: Mapping[str, Any] | None = None, subject: str = "implementation") -> str:
+                     process: Mapping[str, Any] | None = None, subject: str = "implementation",
+                     interrupted: bool = True) -> str:
     """One sentence explaining :func:`run_verdict` for these clause entries (and *process*, the
-    implementation under test when helmcheck started it)."""
+    implementation under test when helmcheck started it). *interrupted*: a partial run was cut
+    short (False: it finished, but not everything it exists for was exercised)."""
     if process is not None and process.get("ended_early") is True:
         judged = [c for c in clauses if c["verdict"] != Verdict.NOT_TESTED]
         failed = [c["id"] for c in clauses if c["verdict"] == Verdict.FAIL]
@@ -138,13 +140,13 @@ def describe_verdict(clauses: list[Mapping[str, Any]], *, strict: bool = False, 
                 f"cannot be certified ({len(judged)} clause(s) judged before it ended")
         text += f", {len(failed)} of them failed: {_id_list(failed)})." if failed else ")."
         return text
-    text = _describe(clauses, strict=strict, partial=partial)
-    if partial and "interrupted" not in text:
+    text = _describe(clauses, strict=strict, partial=partial, interrupted=interrupted)
+    if partial and interrupted and "interrupted" not in text:
         text += " The run was interrupted before it finished."
     return text
 
 
-def _describe(clauses: list[Mapping[str, Any]], *, strict: bool, partial: bool) -> str:
+def _describe(clauses: list[Mapping[str, Any]], *, strict: bool, partial: bool, interrupted: bool = True) -> str:
     by: dict[str, list[str]] = {v: [] for v in CLAUSE_VERDICTS}
     for c in clauses:
         by.setdefault(c["verdict"], []).append(c["id"])
@@ -158,6 +160,12 @@ def _describe(clauses: list[Mapping[str, Any]], *, strict: bool, partial: bool) 
         if by[Verdict.INCONCLUSIVE]:
             return (f"No clause failed, but {len(by['inconclusive'])} could not be judged: "
                     f"{_id_list(by['inconclusive'])}.")
+        if partial and not interrupted:
+            worst = overall_verdict([c["verdict"] for c in clauses], strict)
+            found = (f"; {len(by['non-strict'])} SHOULD clause(s) not met: {_id_list(by['non-strict'])}"
+                     if worst == Verdict.NON_STRICT else "")
+            return (f"No MUST failed in {judged} judged clause(s){found}; not a certificate, as not every "
+                    f"scenario was exercised.")
         if partial:
             return f"The run was interrupted after judging {judged} clause(s); nothing failed before it stopped."
         return "No clause was judged."

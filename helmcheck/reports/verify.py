@@ -201,6 +201,7 @@ class Rejudging:
     role: str  #: ``vehicle``, ``backseat`` or ``both`` (a log check of both roles)
     time_scale: float
     swap: bool = False  #: a log check's ``--swap-directions``
+    line: Optional[str] = None  #: a log check's ``--line`` (``settings.line``)
     missions: tuple[Path, ...] = ()  #: a log check's mission directories (``settings.missions``)
     sha256: Optional[str] = None  #: the SHA-256 the log must have (a log referenced, not copied)
 
@@ -238,8 +239,9 @@ def rejudging(out: Verification, directory: Path, results: Mapping[str, Any], pr
             missions.append(Path(str(d)))
         else:
             out.notes.append(f"the mission directory {d} the check used is not here: re-judged without it")
+    line = settings.get("line") if role == "log" and settings.get("line") in ("clean", "noisy") else None
     return Rejudging(wire_name, wire_path, judge_role, time_scale, swap=bool(settings.get("swap_directions")),
-                     missions=tuple(missions), sha256=sha)
+                     missions=tuple(missions), sha256=sha, line=line)
 
 
 def compare_rejudged(out: Verification, results: Mapping[str, Any], clauses: list, facts: RunFacts,

@@ -23,7 +23,22 @@ fast-resend         RH-BS-5    resends a rejected command every 0.3 s
 resend-burst        RH-BS-5    answers its first refused ``$OMS`` with four copies of it
                                within 0.1 s
 late-refresh        RH-BS-6    refreshes ``$OMS`` only after 1.6 × its timeout
+late-refresh-120    RH-BS-6    chooses the longest timeout, 120 s, and refreshes ``$OMS`` only after
+                               1.2 × it (at ×10: every 14.4 s; a scenario must outlast its cycle)
 no-poll             RH-BS-8    polls ``$OSD`` every 7 s
+==================  =========  ================================================================
+
+And faults seen once in a whole session (each is the backseat's at once on a link that cannot
+damage a byte — helmcheck's pty — and a well-framed line with a right checksum is judged as sent
+on any link):
+
+==================  =========  ================================================================
+once-bad-checksum   RH-BS-1    its fifth state poll, and no other line, has a wrong checksum
+once-timeout-121    RH-BS-2    its third ``$OMS`` has timeout 121 (§4: integer [1,120] s)
+once-heading-360    RH-BS-2    its third ``$OMS`` has heading ``360.0`` (§4: [0,360))
+once-opk-minutes-0  RH-BS-2    once the mission runs, one ``$OPK`` with minutes ``0`` (§4: [1, 1440])
+omw-dollar-sum      RH-BS-1    every 3 s while a mission runs, ``$OMW,Clr`` with its checksum
+                               taken over the ``$`` too
 ==================  =========  ================================================================
 """
 
@@ -183,8 +198,71 @@ class LateRefresh(Backseat):
         self.refresh_every = 1.6 * self.servo_timeout / self.k
 
 
+class LateRefresh120(Backseat):
+    def __init__(self, *a, **kw):
+        super().__init__(*a, **kw)
+        self.servo_timeout = 120
+        self.refresh_every = 1.2 * self.servo_timeout / self.k
+
+
 class NoPoll(Backseat):
     poll_every = 7.0
+
+
+class OnceBadChecksum(Backseat):
+    n = 0
+
+    def poll(self) -> None:
+        self.n += 1
+        if self.n == 5:
+            body = self.poll_body
+            self.ser.write(f"${body}*{checksum(body) ^ 0x01:02X}\r\n".encode())
+        else:
+            super().poll()
+
+
+class _OnceOms(Backseat):
+    """The third ``$OMS`` it sends carries one field out of its range (``bad``)."""
+
+    n = 0
+    bad = ""
+
+    def send_oms(self, now: float) -> None:
+        self.n += 1
+        if self.n != 3:
+            super().send_oms(now)
+            return
+        self.last_oms = now
+        self.send(self.bad.format(timeout=self.servo_timeout, heading=self.heading))
+
+
+class OnceTimeout121(_OnceOms):
+    bad = "OMS,{heading:.1f},2.0,20.0,1.0,121"
+
+
+class OnceHeading360(_OnceOms):
+    bad = "OMS,360.0,2.0,20.0,1.0,{timeout}"
+
+
+class OnceOpkMinutes0(Backseat):
+    sent_opk = False
+
+    def when_running(self, now: float) -> None:
+        super().when_running(now)
+        if not self.sent_opk and now - self.t0 > 2.0:
+            self.sent_opk = True
+            self.send("OPK,41.52,-71.32,0,1.0")
+
+
+class OmwDollarSum(Backseat):
+    last_omw = 0.0
+
+    def when_running(self, now: float) -> None:
+        super().when_running(now)
+        if now - self.last_omw >= 3.0:
+            self.last_omw = now
+            body = "OMW,Clr"
+            self.ser.write(f"${body}*{checksum('$' + body):02X}\r\n".encode())
 
 
 FAULTS = {
@@ -192,7 +270,9 @@ FAULTS = {
     "bare-lf": BareLf, "short-omp": ShortOmp, "rwset-after-start": RwsetAfterStart,
     "oms-while-stopped": OmsWhileStopped, "hasty-oms": HastyOms, "flood": Flood, "lockout-ignore": LockoutIgnore,
     "fast-resend": FastResend, "resend-burst": ResendBurst, "late-refresh": LateRefresh,
-    "no-poll": NoPoll,
+    "no-poll": NoPoll, "late-refresh-120": LateRefresh120,
+    "once-bad-checksum": OnceBadChecksum, "once-timeout-121": OnceTimeout121,
+    "once-heading-360": OnceHeading360, "once-opk-minutes-0": OnceOpkMinutes0, "omw-dollar-sum": OmwDollarSum,
 }
 
 if __name__ == "__main__":

@@ -4,7 +4,10 @@ The judging is not here: it is :class:`helmcheck.judge.backseat.BackseatObserver
 observer ``check-log`` feeds from a wire log. Modules, one concern each:
 
 * :mod:`.scenarios` — the scenarios the tester stages while the backseat runs (``nominal``,
-  ``reject``, ``lockout``, ``mission-end``, ``silence``) and how a run's duration is split.
+  ``reject``, ``lockout``, ``mission-end``, ``silence``) and the plan: how long each lasts, from
+  what it must show at the time scale and on the line (``--plan``).
+* :mod:`.stage` — each scenario's moments, whether they reached the backseat in time, how long the
+  run holds a scenario open for them, and what is not claimed when they did not.
 * :mod:`.certifier` — the library entry: :func:`~.certifier.certify` (:class:`~.certifier.Options`) →
   :class:`~.certifier.Outcome`, used by the command line and the pytest plugin.
 * :mod:`.progress` — the progress bar on standard error.

@@ -1,7 +1,9 @@
 """The library entry of ``certify backseat``: :func:`certify` (:class:`Options`) → :class:`Outcome`.
 
-One certification: the port opened (a pty by default; the caller may hand over a link it
-opened), the backseat under test started there when ``exec_cmd`` says so
+One certification: the plan made (:func:`plan_for`: each scenario as long as what it must show
+needs at the run's time scale and baud; a ``duration`` shorter than that is named on standard
+error before anything runs, and the plan's lengths kept), the port opened (a pty by default; the
+caller may hand over a link it opened), the backseat under test started there when ``exec_cmd`` says so
 (:mod:`.process`), the reference vehicle played and the scenarios staged by :class:`.runner.Runner`
 while every byte the backseat sends is judged (:class:`helmcheck.judge.backseat.BackseatObserver`),
 then ``results.json`` assembled from the ledger and the run facts (:mod:`.report`), the
@@ -24,7 +26,9 @@ from typing import IO, Any, Callable, Optional
 from ... import __version__
 from ...failures import OutputLost, describe_interrupt
 from ...grammar.wirelog import run_header
+from ...judge.linemodel import line_note
 from ...judge.timing import JITTER_S
+from ...line.linekind import line_for
 from ...line.reopen import DEFAULT_WAIT_S, reopenable
 from ...line.transport import BAUD_RATES, Link, open_link, parse_port_spec
 from ...profile import Profile
@@ -35,7 +39,12 @@ from ..outcome import Outcome
 from .report import build_results
 from .scenarios import SCENARIOS, make_plan
 
-__all__ = ["Options", "Outcome", "certify", "problems"]
+__all__ = ["Options", "Outcome", "certify", "problems", "plan_for", "OVERRUN_DEFAULT"]
+
+#: What the vehicle helmcheck plays does with requests that ask for more replies than its line
+#: carries (docs/choices.md, "The vehicle's line"): a request whose replies could not start within
+#: the ACK window goes unanswered. ``queue`` (every reply waits its turn) is the other reading.
+OVERRUN_DEFAULT = "drop"
 
 
 @dataclass
@@ -48,7 +57,8 @@ class Options:
     port: str = "pty"  #: ``pty`` (a new one), a device path, or ``socket://HOST:PORT`` (served)
     time_scale: Optional[float] = None
     baud: Optional[int] = None
-    duration: float = 60.0  #: seconds of judged run after the backseat's first byte
+    #: seconds of judged run after the backseat's first byte (None: what the plan needs, :func:`plan_for`)
+    duration: Optional[float] = None
     scenarios: Optional[list[str]] = None  #: default: all of :data:`.scenarios.SCENARIOS`, in order
     strict: bool = False  #: a SHOULD not met fails the run
     connect_timeout: float = 30.0  #: seconds to wait for the backseat's first byte
@@ -67,6 +77,10 @@ class Options:
     link: Optional[Link] = None
     log: Optional[IO[str]] = None
     settings: dict[str, Any] = field(default_factory=dict)  #: recorded too (``settings`` in results.json)
+    #: ``--line clean|noisy`` (None: guessed from the port, :func:`helmcheck.line.linekind.line_for`)
+    line: Optional[str] = None
+    #: requests asking for more replies than the line carries: ``drop`` or ``queue`` (:data:`OVERRUN_DEFAULT`)
+    overrun: str = OVERRUN_DEFAULT
 
 
 def _positive(x: Optional[float]) -> bool:
@@ -80,8 +94,10 @@ def problems(opts: Options, spell: Callable[[str], str] = lambda name: f"--{name
     scale = opts.time_scale if opts.time_scale is not None else opts.profile.time_scale
     if not _positive(scale):
         out.append(f"{spell('time-scale')} must be a positive number (got {scale})")
-    if not _positive(opts.duration):
+    if opts.duration is not None and not _positive(opts.duration):
         out.append(f"{spell('duration')} must be a positive number of seconds (got {opts.duration})")
+    if opts.overrun not in ("drop", "queue"):
+        out.append(f"{spell('overrun')} must be drop or queue (got {opts.overrun})")
     if not _positive(opts.connect_timeout):
         out.append(f"{spell('connect-timeout')} must be a positive number of seconds (got {opts.connect_timeout})")
     if not (math.isfinite(opts.reconnect_wait) and opts.reconnect_wait >= 0):
@@ -106,6 +122,27 @@ def problems(opts: Options, spell: Callable[[str], str] = lambda name: f"--{name
     return out
 
 
+def plan_for(opts: Options):
+    """The run's plan (:func:`.scenarios.make_plan`) for *opts*: its scenarios at its time scale and
+    baud, the profile's lockout, ACK window, reaction time and longest timeout, and the ascent from
+    the test mission's deepest waypoint (the vehicle helmcheck plays flies its built-in missions)."""
+    from ...emulator.freedoms import DEFAULT_SETTINGS
+    from ...emulator.missionfile import DirectoryCatalog, builtin_dir
+    from ...model.missions import Mission
+
+    scale = float(opts.time_scale if opts.time_scale is not None else opts.profile.time_scale)
+    baud = opts.baud if opts.baud is not None else opts.profile.baud
+    p = opts.profile
+    found = DirectoryCatalog([builtin_dir()]).lookup(p.mission)
+    depth = 0.0
+    if isinstance(found, Mission) and isinstance(found.waypoints, tuple):
+        depth = max((max(0.0, w.depth) for w in found.waypoints), default=0.0)
+    return make_plan(list(opts.scenarios or SCENARIOS), opts.duration, time_scale=scale, lockout_s=p.lockout_s,
+                     baud=baud, ack_window_s=p.ack_window_s, reaction_s=p.reaction_s,
+                     timeout_max_s=float(p.timeout_range[1]), ascent_depth_m=depth,
+                     ascent_mps=DEFAULT_SETTINGS.ascent_mps)
+
+
 def certify(opts: Options) -> Outcome:
     """Run one backseat certification (module docstring). ``ValueError`` for options that
     :func:`problems` rejects; ``OSError`` when the port cannot be opened; :class:`OutputLost`
@@ -117,12 +154,19 @@ def certify(opts: Options) -> Outcome:
     baud = opts.baud if opts.baud is not None else opts.profile.baud
     profile = opts.profile.replace(time_scale=scale, baud=baud)
     names = list(opts.scenarios or SCENARIOS)
-    plan = make_plan(names, opts.duration, time_scale=scale, lockout_s=profile.lockout_s)
+    plan = plan_for(opts)
+    if plan.short:  # named before anything runs, whatever the progress display
+        print(f"helmcheck certify backseat: {plan.note}", file=sys.stderr)
+        for line in plan.describe()[1:]:
+            print(f"helmcheck certify backseat: {line.strip()}", file=sys.stderr)
+        sys.stderr.flush()
     report_dir = Path(opts.report_dir)
     report_dir.mkdir(parents=True, exist_ok=True)
     started_dt = datetime.now(timezone.utc)
     settings: dict[str, Any] = {"time_scale": scale, "strict": bool(opts.strict),
-                                "duration_s": float(opts.duration), "planned_s": round(plan.total, 3),
+                                "duration_s": float(opts.duration if opts.duration is not None else plan.needed),
+                                "planned_s": round(plan.total, 3), "plan_needs_s": round(plan.needed, 3),
+                                "overrun": opts.overrun,
                                 "scenarios": list(dict.fromkeys(names)), "baud": baud,
                                 "connect_timeout_s": float(opts.connect_timeout),
                                 "reconnect_wait_s": float(opts.reconnect_wait),
@@ -168,10 +212,8 @@ def _run(opts: Options, profile: Profile, plan, report_dir: Path, link: Link, lo
                   f"{profile.time_scale:g}, baud {profile.baud}, scenarios {', '.join(s.name for s in plan.slots)} "
                   f"over {plan.total:.1f} s; waiting up to {opts.connect_timeout:g} s for the backseat",
                   file=sys.stderr)
-            if plan.note:
+            if plan.note and not plan.short:
                 print(f"helmcheck certify backseat: {plan.note}", file=sys.stderr)
-        if opts.on_port is not None:
-            opts.on_port(link.name)
         spec = parse_port_spec(opts.port)
         runner = Runner(link, profile, plan, time_scale=profile.time_scale,
                         missions=DirectoryCatalog([builtin_dir()]), log=log, meta=meta,
@@ -179,7 +221,13 @@ def _run(opts: Options, profile: Profile, plan, report_dir: Path, link: Link, lo
                         # helmcheck's own device can come back; a pty it made or a client it
                         # serves that goes away is the backseat leaving (.runner, link life)
                         port=opts.port if spec.kind != "socket" and reopenable(spec) else None,
-                        reconnect_wait=opts.reconnect_wait)
+                        reconnect_wait=opts.reconnect_wait, overrun=opts.overrun)
+        runner.recorder.note(0.0, line_note(line_for(opts.port, opts.line, serving=True)))
+        runner.recorder.note(0.0, f"plan: {plan.describe()[0]}; the vehicle's line: overrun = {opts.overrun}")
+        if plan.note:
+            runner.recorder.note(0.0, f"plan: {plan.note}")
+        if opts.on_port is not None:  # the port is announced once the vehicle is ready to read it
+            opts.on_port(link.name)
         if opts.exec_cmd:
             from .process import start_backseat
             try:

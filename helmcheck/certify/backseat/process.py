@@ -75,12 +75,16 @@ def end_backseat(child: Launcher, *, epoch: float, link_lost: bool) -> dict[str,
 
 
 def unfinished_clauses(clauses: Iterable[str], plan: Plan, connected_at: Optional[float],
-                       ended_at: float) -> dict[str, list[str]]:
+                       ended_at: float, finished: Optional[Iterable[str]] = None) -> dict[str, list[str]]:
     """Clause ID → the exercising scenarios that had not finished by *ended_at*, for every clause
-    of *clauses* that has some (times in seconds since the certifier started)."""
+    of *clauses* that has some (times in seconds since the certifier started; *finished*: the
+    scenarios the run saw end, when it knows — a scenario held open past its plan ends later)."""
     planned = [slot.name for slot in plan.slots]
-    done = {slot.name for slot in plan.slots
-            if connected_at is not None and connected_at + slot.end <= ended_at + 1e-9}
+    if finished is not None:
+        done = set(finished)
+    else:
+        done = {slot.name for slot in plan.slots
+                if connected_at is not None and connected_at + slot.end <= ended_at + 1e-9}
     out: dict[str, list[str]] = {}
     for cid in clauses:
         need = [n for n in EXERCISED_BY.get(cid, ()) if n in planned] or planned
@@ -91,7 +95,8 @@ def unfinished_clauses(clauses: Iterable[str], plan: Plan, connected_at: Optiona
 
 
 def process_notes(process: dict[str, Any], *, clauses: Iterable[str], plan: Plan,
-                  connected_at: Optional[float], ended_at: float) -> list[str]:
+                  connected_at: Optional[float], ended_at: float,
+                  finished: Optional[Iterable[str]] = None) -> list[str]:
     """The run-fact notes of the backseat's end (module docstring), in the order to record them."""
     notes: list[str] = []
     if process.get("ended_early"):
@@ -100,7 +105,7 @@ def process_notes(process: dict[str, Any], *, clauses: Iterable[str], plan: Plan
         at = process.get("ended_at_s")
         when = f" at {at:.1f} s" if at is not None else ""
         groups: dict[str, list[str]] = {}
-        for cid, scenarios in unfinished_clauses(clauses, plan, connected_at, ended_at).items():
+        for cid, scenarios in unfinished_clauses(clauses, plan, connected_at, ended_at, finished).items():
             reason = (f"the backseat {how}{when}, before the scenario(s) exercising this clause "
                       f"({', '.join(scenarios)}) finished")
             groups.setdefault(reason, []).append(cid)

@@ -62,9 +62,15 @@ class Progress:
         self._said_at = self.clock()
         self._say(f"the backseat connected; the judged run takes {total:.1f} s")
 
-    def update(self, elapsed: float, scenario: str, counts: dict) -> None:
+    def update(self, elapsed: float, scenario: str, counts: dict, total: Optional[float] = None) -> None:
+        """``total``: the run's length as it stands now (a scenario held open for its moment
+        lengthens it)."""
         if self.task is None:
             return
+        if total is not None and total > self.total:
+            self.total = total
+            if self.bar is not None:
+                self.bar.update(self.task, total=total)
         now = self.clock()
         bad = ", ".join(f"{c} ×{n}" for c, n in counts.items() if n)
         if self.bar is None:

@@ -6,7 +6,10 @@ entry per §9 clause (RH-BS-1..8), the run verdict and the ``process`` object ex
 findings, :class:`helmcheck.judge.ledger.Ledger`: verdict, reason, the scenarios it was observed
 in as cases, ``offending_count`` and the first offending lines quoted as evidence) and the run
 facts the record's notes give (:mod:`helmcheck.judge.runfacts`); the scenarios staged, the mode
-timeline, the staged events. This module judges nothing and changes no verdict.
+timeline, the staged events; ``coverage.scenarios`` (each scenario as it ran: planned and actual
+length, how long it was held open, its moments and when they reached the backseat, what is not
+claimed, :mod:`.stage`) and ``run.overrun`` (how far the backseat's requests over-asked the
+vehicle's line, or null). This module judges nothing and changes no verdict.
 A MUST not met is ``fail``; a SHOULD not met ``non-strict`` (``fail`` with ``--strict``). A run
 that never started or was cut short (the backseat never connected, closed the port, crashed,
 or Ctrl-C) is ``partial`` and cannot certify: INCONCLUSIVE, with the reason first in
@@ -46,7 +49,10 @@ def build_results(outcome: Optional[RunRecord], *, profile: Profile, settings: d
         facts = RunFacts(not_judged={cid: f"not judged: {why}" for cid in BS_CLAUSES}, partial=why)
     else:
         ledger, facts = outcome.observer.ledger, outcome.facts
-    a = assemble("backseat", ledger, facts, strict=strict, lead=why if facts.partial is not None else "")
+    # the lead: why a run was cut short (the outcome's words: they name a signal), or why a run that
+    # finished is partial all the same (a scenario's moment did not reach the backseat)
+    lead = why if facts.interrupted else (facts.partial or "")
+    a = assemble("backseat", ledger, facts, strict=strict, lead=lead)
     if outcome is not None and outcome.status != "never-connected":
         for t, kind, label in outcome.events:
             add_event(results, round(t, 6), kind, label)
@@ -56,12 +62,13 @@ def build_results(outcome: Optional[RunRecord], *, profile: Profile, settings: d
             if mode not in seen:
                 seen.append(mode)
         results["coverage"]["modes"] = seen
+        results["coverage"]["scenarios"] = [dict(c) for c in outcome.coverage]
         results["scenarios"] = list(outcome.scenarios_run)
         results["run"] = {"status": outcome.status, "connected_at": outcome.connected_at,
                           "ended_at": round(outcome.ended_at, 3), "planned_s": round(outcome.planned, 3),
                           "bytes_from_backseat": outcome.observer.stats["bytes"],
                           "lines_from_backseat": outcome.observer.stats["lines"],
-                          "vehicle": outcome.vehicle_stats}
+                          "vehicle": outcome.vehicle_stats, "overrun": outcome.overrun}
         if outcome.gaps:  # helmcheck's port gone and waited for (.runner, link life)
             results["link_gaps"] = [dict(g) for g in outcome.gaps]
             for g in outcome.gaps:

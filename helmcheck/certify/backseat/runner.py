@@ -37,11 +37,23 @@ SIGINT/SIGTERM (or :meth:`Runner.stop`) end it early as "interrupted". When helm
 :class:`~helmcheck.line.launcher.Launcher`), the loop also ends, as "exited", as soon as
 that process has ended (checked every tick).
 
+Moments (:mod:`.stage`): before each staged step the loop asks whether the scenario must stay
+open (its moment has not reached the backseat yet); if so the step, and the schedule after it,
+wait — by at most the scenario's limit. Each scenario's end is a note saying what it exercised,
+with a ``not claimed`` note for a moment that did not reach the backseat.
+
+The vehicle's line (:mod:`helmcheck.emulator.outbox`): its output leaves at the baud, 10 bits a
+byte; requests asking for more replies than that are queued or dropped as ``overrun`` says
+(default ``drop``: a request whose replies could not start within the ACK window goes
+unanswered; ``queue``: every reply waits its turn). At the run's end a ``line overrun:`` note says
+how far the backseat over-asked the line (a remark beside RH-BS-4).
+
 Run facts (:mod:`helmcheck.judge.runfacts`): before the record closes, the loop stops the
 backseat it started and records its end (``not judged`` notes for the clauses its exit cut
 short, a ``process:`` note, :mod:`.process`), a ``not judged`` note for every clause when the
-backseat never connected, and a ``run partial:`` note when the run did not complete — so the
-results (:mod:`.report`) and ``helmcheck verify`` assemble the same verdicts from the record.
+backseat never connected, and a ``run partial:`` note when the run did not complete, or when it
+did but a scenario's moment did not reach the backseat — so the results (:mod:`.report`) and
+``helmcheck verify`` assemble the same verdicts from the record.
 """
 
 from __future__ import annotations
@@ -58,19 +70,23 @@ from ...grammar import sentences as s
 from ...grammar.wirelog import FROM_VEHICLE, TO_VEHICLE
 from ...judge.backseat import BS_CLAUSES, BackseatObserver
 from ...judge.ledger import Ledger
-from ...judge.runfacts import RunFacts, not_judged_note, partial_note
+from ...judge.runfacts import RunFacts, not_judged_note, overrun_note, partial_note
 from ...model.missions import MissionCatalog
 from ...profile import Profile
 from ...emulator.core import EmulatorCore
+from ...emulator.freedoms import DEFAULT_SETTINGS
+from ...emulator.outload import describe as describe_overrun
 from ...line.recorder import Recorder
 from ...line.reopen import DEFAULT_WAIT_S, RETRY_S, wait_for_port
 from ...line.transport import Link, LinkClosed
 from .link import HangupPty
-from .scenarios import LOCKOUT_CODE, Plan
+from .scenarios import LOCKOUT_CODE, Action, Plan
+from .stage import Stage
 
 __all__ = ["Runner", "RunRecord", "HangupPty", "MAX_OUT"]
 
 MAX_OUT = 256 * 1024  #: bytes waiting for a link nobody reads; beyond this they are dropped
+MAX_COMMAND_EVENTS = 5000  #: the backseat's commands marked on the report's timeline; the rest are in the wire log
 _TICK = 0.05
 #: the core's note about an overlong run it logged in part; the recorder here logs every byte
 _PARTIAL = re.compile(r"^RH-FRM-\d+: \d+ bytes discarded, first \d+ logged$")
@@ -110,6 +126,10 @@ class RunRecord:
     #: helmcheck's port gone and waited for: when (seconds since the certifier started), how long,
     #: why, the scenario it cut, whether it came back
     gaps: list[dict] = field(default_factory=list)
+    #: every scenario as it ran: its moments, how long, what is not claimed (:mod:`.stage`)
+    coverage: list[dict] = field(default_factory=list)
+    #: how far the backseat's requests over-asked the vehicle's line (None: they did not)
+    overrun: Optional[dict] = None
 
 
 class Runner:
@@ -119,7 +139,7 @@ class Runner:
                  missions: Optional[MissionCatalog] = None, log: Optional[IO[str]] = None,
                  meta: Iterable[str] = (), connect_timeout: float = 30.0,
                  clock: Callable[[], float] = time.monotonic, progress: Any = None, child: Any = None,
-                 port: Optional[str] = None, reconnect_wait: float = DEFAULT_WAIT_S):
+                 port: Optional[str] = None, reconnect_wait: float = DEFAULT_WAIT_S, overrun: str = "drop"):
         self.link = link
         #: the name to open again when the link's device vanishes (None: not waited for)
         self.port = port if reconnect_wait > 0 else None
@@ -141,18 +161,29 @@ class Runner:
         self.facts = RunFacts()
         self.recorder = Recorder(log, meta, observers=[self.observer, self.facts])
         self.core = EmulatorCore(profile.replace(fault_injection="none"), missions, start=self.launch,
-                                 time_scale=time_scale, baud=profile.baud, log=_CoreNotes(self.recorder))
+                                 time_scale=time_scale, baud=profile.baud, log=_CoreNotes(self.recorder),
+                                 settings=DEFAULT_SETTINGS.replace(overrun=overrun))
+        self.stage = Stage(plan, observer=self.observer, core=self.core, rel=self.rel,
+                           ack_window_s=profile.ack_window_s, reaction_s=profile.reaction_s, baud=profile.baud)
+        self.core.on_release = self.stage.released
+        #: the staged steps, and the run's end (held like the steps, :mod:`.stage`)
+        self._schedule = (*plan.actions, Action(plan.total, "end"))
+        self._done = False
+        self._extended = 0.0  #: seconds the scenarios were held open past their plan
         self._framer = Framer(profile.max_line_bytes)
         self._stop: Optional[str] = None
         self._out = bytearray()
-        self._actions = deque(plan.actions)
+        self._actions = deque(self._schedule)
         self._silent = False
         self._rejecting = False
         self._silence_noted = False
+        self._commands_marked = 0
+        self._unsent = 0  #: bytes of replies the silent vehicle did not send
         self._lockout = False
         self._mode = ""
         self._scenario = ""
         self._dropped_out = 0
+        self._dropped_total = 0  #: bytes the loop never wrote (nobody read the port), over the run
         self.connected_at: Optional[float] = None
         self.outcome = RunRecord("interrupted", "", self.observer, planned=plan.total, facts=self.facts)
 
@@ -193,7 +224,7 @@ class Runner:
                                   f"come back within {self.reconnect_wait:g} s (--reconnect-wait; {gap['why']})")
                         break
                     continue
-                if self.connected_at is not None and self.rel(now) >= self.connected_at + self._shift + self.plan.total:
+                if self._done:
                     status, reason = "complete", "the run completed"
                     break
                 if self.connected_at is not None:
@@ -222,11 +253,36 @@ class Runner:
             o.ended_at = self.rel(now)
             o.vehicle_stats = dict(self.core.stats)
             try:
+                self._record_end(status, end)
                 self._record_facts(status, reason, end)
             finally:
                 self.observer.close(end)
                 self.recorder.close()
         return o
+
+    def _record_end(self, status: str, t: float) -> None:
+        """The scenarios' record and the line overrun, as notes at *t*."""
+        o = self.outcome
+        if self.stage.current is not None and status == "complete":
+            for text in self.stage.close(t):
+                self.recorder.note(t, text)
+        o.coverage = self.stage.record(t)
+        summary = self.core.load.summary(ack_window_s=self.profile.ack_window_s)
+        if self._dropped_total:
+            summary = dict(summary or {"asked_Bps": 0.0, "line_Bps": self.profile.baud / 10.0, "baud": self.profile.baud,
+                                       "max_lag_s": 0.0, "dropped_bytes": 0, "dropped_sets": 0, "by": "",
+                                       "over_capacity": False})
+            summary["unread_bytes"] = self._dropped_total
+        if summary is not None:
+            o.overrun = summary
+            text = describe_overrun(summary)
+            if self._dropped_total:
+                text += (f"; {self._dropped_total} more byte(s) were never written: nobody read the port "
+                         f"({MAX_OUT // 1024} KiB waiting)")
+            self.recorder.note(t, overrun_note(text))
+        partial = self.stage.partial_reason()
+        if partial is not None and status == "complete":
+            self.recorder.note(t, partial_note(partial))
 
     def _record_facts(self, status: str, reason: str, t: float) -> None:
         """The run facts of the run's end, as notes at *t* (module docstring)."""
@@ -236,8 +292,9 @@ class Runner:
             o = self.outcome
             o.process = end_backseat(self.child, epoch=self.launch, link_lost=status in ("disconnected", "exited"))
             started = None if self.connected_at is None else self.connected_at + self._shift
+            finished = {r["name"] for r in o.coverage if r["finished"]}
             for text in process_notes(o.process, clauses=BS_CLAUSES, plan=self.plan,
-                                      connected_at=started, ended_at=o.ended_at):
+                                      connected_at=started, ended_at=o.ended_at, finished=finished):
                 self.recorder.note(t, text)
         if status == "never-connected":
             self.recorder.note(t, not_judged_note(BS_CLAUSES, f"not judged: {reason}"))
@@ -245,8 +302,9 @@ class Runner:
             self.recorder.note(t, partial_note(reason))
 
     def _elapsed(self, now: float) -> float:
-        """Seconds of the schedule run so far (a gap's scenario, run again, is counted once)."""
-        return 0.0 if self.connected_at is None else self.rel(now) - self.connected_at - self._shift
+        """Seconds of the run so far (a gap's scenario, run again, is counted once; a scenario held
+        open past its plan counts)."""
+        return 0.0 if self.connected_at is None else self.rel(now) - self.connected_at - self._shift + self._extended
 
     # ------------------------------------------------------------------ helmcheck's port gone and back
     def _gap_start(self, now: float, why: str) -> None:
@@ -307,7 +365,9 @@ class Runner:
             self._note(now, "silence ends")
         if cut is not None:  # the schedule goes on from the cut scenario's start
             self._shift = t - (self.connected_at or 0.0) - cut.start
-            self._actions = deque(a for a in self.plan.actions if a.at >= cut.start)
+            self._extended = 0.0
+            self._actions = deque(a for a in self._schedule if a.at >= cut.start)
+            self.stage.restart(cut.name, t)
         if self.progress is not None and hasattr(self.progress, "note"):
             self.progress.note(f"{self.port} is back after {t - gap['lost_at_s']:.1f} s; {again}")
         self._due(now)
@@ -354,15 +414,27 @@ class Runner:
                 self.link.peer_seen()
             self._note(now, "backseat connected (first byte); the judged run starts")
             self.outcome.events.append((self.rel(now), "note", "backseat connected"))
-            self._actions = deque(a for a in self.plan.actions)
+            self._actions = deque(self._schedule)
             if self.progress is not None:
                 self.progress.start(self.plan.total)
             self._due(now)
         self._service(now)  # the vehicle up to now first: a lockout that ended is noted before
-        self.recorder.bytes(self.rel(now), TO_VEHICLE, data)
+        at = self.recorder.bytes(self.rel(now), TO_VEHICLE, data)  # the time the wire log gives them
         for ev in self._framer.feed(data):
+            if not isinstance(ev, Discard):
+                self._mark_command(ev.raw, at)
             self._deliver(ev.raw, None if isinstance(ev, Discard) else ev.raw, now)
             self._after_vehicle(now)
+
+    def _mark_command(self, line: bytes, at: float) -> None:
+        """A sentence the backseat sent (not its ``$OSD`` polls), for the report's timeline at the
+        time the wire log has it (``at``): the same marks a vehicle run gives the tester's
+        commands. A malformed or out-of-range command is marked too (it is often the finding).
+        Judges nothing."""
+        if self._commands_marked >= MAX_COMMAND_EVENTS or not line.startswith(b"$") or line.startswith(b"$OSD,"):
+            return
+        self._commands_marked += 1
+        self.outcome.events.append((at, "command", line.decode("latin-1", "replace").rstrip("\r\n")[:60]))
 
     def _deliver(self, raw: bytes, line: Optional[bytes], now: float) -> None:
         """One framed run from the backseat to the vehicle (``line`` None: a discarded run)."""
@@ -378,6 +450,7 @@ class Runner:
                 t = self.rel(now)
                 if len(self.outcome.events) < 500:
                     self.outcome.events.append((t, "ack-error", f"staged rejection of ${cmd.ID}: err {cmd.ERR}"))
+                self.stage.staged_refusal(now)
                 self._emit(self.core.queue_reply(s.ACK(cmd.ACK_TYPE, 1, cmd.ERR), now))
                 return
         self._emit(self.core.feed(raw, now))
@@ -387,7 +460,9 @@ class Runner:
         out = self.core.tick(now)
         if self._silent:
             if out:
-                self._note(now, f"silence: {len(out)} bytes of replies not sent")
+                if not self._unsent:
+                    self._note(now, "silence: the vehicle's replies are not sent from here on")
+                self._unsent += len(out)
         else:
             self._emit(out)
         self._after_vehicle(now)
@@ -400,6 +475,7 @@ class Runner:
             if not self._dropped_out:
                 self._note(self.clock(), "link: output dropped, nobody is reading the port")
             self._dropped_out += len(data)
+            self._dropped_total += len(data)
             return
         self._out += data
         self._write(self.clock())
@@ -427,6 +503,8 @@ class Runner:
         if lock != self._lockout:
             self._lockout = lock
             self._note(now, f"lockout starts ({m.error_state})" if lock else "lockout ends")
+            if not lock:
+                self.stage.lockout_ended(self.rel(now))
             self.outcome.events.append((self.rel(now), "lockout",
                                         f"lockout {'starts' if lock else 'ends'} ({m.error_state})"))
         if m.mode != self._mode:
@@ -437,13 +515,31 @@ class Runner:
     def _due(self, now: float) -> None:
         start = self.launch + (self.connected_at or 0.0) + self._shift
         while self._actions and start + self._actions[0].at <= now:
+            a = self._actions[0]
+            why = self.stage.hold(a, self.rel(now))
+            if why is not None:  # the scenario stays open: this step and the rest of the schedule wait
+                late = now - (start + a.at)
+                self._shift += late
+                self._extended += late
+                note = self.stage.extend(late, why)
+                if note:
+                    self._note(now, note)
+                break
             self._act(self._actions.popleft(), now)
         if self.progress is not None:
-            self.progress.update(self._elapsed(now), self._scenario, self.observer.offences())
+            self.progress.update(self._elapsed(now), self._scenario, self.observer.offences(),
+                                 self.plan.total + self._extended)
 
     def _act(self, a, now: float) -> None:
         t = self.rel(now)
+        if a.kind in ("scenario", "end"):
+            for text in self.stage.close(t):
+                self._note(now, text)
+        if a.kind == "end":
+            self._done = True
+            return
         if a.kind == "scenario":
+            self.stage.open(a.name, t)
             self._scenario = a.name
             self.outcome.scenarios_run.append(a.name)
             self._note(now, f"scenario {a.name} starts")
@@ -451,30 +547,38 @@ class Runner:
         elif a.kind == "reject":
             self._rejecting = a.on
             self._note(now, "reject: every command but $OSD is refused" if a.on else "reject: window ends")
+            self.stage.acted(a, t)
         elif a.kind == "silence":
+            if not a.on and self._unsent:
+                self._note(now, f"silence: {self._unsent} bytes of replies were not sent")
             self._silent = a.on
             self._silence_noted = False
+            self._unsent = 0
             self._note(now, "silence starts" if a.on else "silence ends")
             self.outcome.events.append((t, "note", "silence starts" if a.on else "silence ends"))
+            self.stage.acted(a, t)
         elif a.kind == "lockout":
             out = self.core.inject_fault(LOCKOUT_CODE, now, source="scenario lockout")
             self.outcome.events.append((t, "lockout", f"safety violation {LOCKOUT_CODE} raised"))
             self._after_vehicle(now)  # the note before any byte that could show the lockout
+            self.stage.acted(a, t)
             self._emit(out)
         elif a.kind == "mission-end":
-            self._end_mission(now)
+            self.stage.acted(a, t, mission_ended=self._end_mission(now))
 
-    def _end_mission(self, now: float) -> None:
-        """The running mission ends on the vehicle, off the wire (scenario ``mission-end``)."""
+    def _end_mission(self, now: float) -> bool:
+        """The running mission ends on the vehicle, off the wire (scenario ``mission-end``); whether
+        one was running to end."""
         core = self.core
         self._emit(core.tick(now))
         if not core.mission_running:
             self._note(now, "mission-end: no mission was running; nothing to end")
-            return
-        self._emit(core.end_mission(now))
+            return False
         self._note(now, "mission-end: the mission ended on the vehicle")
         self.outcome.events.append((self.rel(now), "note", "mission ended on the vehicle"))
+        self._emit(core.end_mission(now))
         self._after_vehicle(now)
+        return True
 
     # ------------------------------------------------------------------ notes
     def _note(self, now: float, text: str) -> None:

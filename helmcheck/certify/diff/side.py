@@ -43,6 +43,7 @@ class SideSpec:
     time_scale: float
     exec_cmd: Optional[str] = None
     link: object = None  #: the port, already opened by the command line
+    line: Optional[str] = None  #: ``--line clean|noisy`` (None: guessed from the port)
 
     @property
     def label(self) -> str:
@@ -58,7 +59,7 @@ class Side:
         self.dir = Path(report_dir) / spec.name
         opts = Options(port=spec.port, profile=spec.profile, time_scale=spec.time_scale, report_dir=self.dir,
                        progress=False, render=False, explore=False, command=command, link=spec.link,
-                       exec_cmd=spec.exec_cmd, log_opener=log_opener, title="diff")
+                       exec_cmd=spec.exec_cmd, log_opener=log_opener, title="diff", line=spec.line)
         self.run = Run(opts)
         self.k = spec.time_scale
         self.session = None

@@ -10,7 +10,9 @@ entry point is :func:`.runner.certify`. Modules, one concern each:
   vanished device.
 * :mod:`.safety` — the bench-safety interlock (profile ``[bench_safety]``).
 * :mod:`.catalogue` — the numbered, data-described clause cases (description, expectation,
-  steps); :mod:`.steps` — their step vocabulary; :mod:`.interpreter` — runs a case's steps.
+  steps); :mod:`.rulecases` — the cases that probe a rule of the traceability table no other case
+  could fail (:mod:`helmcheck.rules`); :mod:`.steps` — their step vocabulary; :mod:`.interpreter` —
+  runs a case's steps.
 * :mod:`.session` — runs steps against a vehicle: verified reset, send, poll, timed waits.
 * :mod:`.linemeter` — what the line costs, measured as the run goes (reply latency, the host's
   jitter, the report's size); :mod:`.durations` — the timeouts, parks and waits chosen from it

@@ -437,12 +437,11 @@ def targets(cover: ModelCoverage, edges, profile: Profile, survey: MissionSurvey
             way, body = _EXTRA[(ev, code)]
             add(way, (body,), f"{ev} err {code}", keeps=True)
     for e in edges.edges:
-        if e.id in edges.reached or e.id in edges.held or (e.field, e.side) in _LEFT_TO_CASES.get(e.command, ()):
+        if e.id in edges.reached or e.id in edges.held:
             continue
         got = edge_body(e, profile)
-        if got is None or got[1] is None or (got[0] and got[0] not in ("@gps", "@under")
-                                               and not all(n in claimed or n == "@oxflt" and oxflt
-                                                           for n in WAYS[got[0]].needs)):
+        if got is None or got[1] is None or (got[0] and not all(n in claimed or n == "@oxflt" and oxflt
+                                                                for n in WAYS[got[0]].needs)):
             continue
         way, body = got
         fire = tuple(body.split("|"))
@@ -538,9 +537,6 @@ def _open(what: str, un: dict) -> bool:
     return False
 
 
-#: Edges the aim leaves to the clause cases: the SRP name's bad paths, whose answer (30 for the
-#: path, or 31 for the SRP look-up, RH-RD-6) the judge does not yet accept both of.
-_LEFT_TO_CASES = {"OMSTART": (("srp", "out"),)}
 #: Commands whose acceptance keeps the vehicle's mode (their range edges can be driven together).
 _KEEP_MODE = ("OSD", "OLOGL", "OLOGD", "OPOS", "ODVL", "ORWSET", "OMLOAD")
 #: Targets of one way driven as one, at most (:func:`_merged`).

@@ -20,6 +20,7 @@ from typing import Optional
 
 from ...grammar import sentences as s
 from ...profile import Profile
+from .rulecases import RULE_CASES
 from .steps import (Burst, Case, ClearWords, Fault, MissionEnd, Octd, Poll, Raw, Send, SetRoundTrip, Settle, Start,
                     Until, Wait, WithSetting)
 
@@ -291,7 +292,8 @@ CASES: tuple[Case, ...] = (
        Send(OMS), Send("OMSTOP,0"), Poll(mode="S"), Start(),
        Send("OMP,8a8a7676{motor},00,{to}"), Send("OMSTOP,0"), Poll(mode="S")),
     _c("V-47", "RH-MSN-4", "The mission ends at its last waypoint",
-       "the profile's end_mission, started by name, ends in S after its last waypoint (and its park)",
+       "the profile's end_mission (without one: the test mission, when the vehicle reports it short enough "
+       "to wait for), started by name, ends in S after its last waypoint (and its park)",
        "S", Start(which="end_mission"), MissionEnd(), needs=("end_mission",)),
     # --- §6 read/write -----------------------------------------------------------------------
     _c("V-48", "RH-POS-1", "$OPOS forms",
@@ -477,6 +479,8 @@ CASES: tuple[Case, ...] = (
        *_no("OLOGL"), *_ok("OLOGL,a", "OLOGL,1,2,3,4,5,6,7,8,9,10,11,12"), Start(),
        *_no("OLOGD", "OLOGD,1,2,3,4,5,6,7,8,9,10,11,12,13"), *_ok("OLOGD,1", "OLOGD,1,2,3,4,5,6,7,8,9,10,11,12"),
        *_ok("OJW,{wp_first}"), *_no("OJW,{wp_under}"), Poll(mode="N")),
+    # --- rules no case above could fail (the traceability table): :mod:`.rulecases` ----------------
+    *RULE_CASES,
     # --- §8 time ---------------------------------------------------------------------------------
     _c("V-62", "RH-TIM-1 RH-TIM-2", "Durations hold at the declared time scale",
        "a servo timeout of 30 s or more and a primitive timeout end within max(0.5 s, 5 %) plus the "
@@ -513,9 +517,10 @@ def unmet_need(case: Case, profile: Profile, durations=None) -> Optional[str]:
             return f"the profile's osd_letters lack {arg}"
         if kind == "safety_action" and profile.safety_action != arg:
             return f"the profile's safety_action is {profile.safety_action}, this case needs {arg}"
-        if kind == "end_mission" and not profile.end_mission:
-            return ("the profile names no end_mission (a short mission whose end a run can wait for): "
-                    "the test mission is too long to reach its end (RH-MSN-4)")
+        if kind == "end_mission" and not profile.end_mission and profile.protocol != "rh5":
+            return ("the profile names no end_mission (a short mission whose end a run can wait for), and "
+                    f"a {profile.protocol} $OSI shows no remaining mission time to tell whether the test "
+                    "mission ends soon enough (RH-MSN-4)")
         if kind == "srp_mission" and not profile.srp_mission:
             return "the profile names no srp_mission: the srp branch of SafetyAction cannot be exercised"
         if kind == "srp_field" and profile.protocol != "rh5" and profile.osi_fields < 16:

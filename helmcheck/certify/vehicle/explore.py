@@ -138,6 +138,7 @@ class _State:
         self.end = self.t0 + budget.wall_s
         self.k = float(run.session.k)
         self.executions = 0  #: sequences that ran at least their reset
+        self.steps = 0  #: steps the sequences ran (for the progress display and stats.explore)
         self.skipped = 0  #: sequences hypothesis asked for after the budget was spent
         #: clause -> the smallest failing trace of it so far ({clause, reason, steps}), in the order found
         self.found: dict[str, dict] = {}
@@ -192,7 +193,7 @@ class _State:
         (at each sequence's start and after each step)."""
         if self.progress is not None:
             self.progress.explore(self.executions, time.monotonic() - self.t0, self.budget.wall_s,
-                                  self.vehicle_spent, self.budget.vehicle_s)
+                                  self.vehicle_spent, self.budget.vehicle_s, steps=self.steps)
 
     def tester_error(self, e: Exception) -> None:
         if self.error is None:
@@ -360,7 +361,8 @@ def explore(run) -> None:
     error = state.error
     which = state.which_spent
     spent = error is None and (state.skipped > 0 or which is not None)
-    run.stats["explore"] = {"examples": examples, "ran": state.executions, "failures": state.failures,
+    run.stats["explore"] = {"examples": examples, "ran": state.executions, "steps": state.steps,
+                            "failures": state.failures,
                             "budget_s": budget.wall_s, "budget_vehicle_s": budget.vehicle_s,
                             "budget_spent": spent, "wall_s": round(time.monotonic() - t0, 3),
                             "vehicle_s": round(state.vehicle_spent, 1),

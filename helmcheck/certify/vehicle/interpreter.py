@@ -27,7 +27,7 @@ from .flow import CaseStop
 from .safety import BenchSafetyRefused
 from .session import Session, frame
 from .steps import (Burst, Case, ClearWords, Fault, MissionEnd, Octd, Poll, Raw, Send, SetRoundTrip, Settle, Start,
-                    Until, Wait, WithSetting)
+                    Until, Wait, WithSetting, Quiet)
 
 __all__ = ["run_case", "run_step", "raw_line", "context", "fill"]
 
@@ -129,6 +129,10 @@ def raw_line(kind: str, body: str, profile: Profile) -> bytes:
         return b"$" + body.encode() + b"\r\n"
     if kind == "shortck":
         return b"$" + body.encode() + b"*" + checksum_hex(body)[:1].encode() + b"\r\n"
+    if kind == "longck":  # the right two digits and one more
+        return b"$" + body.encode() + b"*" + checksum_hex(body).encode() + b"0\r\n"
+    if kind == "hexck":
+        return b"$" + body.encode() + b"*GZ\r\n"
     if kind == "twostar":
         b2 = body + "*"
         return b"$" + b2.encode() + b"*" + checksum_hex(b2).encode() + b"\r\n"
@@ -196,8 +200,8 @@ def _condition(session: Session, osi: s.OSI, mode: Optional[str], mode_not: Opti
 
 def _check_expect(session: Session, sent, text: str) -> None:
     """The case's ``expect`` words must agree with the model (else it is the case's fault)."""
-    if not text.startswith("$ACK,") or sent is None or sent.ack is None:
-        return
+    if not text.startswith("$ACK,") or sent is None or sent.ack is None or sent.reading:
+        return  # (an answer under another reading of the profile is the vehicle's own choice)
     want = text[5:].split(",")
     model = next((r for r in sent.expected if isinstance(r, s.ACK)), None)
     if model is None:
@@ -242,9 +246,10 @@ def run_step(session: Session, st, ctx: dict) -> None:
         _here(session, ctx)
     elif isinstance(st, Fault):
         _violation(session, st, ctx)
+        ctx["raised"] = True
     elif isinstance(st, Start):
         p = session.profile
-        name = getattr(p, st.which)
+        name = getattr(p, st.which) or (p.mission if st.which == "end_mission" else "")
         if st.which == "mission" and session.mission_override:
             name = session.mission_override
         session.start_mission(name, p.srp_mission if st.srp else "", st.ignore_gps)
@@ -262,6 +267,8 @@ def run_step(session: Session, st, ctx: dict) -> None:
         _clear_words(session, st, ctx)
     elif isinstance(st, SetRoundTrip):
         _set_round_trip(session, st)
+    elif isinstance(st, Quiet):
+        session.quiet(st.wall_s, st.reopen)
     elif isinstance(st, Octd):
         if "T" in session.profile.osd_letters:
             session.exchange(frame("OSD,T"))
@@ -288,8 +295,15 @@ def _until(session: Session, st: Until, ctx: dict) -> None:
     srp = None if st.srp_active is None else ("True" if st.srp_active else "False")
     at_least = number(st.depth_at_least, ctx)
     park_below = number(st.park_below, ctx)
+    # the vehicle's own rule (violation_trigger = mission-rule) trips when it will, whatever the case
+    # is doing (a servo dive, a park): once it shows, the case goes on from there (the Fault step)
+    rule = (session.profile.trigger == "mission-rule" and "violation" in session.case_needs
+            and not ctx.get("raised"))
 
     def pred(o: s.OSI) -> bool:
+        if rule and o.error_state not in ("N", ""):
+            ctx["tripped"] = o.error_state
+            return True
         flag = o.srp_active if session.profile.protocol == "rh5" else o.battery
         need = None if at_least is None else min(at_least, session.profile.max_depth / 4)
         deep = need is None or (o.depth is not None and float(o.depth) >= need)
@@ -304,11 +318,20 @@ def _until(session: Session, st: Until, ctx: dict) -> None:
     session.until(st.what, pred, st.budget_v, session.case_clauses[0], refresh=refresh)
 
 
+#: Wall seconds the test mission's end is waited for when the profile names no end_mission.
+TEST_MISSION_END_WALL_S = 120.0
+
+
 def _mission_end(session: Session, st: MissionEnd) -> None:
     """Poll until ``S`` (the observer judges the end, RH-MSN-4); a vehicle that reports more time
-    left than the cap allows (``$OSI`` field 13, rh5) is not waited for: INCONCLUSIVE at once."""
-    name = session.profile.end_mission
+    left than the cap allows (``$OSI`` field 13, rh5) is not waited for: INCONCLUSIVE at once.
+    Without an ``end_mission`` the test mission is waited for when the vehicle reports a time left
+    that ends within :data:`TEST_MISSION_END_WALL_S` of wall time; else NOT-TESTED at once (a
+    long mission is the profile's to know, not a finding)."""
+    name = session.profile.end_mission or session.profile.mission
+    fallback = not session.profile.end_mission
     v0 = session.obs.v(session.now())
+    cap = min(st.cap_v, TEST_MISSION_END_WALL_S * session.k) if fallback else st.cap_v
 
     def pred(o: s.OSI) -> bool:
         if o.mode == "S":
@@ -316,13 +339,25 @@ def _mission_end(session: Session, st: MissionEnd) -> None:
         left = float(o.remaining_time) * 3600.0 if (session.profile.protocol == "rh5" and
                                                      o.remaining_time is not None) else 0.0
         spent = session.obs.v(session.now()) - v0
-        if left and spent + left > st.cap_v:
+        if fallback and not left and o.mode in ("N", "P"):
+            reason = (f"{session.case}: the profile names no end_mission and the vehicle reports no time left for "
+                      f"its test mission {name}: its end cannot be waited for; name a short end_mission")
+            session.tester("not-tested", session.case_clauses[:1], reason)
+            raise CaseStop("not-tested", reason)
+        if left and spent + left > cap:
+            if fallback:
+                reason = (f"{session.case}: the profile names no end_mission, and the vehicle reports about "
+                          f"{left:.0f} s of its test mission {name} left, more than {cap:g} s of vehicle time "
+                          f"({TEST_MISSION_END_WALL_S:g} s of wall time at ×{session.k:g}): name a short "
+                          f"end_mission to judge RH-MSN-4")
+                session.tester("not-tested", session.case_clauses[:1], reason)
+                raise CaseStop("not-tested", reason)
             reason = (f"{session.case}: the vehicle reports about {left:.0f} s of {name} left {spent:.0f} s after "
                       f"its start, past the cap of {st.cap_v:g} s; a shorter end_mission would be judged")
             session.tester("inconclusive", session.case_clauses[:1], reason)
             raise CaseStop("inconclusive", reason)
         return False
-    session.until(f"the end of {name} (S)", pred, st.cap_v, session.case_clauses[0])
+    session.until(f"the end of {name} (S)", pred, cap, session.case_clauses[0])
 
 
 def _with_setting(session: Session, st: WithSetting, ctx: dict) -> None:

@@ -102,6 +102,7 @@ def machine(state, p, tos, deep: bool = True, aim: Optional[list] = None):
             if not self.active or state.batch_spent:  # the budget ends the sequence here too
                 return
             try:
+                state.steps += 1
                 fn()
                 session.check()
                 state.show_progress()

@@ -6,9 +6,11 @@ instead (at 80 columns the bar is 20 characters). Off a terminal (piped, in CI) 
 line, and the exploration a line at its start and then at most one every :data:`PLAIN_EVERY_S`.
 
 The exploration is shown by what its budget allows, not by the examples asked for (the wall
-budget usually ends it long before): the share of the budget used — the wall clock's or the
-vehicle clock's, whichever is further on — and the sequences run so far; on the bar, the
-exploration's step fills as its budget is used.
+budget usually ends it long before): the sequences and steps run so far and the share of the
+budget used — the wall clock's or the vehicle clock's, whichever is further on; on the bar, the
+exploration's step fills as its budget is used. When it ends, its line says what it did
+(:func:`explored_text`: sequences and steps run, the time it took, the budget it had and whether
+the budget or the examples asked for ended it), so a short exploration never reads as skipped.
 """
 
 from __future__ import annotations
@@ -17,7 +19,7 @@ import sys
 import time
 from typing import IO, Callable, Optional
 
-__all__ = ["Progress", "BAR_WIDTH", "PLAIN_EVERY_S", "budget_text"]
+__all__ = ["Progress", "BAR_WIDTH", "PLAIN_EVERY_S", "budget_text", "explored_text"]
 
 #: Characters of the bar on a terminal, whatever the terminal's width.
 BAR_WIDTH = 20
@@ -25,19 +27,45 @@ BAR_WIDTH = 20
 PLAIN_EVERY_S = 10.0
 
 
+def _n(count: int, what: str) -> str:
+    return f"{count} {what}{'s' if count != 1 else ''}"
+
+
 def budget_text(ran: int, wall_s: float, wall_budget_s: float, vehicle_s: float, vehicle_budget_s: float,
-                short: bool = False) -> tuple[float, str]:
+                short: bool = False, steps: Optional[int] = None) -> tuple[float, str]:
     """The share of an exploration's budget used (0..1, whichever clock is further on) and its
-    text: ``45 % of the budget (14 of 30 s wall), 14 sequences``."""
+    text: ``exploration: 14 sequences and 210 steps run so far, 45 % of the budget (14 of 30 s
+    wall)``."""
     wall = wall_s / wall_budget_s if wall_budget_s > 0 else 0.0
     veh = vehicle_s / vehicle_budget_s if vehicle_budget_s > 0 else 0.0
     used = min(1.0, max(wall, veh))
-    seqs = f"{ran} sequence{'s' if ran != 1 else ''}"
+    done = _n(ran, "sequence") + ("" if steps is None else f" and {_n(steps, 'step')}")
     if short:
-        return used, f"exploring: {used * 100:.0f} % of budget, {seqs}"
+        return used, f"exploring: {used * 100:.0f} % of budget, {done}"
     clock = (f"{wall_s:.0f} of {wall_budget_s:g} s wall" if wall >= veh
              else f"{vehicle_s:.0f} of {vehicle_budget_s:g} s vehicle time")
-    return used, f"exploration: {used * 100:.0f} % of the budget ({clock}), {seqs} so far"
+    return used, f"exploration: {done} run so far, {used * 100:.0f} % of the budget ({clock})"
+
+
+def explored_text(stats: Optional[dict]) -> str:
+    """What an exploration did, for its progress line when it ends (``stats``: the run's
+    ``stats.explore``): ``10 sequences and 214 steps in 6.8 s; all 10 examples asked, within its
+    budget of 30 s wall or 1500 s vehicle time`` — or that it was not run, and why."""
+    if not isinstance(stats, dict) or not stats.get("examples"):
+        why = stats.get("outcome") if isinstance(stats, dict) else None
+        return why or "not run"
+    done = _n(int(stats.get("ran") or 0), "sequence")
+    if stats.get("steps") is not None:
+        done += f" and {_n(int(stats['steps']), 'step')}"
+    if stats.get("wall_s") is not None:
+        done += f" in {float(stats['wall_s']):.1f} s"
+    budget = f"{float(stats.get('budget_s') or 0):g} s wall or {float(stats.get('budget_vehicle_s') or 0):g} s vehicle time"
+    if stats.get("budget_spent"):
+        end = f"its budget ({budget}, whichever ends first) spent before the {stats['examples']} examples asked"
+    else:
+        end = f"all {stats['examples']} examples asked, within its budget of {budget}"
+    found = int(stats.get("failures") or 0)
+    return f"{done}; {end}" + (f"; {_n(found, 'failing sequence')}" if found else "")
 
 
 class Progress:
@@ -91,12 +119,13 @@ class Progress:
         print(f"[{self.n}/{self.total}] {label} {verdict}", file=self.stream, flush=True)
 
     def explore(self, ran: int, wall_s: float, wall_budget_s: float, vehicle_s: float = 0.0,
-                vehicle_budget_s: float = 0.0) -> None:
-        """Exploration progress: the share of its budget used and the sequences run (module docstring)."""
+                vehicle_budget_s: float = 0.0, steps: Optional[int] = None) -> None:
+        """Exploration progress: the sequences and steps run and the share of its budget used
+        (module docstring)."""
         if not self.enabled:
             return
         short = self.rich is not None
-        used, text = budget_text(ran, wall_s, wall_budget_s, vehicle_s, vehicle_budget_s, short=short)
+        used, text = budget_text(ran, wall_s, wall_budget_s, vehicle_s, vehicle_budget_s, short=short, steps=steps)
         if self.rich is not None:
             self.rich.update(self.task, completed=self.n + used, last=text)
             return

@@ -52,10 +52,12 @@ from ...grammar.wirelog import run_header
 from ...judge import Ledger
 from ...judge.runfacts import RunFacts, partial_note, selection_note
 from ...judge.linebudget import NOMINAL_WIDENING_S
+from ...judge.linemodel import line_note
 from ...judge.vehicle import VehicleObserver
 from ...judge.wire import tester_note
+from ...line.linekind import line_for
 from ...line.recorder import Recorder
-from ...line.reopen import DEFAULT_WAIT_S, reopenable
+from ...line.reopen import DEFAULT_WAIT_S, reopenable, wait_for_port
 from ...line.transport import open_link
 from ...profile import Profile
 from ...reports import results as R
@@ -66,10 +68,10 @@ from .casecounters import CaseCounters
 from .catalogue import select_cases
 from .clockprobe import ClockMismatch, check_clock
 from .exec_child import ExecChild
-from .flow import LinkLost, LinkSilent
+from .flow import CaseStop, LinkLost, LinkSilent
 from .interpreter import run_case
 from .link import TesterLink
-from .progress import Progress
+from .progress import Progress, explored_text
 from .generate import EXPLORE_WRITES
 from .rejoin import rejoin
 from .restore import Custodian, written_settings
@@ -119,6 +121,9 @@ class Options:
     #: timing coarser than nominal (:data:`~helmcheck.judge.linebudget.NOMINAL_WIDENING_S`), naming
     #: the time scale that would not (:class:`CoarseTiming`); ``"any"``: judge with what the line gives
     precision: str = "any"
+    #: ``--line clean|noisy``: the line model the run states (None: guessed from the port,
+    #: :func:`helmcheck.line.linekind.line_for`)
+    line: Optional[str] = None
     #: wall seconds a vanished port is waited for under the same name before the run stops
     #: (``--reconnect-wait``; 0: not waited for), :mod:`.rejoin`
     reconnect_wait_s: float = DEFAULT_WAIT_S
@@ -251,10 +256,32 @@ class Run(ExecChild):
         except Exception:  # noqa: BLE001
             pass
         self.link.note(f"link: {self.p.baud} baud 8N1 {self.o.port}")
+        shown = getattr(raw, "name", None) if self.o.port == "announced" else None
+        self.link.note(line_note(line_for(shown or self.o.port, self.o.line)))
         self.session = Session(self.link, self.p, self.k, self.observer, max_wait=self.o.max_wait)
         self.session.custodian = self.custodian
+        self.session.reopen = self.reopen_link
         if self.o.operator:
             self.session.operator = self.tell_operator
+
+    def reopen_link(self) -> Optional[str]:
+        """Close the tester's end of the link and open it again under the same name (a client
+        reconnecting: :class:`.steps.Quiet`); None where the name cannot come back (the run's own
+        pty, ``/dev/pts/N``, a vehicle helmcheck started). A name that does not open again within
+        10 s stops the case INCONCLUSIVE (the tester's own reopen, not a finding)."""
+        port = self.o.port
+        if self.o.exec_cmd is not None or not reopenable(port) or self.link is None:
+            return None
+        try:
+            self.link.link.close()
+        except Exception:  # noqa: BLE001
+            pass
+        raw, last = wait_for_port(port, baud=self.p.baud, within_s=10.0)
+        if raw is None:
+            raise CaseStop("inconclusive", f"{port} did not open again within 10 s after the tester closed it "
+                                           f"({last}): the first command after a reconnection could not be sent")
+        self.link.reattach(raw, f"link reopened by the tester: {port} closed and opened again after a quiet line")
+        return f"line quiet: {port} closed and opened again"
 
     def _record(self, wire, meta: list) -> None:
         """The recorder of a new record: to the observer and the run facts; a ``--select`` run's
@@ -464,7 +491,7 @@ def certify(opts: Options) -> Outcome:
             if explore_now and run.aborted is None:
                 from .explore import explore
                 _again(run, "the exploration", lambda: explore(run))
-                run.progress.step("exploration", "done")
+                run.progress.step("exploration", explored_text(run.stats.get("explore")))
         except (ClockMismatch, CoarseTiming) as e:  # the declared time scale is clearly wrong, or too
             run.aborted = run.stopped = str(e)          # coarse for --precision nominal: INCONCLUSIVE
             run.progress.note(f"stopped: {e}")

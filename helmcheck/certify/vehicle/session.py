@@ -104,6 +104,10 @@ class Session:
         #: tells the person at the terminal what to do (``violation_trigger = "operator"``); None
         #: when nobody is there
         self.operator: Optional[Callable[[str], None]] = None
+        #: closes the tester's end of the link and opens it again under the same name (a client
+        #: reconnecting, :class:`.steps.Quiet`); returns what it did, or None where the name cannot
+        #: be opened again (the run's own pty, a vehicle it started). None: never (a plan)
+        self.reopen: Optional[Callable[[], Optional[str]]] = None
         #: keeps what the vehicle was found in and puts it back (:mod:`.restore`); None: not kept
         self.custodian = None
         #: what the line costs (:mod:`.linemeter`), and the durations chosen from it (:mod:`.durations`)
@@ -472,6 +476,17 @@ class Session:
             self.trace = trace
             self.forced_wait += self.now() - t0
 
+    def quiet(self, wall_s: float, reopen: bool = False) -> None:
+        """The line goes quiet for ``wall_s`` (nothing sent, replies still read), then, with
+        ``reopen``, the link is closed and opened again where its name allows (:class:`.steps.Quiet`)."""
+        self.link.note(f"line quiet: the tester sends nothing for {wall_s:g} s")
+        t0 = self.now()
+        self.link.sleep(wall_s)
+        self.forced_wait += self.now() - t0
+        if reopen:
+            did = self.reopen() if self.reopen is not None else None
+            self.link.note(did or "line quiet: the link is kept open (its name cannot be opened again)")
+
     def settle(self, timer: Optional[str] = None, probe: Optional[bytes] = None,
                clause: Optional[str] = None) -> s.OSI:
         """Poll across the deadline of a model timer until the vehicle has left the state before
@@ -479,6 +494,23 @@ class Session:
         ``$OSI``: with a ``probe`` (a command only the lockout refuses) it is left when the probe
         is answered without err 26 (RH-SAF-1), so what follows is judged after it for certain."""
         dl = self.obs.deadline(timer)
+        if (dl is None and timer == "lockout" and self.obs.state().phase != "lockout"
+                and self.obs.state().error_state != "N"):
+            if self.profile.trigger in ("mission-rule", "operator"):
+                # the vehicle's own rule (or the operator) tripped and its lockout ran out before the
+                # case could watch it end: what follows is judged; the lockout's length is not, here
+                self.note(f"{self.case}: the lockout ended before the case could watch it (the vehicle's own "
+                          f"violation came while it was busy): its length is not judged in this case")
+                return self.poll()
+            # raised by the tester, and over before the line brought back an answer from inside
+            # it: this line cannot carry the case at this time scale (the tester's choice, not a
+            # finding, and not INCONCLUSIVE)
+            d = self.durations(fresh=True)
+            reason = (f"{self.case}: the {self.profile.lockout_s:g} s lockout was over before an answer from "
+                      f"inside it came back on this line at time scale {self.k:g} (RH-SAF-1, the line: "
+                      f"{d.budget.describe()}); run at {d.advice('lockout')}")
+            self.tester("not-tested", [clause] if clause else self.case_clauses[:1], reason)
+            raise CaseStop("not-tested", reason)
         if dl is None:
             self._budget(f"the {timer or 'next'} timer", 0.0, clause,
                          "the case did not reach the state whose timer it waits for")

@@ -30,7 +30,7 @@ from dataclasses import dataclass
 from typing import Optional
 
 __all__ = ["Send", "Raw", "Poll", "Wait", "Settle", "Until", "Fault", "Start", "MissionEnd", "WithSetting",
-           "Burst", "SetRoundTrip", "Octd", "ClearWords", "Case", "RAW_KINDS"]
+           "Burst", "SetRoundTrip", "Octd", "ClearWords", "Quiet", "Case", "RAW_KINDS"]
 
 #: Mutations of a valid sentence (:func:`.interpreter.raw_line`), each tied to its clause.
 RAW_KINDS = {
@@ -39,6 +39,8 @@ RAW_KINDS = {
     "lowerck": "RH-FRM-3: lower-case checksum hex",
     "nock": "RH-FRM-4: no *hh",
     "shortck": "RH-FRM-4: one hex digit",
+    "longck": "RH-FRM-4: three hex digits",
+    "hexck": "RH-FRM-4: two characters that are not hex digits",
     "twostar": "RH-FRM-4, RH-RD-16: two '*'",
     "unknown": "RH-FRM-5: an unknown ID (sent as is)",
     "lowerid": "RH-FRM-5, RH-RD-16: a lower-case ID",
@@ -175,6 +177,18 @@ class ClearWords:
     must be refused — the keyword edges of :func:`.edges.edge_list`."""
 
     queue: str
+
+
+@dataclass(frozen=True)
+class Quiet:
+    """The line goes quiet: nothing is sent for ``wall_s`` wall seconds (no poll either). With
+    ``reopen`` the tester then closes its end of the link and opens it again under the same name,
+    where a name can be opened again (a device path, ``socket://``: a client reconnecting; not a
+    pseudo-terminal the run made, nor a vehicle it started). The next step is the first command
+    after it (RH-ACK-1: every command gets its ``$ACK``, the first after a silence too)."""
+
+    wall_s: float = 5.0
+    reopen: bool = False
 
 
 @dataclass(frozen=True)

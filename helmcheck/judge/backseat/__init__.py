@@ -14,7 +14,9 @@ each:
 * :mod:`.preconditions` — RH-BS-3;
 * :mod:`.reaction` — RH-BS-5, rejections and the lockout;
 * :mod:`.servo` — RH-BS-6, the servo refresh;
-* :mod:`.polling` — RH-BS-8, state polls.
+* :mod:`.polling` — RH-BS-8, state polls;
+* :mod:`.words` — the findings in the backseat's words (what it sent, the rule of §1–6 it broke,
+  quoted).
 """
 
 from .budget import line_budget

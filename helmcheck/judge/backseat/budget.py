@@ -71,15 +71,22 @@ class LineBudget:
         maybe = self._possible.add(t, n)
         self.max_window_bytes = max(self.max_window_bytes, sure)
         budget = self.budget
-        why = f"the line drains {budget} bytes a second ({self.s.baud} baud / 10)"
         if sure > budget:
-            self.ledger.failed("RH-BS-4", f"{sure} bytes within one second; {why}", [ev], self.s.case)
+            self.ledger.failed("RH-BS-4", f"{sure} bytes sent within one second, more than the {budget} a "
+                                          f"{self.s.baud}-baud line drains in a second (baud/10)", [ev], self.s.case)
         elif maybe > budget:
-            self.ledger.inconclusive("RH-BS-4", f"{maybe} bytes within one second give or take the "
-                                                f"timestamp step {self.s.resolution:g} s; {why}",
-                                     [ev], self.s.case)
+            self.ledger.inconclusive("RH-BS-4", f"{maybe} bytes sent within one second give or take the timestamp "
+                                                f"step {self.s.resolution:g} s; a {self.s.baud}-baud line drains "
+                                                f"{budget} a second (baud/10)", [ev], self.s.case)
         elif self._passed:
             self.ledger.passed("RH-BS-4", case=self.s.case)
         else:
             self._passed = True
-            self.ledger.passed("RH-BS-4", f"within the budget; {why}", [ev], self.s.case)
+            self.ledger.passed("RH-BS-4", f"no one second held more than the {budget} bytes a {self.s.baud}-baud "
+                                          f"line drains (baud/10)", [ev], self.s.case)
+
+    def close(self) -> None:
+        """The record ended: the busiest second, beside the verdict."""
+        if self.bytes and self._passed:
+            self.ledger.remark("RH-BS-4", f"its busiest second held {self.max_window_bytes} bytes of the "
+                                          f"{self.budget} allowed.")

@@ -47,6 +47,7 @@ class Settings:
     reaction_s: float
     lockout_s: float
     case: str = ""
+    clean: bool = False  #: the record states a link that cannot damage bytes (``line model: clean``)
 
 
 @dataclass(slots=True)

@@ -92,6 +92,11 @@ class StateReports:
             return False
         return not (i < len(self._v) and self._rec[i] <= at)  # the next change says ``need``
 
+    def known(self, t: float) -> Optional[tuple[float, bool]]:
+        """The last state report that had fully arrived by ``t``: (when it arrived, running), or None."""
+        i = bisect_right(self._arr, t)
+        return (self._arr[i - 1], self._v[i - 1]) if i else None
+
     def broken(self, arrived: float) -> None:
         """A vehicle line that reached the backseat broken (bytes that frame into nothing, a
         checksum that does not match): what it said, the backseat may or may not have read."""
@@ -162,6 +167,7 @@ class Episode:
 
     code: str
     known: Optional[float] = None  #: first sign arrived + ``reaction_s`` (None: no sign yet)
+    start: Optional[float] = None  #: the ``lockout starts`` note's time (None: no notes)
     end: Optional[float] = None  #: when it ends (None: until a ``lockout ends`` note)
     noted: bool = False  #: announced by a ``lockout starts`` note
     offences: int = 0
@@ -208,7 +214,7 @@ class Lockout:
         ep = self.episode
         if ep is not None and ep.noted:
             return None
-        self.episode = Episode(code, noted=True, case=self.s.case)
+        self.episode = Episode(code, noted=True, case=self.s.case, start=t)
         self.count += 1
         return ep
 

@@ -14,8 +14,11 @@
 * **RH-BS-7** (SHOULD) — upper-case checksum hex and CR LF: a grammar finding on the line
   (lower-case hex, bare LF) is a violation; every other line meets it.
 
-A faulty line between the backseat and the vehicle breaks lines the backseat wrote whole, so a
-broken line's violations are held, not booked (``docs/contracts.md``, "A faulty line"; the
+A well-framed line with a right checksum is judged as sent, on any link: a field out of range
+under a right checksum is what the backseat wrote (RH-BS-2 at once). On a link that cannot damage
+a byte (``line model: clean``) every broken line is the backseat's at once too. Elsewhere a faulty
+line between the backseat and the vehicle breaks lines the backseat wrote whole, so a broken
+line's violations are held, not booked (``docs/contracts.md``, "A faulty line"; the
 repetition rule, :mod:`helmcheck.judge.streaks`, and the damage's form,
 :mod:`helmcheck.judge.spoil`): the next line of the same sentence read whole makes them the
 line's; the same error on the backseat's next lines of that sentence, as often as its form
@@ -29,11 +32,13 @@ from __future__ import annotations
 
 from ...grammar import sentences as s
 from ...grammar.errors import FRAMING
+from ...grammar.ranges import check_ranges
 from ...model.validate import field_error
 from ..ledger import Ledger
 from ..spoil import REPEAT, SHORTEST_COMMAND, explain, explain_discard, signature
 from ..streaks import OTHER_REPEAT, Streaks
 from .common import SentLine, Settings
+from .words import discard_words, field_words, finding_words, framing_words
 
 __all__ = ["LineRules"]
 
@@ -71,6 +76,13 @@ class LineRules:
                 self.ledger.failed(cid, reason, [line.evidence()], case)
             return
         raw, d = line.raw, line.decoded
+        if (fault is None and d is not None and not d.findings and (d.error is None or d.error.kind != FRAMING)
+                and explain(raw, self.s.profile, d, SHORTEST_COMMAND) is None):
+            # well framed with a right checksum: judged as sent, on any link (no one line fault
+            # makes it; a value out of range under a right checksum is what the backseat wrote)
+            for cid, reason in fails:
+                self.ledger.failed(cid, reason, [line.evidence()], case)
+            return
         junk = d is None and raw[:1] != b"$"
         key = ("bs-junk",) if junk else ("bs", line.sid or "?")
         if fault is not None:
@@ -93,7 +105,7 @@ class LineRules:
         d = line.discard
         if line.raw[:1] != b"$":
             self._junk_before = True
-        self._hold(line, [("RH-BS-1", f"{d.length} byte(s) that are no sentence ({d.clause}: {d.reason})")])
+        self._hold(line, [("RH-BS-1", discard_words(d.length, d.clause, d.reason))])
 
     def line(self, line: SentLine) -> None:
         d = line.decoded
@@ -101,27 +113,29 @@ class LineRules:
         self.lines += 1
         junk, self._junk_before = self._junk_before, False
         if d.findings:
-            fails.append(("RH-BS-7", str(d.findings[0])))
+            fails.append(("RH-BS-7", finding_words(d.findings[0].message)))
         else:
             self._pass("RH-BS-7", "upper-case checksum hex and CR LF", line)
         err = d.error
         if err is not None:
             if err.kind == FRAMING:
-                fails.append(("RH-BS-1", str(err)))
+                fails.append(("RH-BS-1", framing_words(err)))
             else:
-                self._pass("RH-BS-1", "well framed, correct checksum", line)
-                fails.append(("RH-BS-2", str(err)))
+                self._pass("RH-BS-1", "well framed, with a correct two-digit checksum", line)
+                fails.append(("RH-BS-2", field_words(err)))
             self._hold(line, fails)
             return
-        self._pass("RH-BS-1", "well framed, correct checksum", line)
+        self._pass("RH-BS-1", "well framed, with a correct two-digit checksum", line)
         cmd = d.sentence
         if isinstance(cmd, s.Command):
             self.commands += 1
             code = field_error(cmd, self.s.profile)
             if code is not None:
-                fails.append(("RH-BS-2", f"${cmd.ID}: a field is out of range (a vehicle answers err {code})"))
+                bad = check_ranges(cmd, self.s.profile)
+                fails.append(("RH-BS-2", field_words(bad) if bad is not None else
+                              f"${cmd.ID}: a field outside the ranges of §4–6 (a vehicle answers err {code})"))
             else:
-                self._pass("RH-BS-2", f"${cmd.ID} fields within range", line)
+                self._pass("RH-BS-2", f"every field of ${cmd.ID} within the ranges of §4–6", line)
         if fails:
             self._hold(line, fails)
             return

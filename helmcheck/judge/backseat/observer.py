@@ -19,7 +19,8 @@ Dispatch:
   (:mod:`.knowledge`) from the time it had fully arrived; an ``$ACK`` answers a waiting command;
 * a faulty line: the backseat's broken lines are held until it sends the sentence again
   (:mod:`.lines`; a line-fault relay's notes, :mod:`helmcheck.judge.linefaults`, say exactly which
-  the line broke). A report the line broke on its way to the backseat is still taken as known
+  the line broke; a ``line model: clean`` note, :mod:`helmcheck.judge.linemodel`, says the line
+  broke none). A report the line broke on its way to the backseat is still taken as known
   (decision: a backseat may read a damaged line; the live certification cannot tell either);
 * notes (``!``, :func:`~helmcheck.judge.wire.parse_note`) — ``scenario X starts`` (findings
   then carry ``X`` as their case), ``lockout starts (<code>)`` / ``lockout ends``, ``silence
@@ -40,9 +41,10 @@ from ...grammar import Discard, Framer, Line
 from ...grammar import sentences as s
 from ...grammar.wirelog import TO_VEHICLE_RUN, escape, is_line
 from ...profile import Profile
-from ..facts import LOCKOUT_REFUSED, NEEDS_MISSION, NEEDS_RUNNING, NEEDS_STOPPED
+from ..facts import LOCKOUT_REFUSED, NEEDS_MISSION
 from ..ledger import Evidence, Ledger
 from ..linefaults import LineFaults
+from ..linemodel import UNKNOWN
 from ..timing import ack_allowance, ack_give_up_after
 from ..wire import FROM_VEHICLE, NOTE, TO_VEHICLE, Decodings, WireEvent, parse_note
 from .budget import LineBudget
@@ -50,7 +52,7 @@ from .common import BS_CLAUSES, SentLine, Settings
 from .knowledge import Arrivals, Lockout, Pending, StateReports
 from .lines import LineRules
 from .polling import Polling
-from .preconditions import Preconditions
+from .preconditions import LISTED, Preconditions
 from .reaction import Reaction
 from .servo import ServoRefresh
 
@@ -64,8 +66,8 @@ _READ = frozenset({b"$OSI,", b"$ACK,"})
 _NOT_TESTED = {
     "RH-BS-1": "the backseat sent no line",
     "RH-BS-2": "the backseat sent no well-framed command",
-    "RH-BS-3": ("no command with a state precondition ("
-                + ", ".join(sorted("$" + e for e in NEEDS_RUNNING | NEEDS_STOPPED))
+    "RH-BS-3": ("no command the clause names ("
+                + ", ".join("$" + c for c in LISTED["stopped"] + LISTED["running"])
                 + ") was sent while the vehicle's state was known"),
     "RH-BS-4": "the backseat sent nothing",
     "RH-BS-5": "no command was rejected and no lockout was known to the backseat",
@@ -82,6 +84,7 @@ class BackseatObserver:
                  resolution: float = 1e-6, decodings: Optional[Decodings] = None):
         self.profile = profile
         self.ledger = ledger
+        ledger.track_cases()  # a scenario's observations may be left out of the claim (``not claimed``)
         self.settings = st = Settings(profile, float(time_scale), int(baud), float(resolution),
                                       float(profile.reaction_s), float(profile.lockout_s))
         self._framer = Framer(profile.max_line_bytes)
@@ -109,6 +112,9 @@ class BackseatObserver:
                                                         st.baud, st.resolution))
         self.silent = False
         self.faults = LineFaults()  #: what a line-fault relay's notes say the line did
+        self.line_model = UNKNOWN  #: whether the link can damage bytes, as the record states it
+        #: the lockouts the record's notes announced, in order (each as the backseat could know it)
+        self.episodes: deque = deque(maxlen=16)
         self.started: Optional[float] = None  #: time of the backseat's first byte
         self.ended: Optional[float] = None
 
@@ -155,6 +161,7 @@ class BackseatObserver:
             self.reaction.episode_over(ep)
         self.reaction.close()
         self.lines.close()
+        self.budget.close()
         self.pending.clear()
         for cid, why in _NOT_TESTED.items():
             self.ledger.not_tested(cid, why)
@@ -309,7 +316,7 @@ class BackseatObserver:
         self.reaction.answered(line, a.status, arrived)
         self.preconditions.answered(line, accepted)
         event = line.event
-        if event == "OMS":
+        if event == "OMS" or (not accepted and line.sid == "OMS"):  # a refused $OMS, readable or not
             self.servo.answered(line, accepted, t)
         if accepted and event in LOCKOUT_REFUSED:
             ended = self.lockout.clear(t, reset_code=event in ("OMSTART", "OMSTOP"))
@@ -325,6 +332,8 @@ class BackseatObserver:
             st.case = n.text
         elif n.kind == "lockout":
             self.reaction.episode_over(self.lockout.note_start(ev.t, n.code))
+            if self.lockout.episode is not None and self.lockout.episode not in self.episodes:
+                self.episodes.append(self.lockout.episode)
         elif n.kind == "lockout-end":
             self.reaction.episode_over(self.lockout.note_end(ev.t))
         elif n.kind == "silence":
@@ -337,11 +346,19 @@ class BackseatObserver:
             self.faults.note(ev.t, n.value)
         elif n.kind == "relay":
             self.faults.relay_started()
+        elif n.kind == "line-model":
+            self.line_model = n.value
+            st.clean = not n.value.can_damage
+            if not n.value.can_damage:
+                self.faults.clean_link()
         elif n.kind == "link" and n.value:
             st.baud = int(n.value)
             self.arrivals.baud = st.baud
         elif n.kind == "resumed":
             self._resume(ev)
+        elif n.kind == "overrun":
+            self.ledger.remark("RH-BS-4", f"line overrun (a remark, not a verdict: the clause bounds the bytes the "
+                                          f"backseat sends, not the replies it asks for): {n.text}")
 
     def _resume(self, ev: WireEvent) -> None:
         """``run resumed``: the record goes on after a gap in what it saw (an interrupted run,

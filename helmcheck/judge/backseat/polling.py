@@ -32,6 +32,7 @@ class Polling:
         self._last: Optional[float] = None
         self._last_ev: Optional[Evidence] = None
         self.polls = 0
+        self.max_gap = 0.0  #: the longest interval between two of its polls seen so far (its poll cycle)
         self._passed = False
         self._resumed = False  #: the interval open now began at a ``run resumed`` note
 
@@ -50,9 +51,11 @@ class Polling:
         if cmd is None or cmd.ID != "OSD" or "S" not in cmd.requested:
             return
         self.polls += 1
+        if self.polls > 1 and not self._resumed:
+            self.max_gap = max(self.max_gap, line.t - self._last)
         ev = line.evidence()
         self._judge(line.t, ev, "first state poll {:.2f} s after the record resumed" if self._resumed
-                    else "state poll {:.2f} s after the previous one" if self.polls > 1
+                    else "polled for state {:.2f} s after its previous poll" if self.polls > 1
                     else "first state poll {:.2f} s after the backseat's first byte")
         self._last, self._last_ev = line.t, ev
         self._resumed = False
@@ -72,7 +75,7 @@ class Polling:
     def _judge(self, t: float, ev: Evidence, text: str) -> None:
         measured = t - self._last
         v = gap(measured, POLL_INTERVAL_S + JITTER_S, self.s.resolution)
-        what = text.format(measured) + f" (at most {POLL_INTERVAL_S:g} s apart)"
+        what = text.format(measured) + f"; RH-BS-8 asks for one at least every {POLL_INTERVAL_S:g} s"
         if v == VIOLATION:
             self.ledger.failed("RH-BS-8", what, [ev], self.s.case)
         elif v == INCONCLUSIVE:

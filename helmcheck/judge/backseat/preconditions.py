@@ -1,11 +1,16 @@
 """RH-BS-3: a backseat respects the preconditions it can know.
 
-Which commands: those the transition table refuses in ``S`` but accepts while a mission runs
-(:data:`~helmcheck.judge.facts.NEEDS_RUNNING`: ``$OMS``, ``$OJW``, ``$OPK``, ``$OMW`` in every
-form — and ``$OLOGD``) and those it accepts in ``S`` but refuses while one runs
-(:data:`~helmcheck.judge.facts.NEEDS_STOPPED`: ``$OLOGL``, ``$ORWSET`` — and ``$OMLOAD``,
-``$OMSTART``). The clause names six; the table shows these preconditions too, and a backseat
-can know them all from the same reports, so all are judged.
+Which commands: the ones the clause names, each with the state it names — "``$OLOGL`` and
+``$ORWSET`` only before starting a mission; ``$OMS``, ``$OJW``, ``$OPK``, ``$OMW`` only while the
+vehicle reports a running mission" (:data:`JUDGED_STOPPED`, :data:`JUDGED_RUNNING`; ``$OMW`` in
+every form). The transition table shows preconditions of other commands too (``$OLOGD`` needs a
+running mission, ``$OMLOAD`` and ``$OMSTART`` none: :data:`~helmcheck.judge.facts.NEEDS_RUNNING`,
+:data:`~helmcheck.judge.facts.NEEDS_STOPPED`), but whether the clause's list is exhaustive is a
+reading its words leave open: read as a list of examples it would fail a backseat for an
+``$OLOGD`` after the mission's end, read as the list it is it would not. A FAIL needs the
+profile's words, so both readings are accepted: only the commands the clause names are judged
+(docs/choices.md, "Backseat judging"). The vehicle still refuses the others (RH-ACK-4); that
+refusal is the vehicle's clause, not the backseat's.
 
 When: a command is judged against every state report
 (:class:`~.knowledge.StateReports`) that had fully arrived ``reaction_s`` (profile, default
@@ -25,12 +30,19 @@ fell silent, the run ended) it is not judged.
 
 from __future__ import annotations
 
-from ..facts import NEEDS_RUNNING, NEEDS_STOPPED
+from ..facts import COMMAND_ID_OF_EVENT, NEEDS_RUNNING, NEEDS_STOPPED
 from ..ledger import Ledger
 from .common import SentLine, Settings
 from .knowledge import Pending, StateReports
 
-__all__ = ["Preconditions"]
+__all__ = ["Preconditions", "JUDGED_RUNNING", "JUDGED_STOPPED", "LISTED"]
+
+#: The commands RH-BS-3 names, by the state it names for them (module docstring).
+LISTED = {"running": ("OMS", "OJW", "OPK", "OMW"), "stopped": ("OLOGL", "ORWSET")}
+#: Command events judged as needing a running mission: the clause's four, in every form.
+JUDGED_RUNNING = frozenset(e for e in NEEDS_RUNNING if COMMAND_ID_OF_EVENT[e] in LISTED["running"])
+#: Command events judged as needing no running mission ("only before starting a mission").
+JUDGED_STOPPED = frozenset(e for e in NEEDS_STOPPED if COMMAND_ID_OF_EVENT[e] in LISTED["stopped"])
 
 
 class Preconditions:
@@ -46,9 +58,9 @@ class Preconditions:
     def command(self, line: SentLine) -> None:
         """A decoded command from the backseat."""
         ev = line.event
-        if ev in NEEDS_RUNNING:
+        if ev in JUDGED_RUNNING:
             need, starter = True, "OMSTART"
-        elif ev in NEEDS_STOPPED:
+        elif ev in JUDGED_STOPPED:
             need, starter = False, "OMSTOP"
         else:
             return
@@ -74,25 +86,30 @@ class Preconditions:
 
     def _judge(self, line: SentLine, need: bool, case: str) -> None:
         t = line.t
-        against = self.reports.contradicts(t - self.s.reaction_s, t, need)
+        r = self.s.reaction_s
+        against = self.reports.contradicts(t - r, t, need)
         if against is None:
             return
         if not against:
-            self._ok(line, f"${line.sid} while the vehicle reported "
-                           f"{'a running mission' if need else 'no running mission'}", case)
+            self._ok(line, f"${line.sid} sent while the vehicle reported "
+                           f"{'a running mission' if need else 'no running mission'}, as the clause asks", case)
             return
+        known = self.reports.known(t - r)
+        ago = f"{t - known[0]:.2f} s" if known is not None else f"at least {r:g} s"
         if need:
-            why = (f"${line.sid} sent while the vehicle reported no running mission (known for at "
-                   f"least {self.s.reaction_s:g} s)")
+            why = (f"${line.sid} sent {ago} after the vehicle's report of no running mission had reached the "
+                   f"backseat (it is given {r:g} s to act on a report); RH-BS-3 allows ${line.sid} only while the "
+                   f"vehicle reports a running mission")
         else:
-            why = (f"${line.sid} sent while the vehicle reported a running mission (only before a "
-                   f"start; known for at least {self.s.reaction_s:g} s)")
-        broken = self.reports.uncertain(t - self.s.reaction_s, t)
+            why = (f"${line.sid} sent {ago} after the vehicle's report of a running mission had reached the "
+                   f"backseat (it is given {r:g} s to act on a report); RH-BS-3 allows ${line.sid} only before "
+                   f"a mission starts")
+        broken = self.reports.uncertain(t - r, t)
         if broken is not None:  # a faulty line's, maybe: never a FAIL on it (docs/contracts.md)
-            self.ledger.inconclusive("RH-BS-3", f"{why}; but a vehicle line the line broke reached the backseat at "
-                                                f"{broken:.2f} s, after the last whole report of that state: the "
-                                                f"backseat may have read a change in it (a faulty line's, maybe)",
-                                     [line.evidence()], case)
+            who = ("the vehicle sent a broken line" if self.s.clean else "a vehicle line the line broke")
+            self.ledger.inconclusive("RH-BS-3", f"{why}; but {who} that reached the backseat at {broken:.2f} s, after "
+                                                f"the last whole report of that state: the backseat may have read a "
+                                                f"change in it", [line.evidence()], case)
             return
         self.ledger.failed("RH-BS-3", why, [line.evidence()], case)
 

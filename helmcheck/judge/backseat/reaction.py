@@ -113,21 +113,22 @@ class Reaction:
             return  # sent before the backseat could know: the one excused copy
         ser.judged += 1
         v = spacing(measured, RESEND_SPACING_S - JITTER_S, r)
-        what = (f"${line.sid} sent again {measured:.3f} s after its previous sending, once the "
-                f"vehicle had rejected it (at most once per second)")
+        what = (f"${line.sid} sent again {measured:.3f} s after its previous sending, once the vehicle had "
+                f"refused it")
         if v == VIOLATION and not in_flight:
-            self.ledger.failed("RH-BS-5", what, [line.evidence()], self.s.case)
+            self.ledger.failed("RH-BS-5", f"{what}: RH-BS-5 allows a refused command again at most once a "
+                                          f"second", [line.evidence()], self.s.case)
         elif v != PASS:
-            why = ("it may have been sent before the rejection could be known" if v == VIOLATION
+            why = ("it may have been sent before the refusal could be known" if v == VIOLATION
                    else "the timestamp step cannot tell")
-            self.ledger.inconclusive("RH-BS-5", f"{what}; {why}", [line.evidence()], self.s.case)
+            self.ledger.inconclusive("RH-BS-5", f"{what} (at most once a second); {why}", [line.evidence()],
+                                     self.s.case)
         else:
-            self._met(self.s.case, line, f"${line.sid} sent again {measured:.3f} s after its previous "
-                                         f"sending, once the vehicle had rejected it")
+            self._met(self.s.case, line, f"{what}: at most once a second, as the clause asks")
 
     def _end(self, ser: _Series) -> None:
         if not ser.judged:
-            self._met(ser.case, None, "a rejected command was not resent once the rejection was known")
+            self._met(ser.case, None, "a refused command was not sent again once the refusal was known")
 
     # ------------------------------------------------------------------ lockout
     def _lockout_rule(self, line: SentLine) -> None:
@@ -141,8 +142,11 @@ class Reaction:
             ep.osd += 1
             return
         ep.offences += 1
-        self.ledger.failed("RH-BS-5", f"${sid} sent during the safety lockout ({ep.code}; only $OSD "
-                                      f"is allowed)", [line.evidence()], self.s.case)
+        into = line.t - (ep.known - self.s.reaction_s)
+        self.ledger.failed("RH-BS-5", f"${sid} sent {into:.2f} s after the first sign of the {ep.code} lockout "
+                                      f"had reached the backseat (it is given {self.s.reaction_s:g} s to act on "
+                                      f"it): RH-BS-5 allows nothing but $OSD during a lockout",
+                           [line.evidence()], self.s.case)
 
     def episode_over(self, ep: Optional[Episode]) -> None:
         """An episode ended (or the run did): one observation if the backseat knew of it."""
@@ -150,7 +154,8 @@ class Reaction:
             return
         if ep.end is not None and ep.end <= ep.known:
             return  # over before the backseat could know
-        self._met(ep.case, None, f"only $OSD during the lockout ({ep.code}, {ep.osd} poll(s))")
+        span = f" in the {ep.end - ep.known:.1f} s it knew of it" if ep.end is not None else ""
+        self._met(ep.case, None, f"nothing but $OSD ({ep.osd} poll(s)) during the {ep.code} lockout{span}")
 
     def forget(self) -> None:
         """After a gap in the record (``run resumed``): the rejections the backseat knew of may

@@ -43,10 +43,17 @@ class ServoRefresh:
         self._deadline: Optional[float] = None  #: servo held until (wall), None: not held
         self._tol = 0.0
         self._timeout_wall = 0.0
-        #: refreshes sent in time, awaiting their ACK: (first byte, deadline, tolerance, timeout)
-        self._inflight: deque[tuple[float, float, float, float]] = deque()
+        self._timeout_v = 0.0  #: the timeout the holding $OMS chose, vehicle seconds
+        #: refreshes sent in time, awaiting their ACK: (first byte, deadline, tolerance, wall timeout,
+        #: the timeout it chose)
+        self._inflight: deque[tuple[float, float, float, float, float]] = deque()
         self._ended = float("-inf")  #: when servo control last stopped being held
         self.accepted = 0
+        #: the first and the latest accepted ``$OMS`` that held servo control: (its ACK's time, the
+        #: timeout it chose in wall seconds, the tolerance) — the backseat's own cycle, for a tester
+        #: that waits to see it twice
+        self.first_accept: Optional[tuple[float, float, float]] = None
+        self.last_accept: Optional[tuple[float, float, float]] = None
         self._passed = False
 
     def _window(self, start: float, timeout: int) -> tuple[float, float, float]:
@@ -78,21 +85,27 @@ class ServoRefresh:
             self._drop()  # a fresh start after a lapse the backseat chose; its ACK holds it anew
             return
         v = gap(t, self._deadline + self._tol, self.s.resolution)
-        what = f"$OMS refresh {late:+.3f} s from the previous timeout's end"
+        k = self.s.time_scale
+        chose = f"its {self._timeout_v:g} s timeout" + (f" ({self._timeout_wall:.2f} s at ×{k:g})" if k != 1 else "")
+        what = (f"refreshed {-late:.2f} s before {chose} ran out" if late <= 0
+                else f"refreshed {late:.2f} s after {chose} ran out")
         if v == VIOLATION:
-            self.ledger.failed("RH-BS-6", what + f" (tolerance {self._tol:.3f} s): servo control had lapsed",
-                               [line.evidence()], self.s.case)
+            self.ledger.failed("RH-BS-6", what + f", beyond RH-TIM-1's tolerance of {self._tol:.2f} s: servo control "
+                                                 f"had lapsed", [line.evidence()], self.s.case)
             self._drop()  # lapsed; this $OMS's own ACK holds servo control afresh
             return
         if v == INCONCLUSIVE:
-            self.ledger.inconclusive("RH-BS-6", what + "; the timestamp step cannot tell",
+            self.ledger.inconclusive("RH-BS-6", what + "; the timestamp step cannot tell whether within "
+                                                       f"RH-TIM-1's tolerance of {self._tol:.2f} s",
                                      [line.evidence()], self.s.case)
         elif self._passed:
             self.ledger.passed("RH-BS-6", case=self.s.case)
         else:
             self._passed = True
-            self.ledger.passed("RH-BS-6", what + " (in time)", [line.evidence()], self.s.case)
-        self._inflight.append((t, *self._window(t, line.command.timeout)))
+            self.ledger.passed("RH-BS-6", what + ("" if late <= 0 else f", within RH-TIM-1's tolerance of "
+                                                                        f"{self._tol:.2f} s"),
+                               [line.evidence()], self.s.case)
+        self._inflight.append((t, *self._window(t, line.command.timeout), float(line.command.timeout)))
         self._extend()
 
     def answered(self, line: SentLine, accepted: bool, t_ack: float) -> None:
@@ -104,12 +117,16 @@ class ServoRefresh:
         if line.t < self._ended:
             return  # sent before servo control stopped being held
         d, tol, wall = self._window(t_ack, line.command.timeout)
+        self.last_accept = (t_ack, wall, tol)
+        if self.first_accept is None:
+            self.first_accept = self.last_accept
         while self._inflight and self._inflight[0][0] <= line.t:
             self._inflight.popleft()
         self._deadline, self._tol, self._timeout_wall = d, tol, wall
+        self._timeout_v = float(line.command.timeout)
         self._extend()
 
     def _extend(self) -> None:
-        for _, d, tol, wall in self._inflight:
+        for _, d, tol, wall, chose in self._inflight:
             if d + tol > self._deadline + self._tol:
-                self._deadline, self._tol, self._timeout_wall = d, tol, wall
+                self._deadline, self._tol, self._timeout_wall, self._timeout_v = d, tol, wall, chose

@@ -33,6 +33,7 @@ from typing import Optional
 
 from ...grammar import sentences as s
 from ...grammar.wirelog import escape
+from ...model.readings import BY_KEY as _READINGS
 from ...model.timers import tolerance
 from ..ledger import Evidence
 from ..spoil import REPEAT
@@ -50,6 +51,12 @@ OWN_REASON = {"RH-INT-3": "after the control that interrupted an $OPK park ended
               "RH-OMW-5": "after the control that interrupted the $OMW queue ended, the mission resumed, "
                           "not the queue",
               "RH-SAF-2": "the commands refused during the lockout had no effect after it"}
+
+
+def reading_clause(taken: str) -> str:
+    """The clause of a reading taken (``key = value``)."""
+    r = _READINGS.get(taken.split(" = ")[0])
+    return r.clause if r is not None else "a reading"
 
 
 class Answers:
@@ -254,6 +261,9 @@ class Answers:
         note = self.faults.held_between(p.t, p.t + dt)
         if note is not None:
             return f"the line held it (the relay's note: {note})"
+        if self.faults.clean:
+            return (f"an $ACK {dt:.2f} s after its command: the link is clean, but an implementation on a pty "
+                    f"or local TCP shares this host's CPU, whose stall may have held it")
         if self.faults.instrumented:
             return None
         return f"an $ACK {dt:.2f} s after its command: a stall of the line (or of the host) may have held it"
@@ -317,7 +327,7 @@ class Answers:
             self.event(p.t, "command", text_of(p)[:60])
             if res.before[0] in ("A", "M", "mP", "W") and res.row is not None and res.row.target != "=":
                 self.interrupt_pairs.add((res.before[0], p.kind.item.ID))
-        cands = command_clauses(p.kind.item, want, res.row, res.before[0])
+        cands = command_clauses(p.kind.item, want, res.row, res.before[0], res.before[1])
         if p.kind.variant and a.status == 1 and (want is None or want.status == 0):
             # refused where a conforming vehicle accepts: the form it must still read (RH-FRM-2/3/6/7)
             # first; a wrong answer to a line it did read is about the command, not the form
@@ -372,6 +382,15 @@ class Answers:
         if res.adopted:
             for cid in cands[:1]:
                 self.ledger.remark(cid, f"explained by an unseen event: {res.adopted[-1]}.")
+        if res.reading:
+            p.reading = res.reading
+            for taken in res.reading:  # named in the clause's reason at the end (observer.close)
+                r = _READINGS.get(taken.split(" = ")[0])
+                cid = r.books if r is not None and r.books else (cands[0] if cands else "")
+                self.readings_shown.setdefault(taken.split(" = ")[0], (taken, cid, p.ev))
+                if cid:
+                    self.ledger.passed(cid, lambda: f"{text_of(p)} answered {brief([a])} as a conforming vehicle "
+                                                    f"taking the reading {taken} does", ev, self.case)
         row = res.row
         if a.status:
             self.passed(passable(cands), lambda: f"{text_of(p)} refused with $ACK,{a.type},1,{a.err} as a conforming "
@@ -451,9 +470,12 @@ class Answers:
                 self.book("inconclusive", cands, f"{msg} — not judged: the observer lost track of the "
                                                  f"vehicle's state before ({res.desync})", ev, at=p)
             else:
-                self.book("fail", cands, msg, ev, at=p)
+                self.book("fail", cands, msg, ev, at=p, stated=res.diagnosis)
             self.checks.after_osi(osi, p, t, ev, judged=False)
             return
+        m = self.beliefs.primary.model
+        if osi.mode == "P" and m.mode == "P" and osi.next_waypoint == m.mission_wp + 1:  # park_waypoint = next
+            self.readings_shown.setdefault("park_waypoint", ("park_waypoint = next", "RH-OUT-4", evd))
         self.ledger.passed("RH-OUT-4", lambda: f"mode {osi.mode}, waypoint {osi.next_waypoint}, P{osi.park_time}, "
                                        f"error {osi.error_state} as a conforming vehicle reports", ev, self.case)
         if res.adopted:

@@ -47,6 +47,7 @@ from typing import Optional
 
 from ...grammar import sentences as s
 from ...grammar.errors import SentenceError
+from ...model.readings import taken as taken_readings
 from ...model.timers import tolerance
 from ...model.transitions import INTERNAL_EVENTS, REMOTE_MODES, STAY, rows_for
 from ...model.vehicle import VehicleModel
@@ -83,6 +84,8 @@ class CommandResult:
     #: (command, row, ACK) of the accepted command before this one, with no report between, whose
     #: not being carried out explains this answer too (module docstring); () when none does
     ignored: tuple = ()
+    #: the readings of the profile's open questions the chosen state took to explain the answer
+    reading: tuple = ()
 
 
 @dataclass(slots=True)
@@ -95,6 +98,10 @@ class OsiResult:
     adopted: tuple = ()
     desync: str = ""
     causes: tuple = ()  #: clauses of what changed since the last confirmed report (for blame)
+    #: the clause whose rule the report itself shows broken, booked even inside another clause's case
+    #: (that case's subject named as related): a remote control back after a lockout that refused
+    #: commands is RH-SAF-2's ("no effect even after the lockout ends"), not the lockout's own
+    diagnosis: tuple = ()
     own: set = field(default_factory=set)  #: clauses this report passes by their own evidence
     #: after a :attr:`CommandResult.ignored` answer: whether the state of a vehicle that did not
     #: carry out the command before it explains this report (None: no such question)
@@ -161,9 +168,12 @@ class Beliefs:
         match = [o for o in options if reply_keys(o[1]) == got]
         if match:
             base = len(self.cands[0].story)
+            took = len(self.cands[0].took)
             self._keep([o[0] for o in match])
             chosen = match[0]
             result = CommandResult(chosen[1], True, chosen[2], chosen[3], chosen[0].story[base:], False, desync)
+            sid = getattr(item, "ID", None) or getattr(item, "sentence_id", None) or ""
+            result.reading = chosen[0].took[took:] or taken_readings(sid, chosen[0].model.readings)
         else:
             explanations = []  # each candidate's own (they may differ in what no report shows yet)
             for c in self.cands:
@@ -425,6 +435,8 @@ class Beliefs:
                 # a command refused in the lockout, and the lockout over (or ending within the
                 # tolerance before this report): what changed may be that command, carried out
                 causes.insert(0, "RH-SAF-2")
+                if osi.mode in _REMOTE and osi.mode != p.model.mode:
+                    result.diagnosis = ("RH-SAF-2",)
             if osi.mode == p.model.mode:  # the mode is right: a countdown is what differs
                 causes += {"mP": ["RH-PK-2"], "W": ["RH-OMW-4"]}.get(osi.mode, [])
             if (p.resumed and osi.mode == p.model.mode == "P"

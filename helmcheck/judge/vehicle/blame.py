@@ -11,7 +11,9 @@ Every finding names an ordered tuple of *candidate* clauses, the most specific f
   names that clause for each field whose form or range a vehicle clause sets, also where a reading
   spells the range out (``RH-RD-6``: the rh5 ``$OMSTART`` flags are RH-MSN-2's, its names follow
   RH-MSN-1's path rules); a field count, or a field whose range only a reading sets
-  (``RH-RD-9``: ``$OPOS`` speed, ``$ODVL`` x/y, the ``$OMW`` fields), is RH-ACK-3's. Readings (``RH-RD-*``) are never booked: they say how a clause
+  (``RH-RD-9``: ``$OPOS`` speed, ``$ODVL`` x/y, the ``$OMW`` fields), is RH-ACK-3's — but a count a
+  clause states itself (``$OLOGL``'s 1–12 labels, ``$OLOGD``'s 12 values: :data:`COUNT_CLAUSE`) is
+  that clause's. Readings (``RH-RD-*``) are never booked: they say how a clause
   is read, not what a vehicle must do;
 * an ``$OSI`` no conforming state explains — RH-OUT-4 and the clauses of what changed since the
   last confirmed report (a timer's row, an accepted command's row); RH-TIM-1/2 follow when a
@@ -68,7 +70,8 @@ from ...grammar import sentences as s
 from ...grammar.errors import SentenceError
 from ...model.transitions import COMMAND_EVENTS, MODES, PHASES, TABLE
 
-__all__ = ["command_clauses", "looked_up", "targets", "vehicle_clause", "OWN_EVIDENCE", "FIELD_CLAUSE", "passable",
+__all__ = ["command_clauses", "looked_up", "targets", "vehicle_clause", "OWN_EVIDENCE", "FIELD_CLAUSE", "COUNT_CLAUSE", "CHECK_CLAUSE",
+           "passable",
            "stated_by", "phase_exceptions", "FORMS"]
 
 #: clause → the observation that passes it (instead of a row's confirmation).
@@ -109,6 +112,18 @@ FIELD_CLAUSE = {
     ("OMSTART", "name"): "RH-MSN-1", ("OMSTART", "srp"): "RH-MSN-1",
 }
 
+#: Command event → the clause that states the check a conforming vehicle refuses it by in a state
+#: its row accepts it in: ``$OJW`` n in [0, waypoints−1] (RH-JW-1, also under remote control,
+#: whose row is RH-JW-2's), the ``$OPK`` 10 miles (RH-PK-1, also in ``mP``, whose row is RH-PK-2's),
+#: ``$OLOGD``'s values against the labels (RH-LOG-2).
+CHECK_CLAUSE = {"OJW": "RH-JW-1", "OPK": "RH-PK-1", "OLOGD": "RH-LOG-2"}
+
+#: Sentence ID → the vehicle clause that states how many fields it takes, where one does beyond
+#: RH-ACK-3's "the wrong number of fields": ``$OLOGL`` 1–12 labels, none empty (RH-LOG-1, RH-RD-9),
+#: ``$OLOGD`` at most 12 values (RH-LOG-2's ``<d1>…<d12>``). A count the grammar refuses there breaks
+#: that clause (the traceability table, ``helmcheck/spec/rules.toml``), RH-ACK-3 related.
+COUNT_CLAUSE = {"OLOGL": "RH-LOG-1", "OLOGD": "RH-LOG-2"}
+
 _KNOWN = None
 
 
@@ -139,18 +154,25 @@ def _dedupe(xs: tuple[str, ...]) -> tuple[str, ...]:
     return tuple(dict.fromkeys(x for x in xs if vehicle_clause(x)))
 
 
-def command_clauses(item, expected_ack: Optional[s.ACK], row, before_mode: str = "") -> tuple[str, ...]:
+def command_clauses(item, expected_ack: Optional[s.ACK], row, before_mode: str = "",
+                    before_phase: str = "") -> tuple[str, ...]:
     """The clauses an answered command speaks to, most specific first (module docstring).
     ``before_mode``: the mode the command met; a command a conforming vehicle accepts there that
     takes over from another remote control speaks first to RH-INT-1 (any remote command interrupts
-    any other), whatever else its row names."""
+    any other), whatever else its row names. ``before_phase``: the safety phase it met (a refusal
+    owed in the ascent after the lockout is RH-SAF-3's, not the lockout's)."""
     if isinstance(item, SentenceError):
         if expected_ack is not None and expected_ack.err == 26:
-            return ("RH-SAF-1",) if row is None else _dedupe(row.clauses)
+            if row is None:
+                return ("RH-SAF-3",) if before_phase == "ascent" else ("RH-SAF-1",)
+            return _dedupe(row.clauses)
         first = "RH-OSD-2" if item.sentence_id == "OSD" else item.clause
         if (first == "RH-ACK-3" or first.startswith("RH-RD-")) and item.field:
             # a field's form or range (set by a clause, or by a reading of one): the clause that sets it
             first = FIELD_CLAUSE.get((item.sentence_id, item.field), first)
+        elif first == "RH-ACK-3" and not item.field:
+            # a count a clause states (1–12 labels, at most 12 values): that clause's (COUNT_CLAUSE)
+            first = COUNT_CLAUSE.get(item.sentence_id, first)
         return _dedupe((first, "RH-ACK-3")) or ("RH-ACK-3",)
     if row is None:
         return ("RH-ACK-1",)
@@ -160,8 +182,9 @@ def command_clauses(item, expected_ack: Optional[s.ACK], row, before_mode: str =
         out = ("RH-INT-1",) + tuple(c for c in out if c != "RH-INT-1")
     if expected_ack is not None and expected_ack.status == 1 and row.error is None:
         # accepted by the table, refused by a data check (index, count, file, distance): the
-        # row's own clause (RH-JW-1, RH-LOG-2, RH-MSN-1/2, RH-PK-1) says what was checked
-        out = out[:1]
+        # clause that states the check (CHECK_CLAUSE), else the row's own (RH-MSN-1/2)
+        own = CHECK_CLAUSE.get(row.event)
+        out = (own,) if own else out[:1]
     return out or ("RH-ACK-1",)
 
 

@@ -6,13 +6,16 @@ ran: from its checkpoint, the state before it); an accepted ``$OPK`` also with i
 waiting for on station (RH-PK-2: where the vehicle is at the ACK, no report settles); before a
 command that freezes the mission (RH-INT-1) — or a violation raised with ``$OXFLT``, which freezes
 it too (RH-RD-11) — a candidate in ``N`` also with the next waypoint reached unseen just before it,
-where it can have got there (:func:`~.closure.reachable`).
+where it can have got there (:func:`~.closure.reachable`); and under every other reading of the
+profile's open questions the command meets (:mod:`helmcheck.model.readings`), where the answer
+differs: a vehicle may take any of them.
 """
 
 from __future__ import annotations
 
 from ...grammar import sentences as s
 from ...grammar.errors import SentenceError
+from ...model.readings import alternatives
 from ...model.timers import tolerance
 from ...model.vehicle import VehicleModel
 from ..facts import INTERRUPTS
@@ -81,7 +84,30 @@ def branches(c: Candidate, item, v: float, slack_v: float, catalog) -> list:
             before = (t.model.mode, t.model.phase)
             row = t.model.row_for(item)
             out.append((t, t.model.receive(item, v), row, before))
+    if out:
+        out += _readings(c, item, v, out)
     return out + late  # the nominal answer first: it is what a finding names
+
+
+def _readings(c: Candidate, item, v: float, out: list) -> list:
+    """The answers under every other reading of the profile's open questions that this command
+    meets (:func:`helmcheck.model.readings.alternatives`), where they differ from the others."""
+    sid = getattr(item, "ID", None) or getattr(item, "sentence_id", None)
+    if sid is None:
+        return []
+    first = out[0][0].model
+    got = []
+    for key, value in alternatives(sid, first.phase, c.model.readings):
+        t = c.clone()
+        t.model.readings = {**t.model.readings, key: value}
+        t.model.advance(v)
+        before = (t.model.mode, t.model.phase)
+        row = None if isinstance(item, SentenceError) else t.model.row_for(item)
+        replies = t.model.receive(item, v)
+        if all(replies != o[1] for o in out + got):
+            t.took = t.took + (f"{key} = {value}",)
+            got.append((t, replies, row, before))
+    return got
 
 
 def _wp():

@@ -5,7 +5,8 @@ A :class:`Candidate` wraps a :class:`~helmcheck.model.vehicle.VehicleModel` (wit
 never their values) and keeps, besides the model, what judging needs and the model does not:
 
 * ``events`` / ``story`` — the unseen plant events adopted to explain the wire (fewer is more
-  plausible) and what they were;
+  plausible) and what they were; ``took`` — the readings of the profile's open questions taken to
+  explain an answer (:mod:`helmcheck.model.readings`: the model under them is the candidate's);
 * ``extra_v`` — vehicle seconds of uncertainty an adopted event's time window adds to every
   timer it started (RH-TIM-1: the observer widens by what it cannot see); it lapses when no timer
   started inside the window is left — nor one that did and was frozen and resumed since (a mission
@@ -61,7 +62,7 @@ from typing import Optional
 
 from ...model.observe import Finding, quick_check
 from ...model.timers import tolerance
-from ...model.transitions import REMOTE_MODES, STAY, Row
+from ...model.transitions import COMMAND_EVENTS, REMOTE_MODES, STAY, Row
 from ...model.vehicle import VehicleModel
 
 __all__ = ["Candidate", "Timed", "sig"]
@@ -107,7 +108,7 @@ def sig(m: VehicleModel) -> tuple:
 class Candidate:
     """See the module docstring."""
 
-    __slots__ = ("model", "events", "story", "extra_v", "window", "pending", "timed", "abandoned",
+    __slots__ = ("model", "events", "story", "took", "extra_v", "window", "pending", "timed", "abandoned",
                  "s_cause", "refused_locked", "seen_v", "seen_mode", "seen_at", "locked_v", "code_unknown",
                  "refresh", "nav_seen", "fix_seen", "left_v", "release", "resumed", "left_known", "noted",
                  "_mode", "_phase", "carried")
@@ -119,6 +120,9 @@ class Candidate:
         self.model = model
         self.events = 0
         self.story: tuple[str, ...] = ()
+        #: readings of the profile's open questions this state took to explain an answer (not
+        #: unseen events: a reading is a conforming vehicle's own choice, :mod:`helmcheck.model.readings`)
+        self.took: tuple[str, ...] = ()
         self.extra_v = 0.0
         self.window: Optional[tuple[float, float]] = None
         #: timers started inside ``window`` (their remaining time carries its uncertainty when
@@ -157,6 +161,7 @@ class Candidate:
         # (RH-TIM-1's slow shadow): a copy answering a command is the same vehicle, not a new one
         c.model._base = self.model.checkpoint
         c.events, c.story, c.extra_v, c.window = self.events, self.story, self.extra_v, self.window
+        c.took = self.took
         c.carried = self.carried
         c.pending = list(self.pending)
         c.timed = [Timed(**vars(t)) for t in self.timed] if self.timed else []
@@ -202,6 +207,14 @@ class Candidate:
                     self._mode = row.target
                 if row.phase_to is not None:
                     self._phase = row.phase_to
+            if (row.error is None and not st.timer and self.timed
+                    and ((row.target != STAY and row.event in COMMAND_EVENTS) or self._mode in
+                         {tt.pre_mode for tt in self.timed})):
+                # a command took control again after a timer ran out, or the state went back to
+                # the timer's before-state, before any report showed the timer's end: no report can
+                # tell any more when (or whether) it ended there, so it is not judged (a $OMS with
+                # the range's lowest timeout restarted at once, V-65: RH-RD-3 either way)
+                self.timed = [tt for tt in self.timed if tt.timer == "lockout"]
             if st.timer:
                 fired.append(st)
                 t_old = None
@@ -353,4 +366,5 @@ class Candidate:
         timers = tuple(sorted((n, round(t.deadline(n) or 0.0, 3)) for n in t.names()))
         return (m.mode, m.phase, m.mission_wp, m.mission_mode, m.error_state, m.srp_active,
                 len(m.queue), m.queue_parking, timers, m.mission.name if m.mission else "",
-                m.park_left, m.opk_seconds if m.opk else None, self.code_unknown)
+                m.park_left, m.opk_seconds if m.opk else None, self.code_unknown,
+                tuple(sorted(m.readings.items())))

@@ -36,7 +36,8 @@ end concludes what it held), ``not tested``/``inconclusive`` (tester facts), ``l
 for before them and still on its way, which shows the state before them; a mission waypoint
 reached whose park or end the observer has not learnt is left to the reports, from the note's
 moment on),
-``line fault …`` and ``relay started:`` (a line-fault relay's record).
+``line fault …`` and ``relay started:`` (a line-fault relay's record), ``line model:`` (a clean
+link: nothing is held, every error is the vehicle's at once, :mod:`helmcheck.judge.linemodel`).
 
 A driver reads, besides the ledger: :attr:`sent` (every classified backseat line, with its
 outcome — the handle a live driver waits on), :attr:`last_osi`, :meth:`deadline` and
@@ -56,20 +57,24 @@ from ...model import plant as P
 from ...profile import Profile
 from ..ledger import Evidence, Ledger, Reason
 from ..linefaults import LineFaults
+from ..linemodel import UNKNOWN
 from ..spoil import REPEAT, explain, explain_discard, signature
 from ..streaks import OTHER_REPEAT, Streaks
 from ..timing import JITTER_S
 from ..wire import FROM_VEHICLE, LINE_CACHE, NOTE, TO_VEHICLE, Decodings, WireEvent, parse_note
 from . import osichecks
 from .belief import Beliefs
-from .answers import Answers
-from .blame import command_clauses, targets
+from .answers import Answers, reading_clause
+from .blame import command_clauses, targets, vehicle_clause
 from .catalog import GivenMissions, KnownMissions
 from .deadlines import Deadlines
 from .lines import PREFIX_REPEAT, Kind, OutputJudge, classify
 from .sent import Sent, class_of_id, text_of
 
 __all__ = ["VehicleObserver", "Sent"]
+
+#: Never named as the related clause of a finding: the generic report check and time.
+_NOT_RELATED = frozenset({"RH-OUT-4", "RH-TIM-1", "RH-TIM-2"})
 
 _PLANT = {"WaypointReached": P.WaypointReached, "OnStation": P.OnStation,
           "QueueWaypointReached": P.QueueWaypointReached, "AtSurface": P.AtSurface,
@@ -113,8 +118,12 @@ class VehicleObserver(Answers, Deadlines):
         #: observations a faulty line may have spoilt, held until made again (module docstring)
         self.streaks = Streaks(ledger)
         self.faults = LineFaults()  #: what a line-fault relay's notes say the line did
+        self.line_model = UNKNOWN  #: whether the link can damage bytes, as the record states it
         #: a command's bytes -> the latest sending of it answered in full, on time, nothing spoilt
         self.clean_sendings: dict = {}
+        #: key -> (``key = value``, the clause it was seen on, the first evidence) of every reading of the profile's open
+        #: questions the vehicle was seen to take (:mod:`helmcheck.model.readings`)
+        self.readings_shown: dict = {}
         self.late_until = 0.0  #: when the latest late $ACK came (what was sent before may share its stall)
         self._unit_fault: Optional[str] = None  #: the relay's note on the vehicle run being judged
         self._junk_wait: Optional[tuple] = None  #: bytes between lines, waiting for what follows them
@@ -177,7 +186,15 @@ class VehicleObserver(Answers, Deadlines):
         case, clauses = (at.case, at.case_clauses) if at is not None else (self.case, self.case_clauses)
         if case and verdict != "pass":
             reason = f"{case}: {reason}"
-        for cid in targets(candidates, clauses, stated):
+        booked = targets(candidates, clauses, stated)
+        if verdict == "fail":
+            # the other clauses the evidence fits, named beside the one whose rule it broke (the
+            # traceability table, helmcheck/spec/rules.toml)
+            related = [c for c in dict.fromkeys(candidates) if c not in booked and vehicle_clause(c)
+                       and c not in _NOT_RELATED]
+            if related:
+                reason = f"{reason} (related: {', '.join(related)})"
+        for cid in booked:
             if verdict == "fail":
                 if at is not None and at.holding:  # the line may have spoilt it: held (module docstring)
                     at.held.append((cid, reason, list(evidence), case))
@@ -296,6 +313,10 @@ class VehicleObserver(Answers, Deadlines):
             self.faults.note(ev.t, n.value)
         elif n.kind == "relay":
             self.faults.relay_started()
+        elif n.kind == "line-model":
+            self.line_model = n.value
+            if not n.value.can_damage:
+                self.faults.clean_link()
         elif n.kind == "case":
             self.case, self.case_clauses = n.case, n.clauses
         elif n.kind == "case-end":
@@ -615,6 +636,10 @@ class VehicleObserver(Answers, Deadlines):
         if self.closed:
             return
         self.closed = True
+        for taken, cid, _ev in self.readings_shown.values():
+            if cid:
+                self.ledger.remark(cid, f"the vehicle takes the reading {taken} ({reading_clause(taken)}; every "
+                                        f"reading is accepted: helmcheck profile readings).")
         t = self.t
         for fe in self.framers[TO_VEHICLE].close():
             self._backseat(fe, WireEvent(t, TO_VEHICLE, b"", "", 0))

@@ -141,6 +141,9 @@ class OsiChecks:
         self.o = obs
         self.oxflt: Optional[tuple[str, float]] = None
         self.ct: Optional[tuple[Decimal, Decimal]] = None
+        #: the vehicle's ``$OCTD`` was seen to show what an ``$OPOS`` applied (the readings table's
+        #: ``opos_ctd = reported``): from then on it is held to it
+        self.ct_reported = False
         self.pos: Optional[dict] = None
         self.known: dict[str, tuple[str, ...]] = {}
         self.watch: Optional[tuple] = None  #: (key, first v on station/at surface, clause, what)
@@ -245,12 +248,18 @@ class OsiChecks:
             except (InvalidOperation, TypeError):
                 ok = False
             if ok:
+                self.ct_reported = True
                 self.o.ledger.passed("RH-POS-2", "$OCTD shows the conductivity and temperature $OPOS gave",
                                      [p.ev, evd], p.case)
-            else:
+            elif self.ct_reported:  # it reports what it applies (it did before): held to it
                 self.o.book("fail", ("RH-POS-2",), f"$OCTD shows {sentence.conductivity} mS/cm, "
                                                    f"{sentence.temperature} °C; $OPOS gave {self.ct[0]}, "
-                                                   f"{self.ct[1]} (always applied)", [p.ev, evd], at=p)
+                                                   f"{self.ct[1]} (always applied; this vehicle's $OCTD "
+                                                   f"showed what an earlier $OPOS applied)", [p.ev, evd], at=p)
+            else:  # "applied" may be used without being reported: $OCTD may be its own sensor's
+                self.o.ledger.remark("RH-POS-2", "$OCTD does not show the conductivity and temperature $OPOS "
+                                                 "gave: the vehicle may apply them without reporting them "
+                                                 "(the reading opos_ctd = internal), so their use is not judged.")
 
     # ------------------------------------------------------------------ reports
     def after_osi(self, osi: s.OSI, p, t: float, ev: list, judged: bool, passes=frozenset()) -> None:

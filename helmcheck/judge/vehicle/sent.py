@@ -55,6 +55,9 @@ class Sent:
     held_item: object = None  #: the :class:`~helmcheck.judge.streaks.Held` its findings went to
     mark: int = 0  #: the streaks' order when it was sent
     late_text: str = ""  #: why its late ``$ACK`` may be the line's (a stall)
+    #: the readings of the profile's open questions its answer showed the vehicle takes
+    #: (:mod:`helmcheck.model.readings`; ``key = value``)
+    reading: tuple = ()
 
     @property
     def ident(self) -> tuple:
