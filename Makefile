@@ -50,7 +50,9 @@ fuzz: $(STAMP)
 explore-reach: $(STAMP)
 	HELMCHECK_REACH=1 $(PY) -m pytest -q tests/test_explore_reach.py
 
-# Not run by CI (about two hours on two cores: 75 minutes, the third vehicle's faults 45 more; the line-fault grid alone 6 minutes): the slow-line grid — every case on the reference and
+# Not run by CI (about two and a half hours on two cores: 75 minutes, the third vehicle's faults
+# certified whole 45 more, the exploration alone against them 40 more; the line-fault grid alone 6
+# minutes): the slow-line grid — every case on the reference and
 # every faulty vehicle over lines in virtual time (time scales 1-40, replies 3 ms-0.9 s, 9600-115200
 # baud, the timing freedoms at their bounds), and whole certifications on real ptys of the emulator
 # at each line-timing freedom's bound at x5, x20 and x40 and of the independent simulator behind a
@@ -66,9 +68,12 @@ explore-reach: $(STAMP)
 # vehicle (../shared/third-party/vehicle3) on its own default line (tests/test_vehicle3.py) and each
 # of its 36 single faults certified whole at x20 on the fast line, each FAILing its own clause (or the
 # clause the traceability table books its reading on), the three timing faults at the time scale
-# --precision nominal picks (tests/test_vehicle3_mutants.py, about 45 minutes more).
+# --precision nominal picks (tests/test_vehicle3_mutants.py, about 45 minutes more);
+# and the exploration alone against each of those 36 faults (tests/test_explore_vehicle3.py,
+# benchmarks/explore_reach.py --families vehicle3: about 40 minutes, its timing faults at the time
+# scale --precision nominal names).
 matrix: $(STAMP)
-	HELMCHECK_MATRIX=1 $(PY) -m pytest -n 2 tests/test_line_budget.py tests/test_slow_line.py tests/test_unplugged.py tests/test_bad_line.py tests/test_third_party_vehicle.py::test_its_own_missions_with_oxflt_certify tests/test_third_party_vehicle.py::test_a_violation_it_raises_by_itself_is_judged_like_any_other tests/test_third_party_vehicle.py::test_the_pytest_plugin_certifies_it tests/test_explore_replays.py tests/test_vehicle3.py tests/test_readings.py tests/test_certify_backseat_realtime.py tests/test_vehicle3_mutants.py
+	HELMCHECK_MATRIX=1 $(PY) -m pytest -n 2 tests/test_line_budget.py tests/test_slow_line.py tests/test_unplugged.py tests/test_bad_line.py tests/test_third_party_vehicle.py::test_its_own_missions_with_oxflt_certify tests/test_third_party_vehicle.py::test_a_violation_it_raises_by_itself_is_judged_like_any_other tests/test_third_party_vehicle.py::test_the_pytest_plugin_certifies_it tests/test_explore_replays.py tests/test_vehicle3.py tests/test_readings.py tests/test_certify_backseat_realtime.py tests/test_vehicle3_mutants.py tests/test_explore_vehicle3.py
 
 # Not run by CI (several minutes): every --help example, the slow ones and those that need a
 # vehicle too (run against the emulator on their port); make test runs the others.

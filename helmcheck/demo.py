@@ -30,7 +30,7 @@ from .certify.vehicle.runner import Options, certify
 from .emulator.process import EmulatorProcess
 from .profile import emulator_profile
 from .reports.identity import source_revision
-from .reports.scope import headline, precision_note, what_to_change
+from .reports.scope import exploration_note, headline, precision_note, what_to_change
 
 TIME_SCALE = 40.0
 BAUD = 115200
@@ -75,7 +75,8 @@ def main(argv: list[str] | None = None) -> int:
                                       f"--report-dir {out}"))
     finally:
         emu.stop()
-    notes = [x for x in (what_to_change(res.results), precision_note(res.results)) if x]
+    notes = [x for x in (what_to_change(res.results), precision_note(res.results), exploration_note(res.results))
+             if x]
     print(f"{headline(res.results)}. {res.reason}{''.join(' ' + x for x in notes)}")  # as certify vehicle says it
     print(f"report: {out / 'report.html'}")
     print(f"demo: also {out}/results.json, wire.log, profile.toml, junit.xml, report.md; "

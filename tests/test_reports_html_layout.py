@@ -58,12 +58,13 @@ def test_model_coverage_says_what_it_means_for_a_certificate(tmp_path):
     assert "model-coverage-note" in [a.get("id") for a in page.find("p", inside="coverage")]
     assert "not part of the verdict" in page.text_of("coverage") and "30 of 91" in page.text_of("coverage")
     beside = page.text_of("coverage-beside")  # on the first page, beside the digest
-    assert "model rows 30 of 91 (33.0 %)" in beside and note in beside
+    assert "30 of 91 transitions (33.0 %)" in beside and "22 of 32 error codes" in beside and note in beside
     assert "coverage-beside" in [a.get("id") for a in page.find("p", inside="certificate-page")]
     render_all(d, formats=("md",))
     md = (d / "report.md").read_text(encoding="utf-8")
     line = next(ln for ln in md.splitlines() if ln.startswith("Exploration's model coverage"))
-    assert "rows 30/91" in line and "not part of the verdict" in line and "certificate" in line
+    assert "30 of 91 transitions, 22 of 32 error codes" in line and "not part of the verdict" in line
+    assert "certificate" in line
 
 
 def test_model_coverage_beside_a_partial_run_claims_no_certificate(tmp_path):

@@ -273,9 +273,10 @@ def run(args: argparse.Namespace) -> int:  # noqa: C901 - argument checks, then 
     finally:
         if link is not None:
             link.close()
-    from ..reports.scope import headline, precision_note, what_to_change
+    from ..reports.scope import exploration_note, headline, precision_note, what_to_change
     from .messages import report_line
-    notes = [x for x in (what_to_change(out.results), precision_note(out.results)) if x]
+    notes = [x for x in (what_to_change(out.results), precision_note(out.results), exploration_note(out.results))
+             if x]
     print(f"{headline(out.results)}. {out.reason}{''.join(' ' + x for x in notes)}")
     print(report_line(out.report_dir))
     if out.resume_command:  # the port did not come back: one line that goes on from the cut

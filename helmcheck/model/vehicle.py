@@ -165,6 +165,9 @@ class VehicleModel(VehicleStatus, StateEffects):
         self.checkpoints = True
         #: when a list, every table row applied is appended as a :class:`Step` (for observers)
         self.trace: Optional[list] = None
+        #: when a dict, how many times each table row was applied (row id -> count), copied into
+        #: clones and never drained: what a model has been through, for coverage counts
+        self.applied: Optional[dict] = None
         #: ``$OSD`` answers carry each data sentence's class name (``"OSI"``), not the sentence:
         #: for observers that judge which sentences come and in what order, not their values
         self.data_names = False
@@ -300,6 +303,8 @@ class VehicleModel(VehicleStatus, StateEffects):
         self.last_row = row
         if self.trace is not None:
             self.trace.append(Step(row, now))
+        if self.applied is not None:
+            self.applied[row.id] = self.applied.get(row.id, 0) + 1
         replies = _APPLY[event](self, row, item, now)
         if event != "OSD":
             self._base = None
@@ -394,6 +399,7 @@ class VehicleModel(VehicleStatus, StateEffects):
         new._pending = []
         new._base = None
         new.trace = [] if self.trace is not None else None
+        new.applied = dict(self.applied) if self.applied is not None else None
         return new
 
     def expectation(self, now: float, slack: float = 0.0):
@@ -446,6 +452,8 @@ class VehicleModel(VehicleStatus, StateEffects):
         if self.trace is not None:
             timer, duration = self._firing if self._firing is not None else ("", 0.0)
             self.trace.append(Step(row, now, timer, duration))
+        if self.applied is not None:
+            self.applied[row.id] = self.applied.get(row.id, 0) + 1
         _APPLY[event](self, row, None, now)
         return row
 
@@ -459,6 +467,8 @@ class VehicleModel(VehicleStatus, StateEffects):
         self.last_row = row
         if self.trace is not None:
             self.trace.append(Step(row, now))
+        if self.applied is not None:
+            self.applied[row.id] = self.applied.get(row.id, 0) + 1
         self._end_remote()
         self.error_state = code
         self.timers.arm("lockout", now, self.profile.lockout_s)

@@ -12,11 +12,10 @@ import re
 from typing import Mapping
 
 from ..judge.verdict import Verdict
-from .html_coverage import exploration_coverage
 from .html_markup import _e
 from .identity import backseat_name, identity_rows
 from .rundir import Run
-from .scope import failures, model_coverage_note, precision_note, scope_of
+from .scope import failures, model_coverage, model_coverage_note, precision_note, reach_text, scope_of
 
 _CLAUSE_ID = re.compile(r"RH-[A-Z]+-\d+[a-z]?")
 from .view import VERDICT_LABEL, counts
@@ -97,9 +96,11 @@ def _run_box(run: Run) -> str:
              "" if settings.get("time_scale") is None else f"time scale {settings['time_scale']:g}",
              "" if r["seed"] is None else f"seed {r['seed']}",
              "" if not (r.get("profile") or {}).get("name") else f"profile {r['profile']['name']}"]
-    cov = exploration_coverage(run).get("rows")
-    note = (f'<p class="note" id="coverage-beside">Exploration: model rows {_e(cov.get("covered"))} of '
-            f'{_e(cov.get("of"))} ({_e(cov.get("percent"))} %). {_e(model_coverage_note(r))}</p>' if cov else "")
+    mc = model_coverage(r)
+    cov = mc.get("rows")
+    note = (f'<p class="note" id="coverage-beside">Exploration: {_e(cov.get("covered"))} of {_e(cov.get("of"))} '
+            f'transitions ({_e(cov.get("percent"))} %); {_e(reach_text({k: v for k, v in mc.items() if k != "rows"}))}. '
+            f'{_e(model_coverage_note(r))}</p>' if cov else "")
     return (f'<div class="when"><h2>Run</h2><p id="run-summary">{_e(" · ".join(f for f in facts if f))}</p>'
             f"{note}</div>")
 

@@ -13,7 +13,7 @@ from typing import Any, Mapping
 
 from .html_markup import _e
 from .rundir import Run
-from .scope import edge_coverage, edge_gist, model_coverage_note
+from .scope import MODEL_DIMENSIONS, edge_coverage, edge_gist, model_coverage, model_coverage_note
 from .timeline import MODE_ORDER, event_counts
 
 _REMOTE_MODES = ("A", "M", "mP", "W")
@@ -80,10 +80,7 @@ def natural_key(text: object) -> tuple:
 
 def exploration_coverage(run: Run) -> dict[str, Mapping[str, Any]]:
     """``stats.explore.model_coverage`` of a vehicle run (empty when the run recorded none)."""
-    mc = ((run.results.get("stats") or {}).get("explore") or {}).get("model_coverage")
-    if not isinstance(mc, dict):
-        return {}
-    return {name: d for name, d in mc.items() if isinstance(d, dict)}
+    return model_coverage(run.results)
 
 
 def _exploration_coverage(run: Run) -> str:
@@ -96,12 +93,14 @@ def _exploration_coverage(run: Run) -> str:
         missing = sorted((str(x) for x in d.get("uncovered") or []), key=natural_key)
         more = (f'<details><summary>{len(missing)} uncovered</summary><ul class="uncovered">'
                 + "".join(f"<li><code>{_e(x)}</code></li>" for x in missing) + "</ul></details>") if missing else "—"
-        rows.append(f"<tr><td>{_e(name.replace('_', ' '))}</td><td>{_e(d.get('covered'))} of {_e(d.get('of'))}"
-                    f" ({_e(d.get('percent'))} %)</td><td>{more}</td></tr>")
+        both = d.get("with_cases")
+        rows.append(f"<tr><td>{_e(MODEL_DIMENSIONS.get(name, name.replace('_', ' ')))}</td><td>{_e(d.get('covered'))} "
+                    f"of {_e(d.get('of'))} ({_e(d.get('percent'))} %)</td>"
+                    f"<td>{_e(both) if isinstance(both, int) else '—'}</td><td>{more}</td></tr>")
     return ('<h3 id="exploration-coverage">What the exploration reached of the model</h3>'
             f'<p class="note" id="model-coverage-note">{_e(model_coverage_note(run.results))}</p>'
-            '<table class="exploration-coverage"><thead><tr><th>dimension</th><th>covered</th>'
-            f"<th>uncovered</th></tr></thead><tbody>{''.join(rows)}</tbody></table>")
+            '<table class="exploration-coverage"><thead><tr><th>dimension</th><th>reached</th>'
+            f"<th>with the cases</th><th>not reached</th></tr></thead><tbody>{''.join(rows)}</tbody></table>")
 
 
 def _coverage_gist(run: Run) -> str:
@@ -113,7 +112,7 @@ def _coverage_gist(run: Run) -> str:
              f"{len({tuple(p) for p in cov['interrupt_pairs']})} interrupt pairs"]
     rows = exploration_coverage(run).get("rows")
     if rows:
-        parts.append(f"exploration: model rows {rows.get('covered')} of {rows.get('of')} "
+        parts.append(f"exploration: {rows.get('covered')} of {rows.get('of')} transitions "
                      f"({rows.get('percent')} %), not part of the verdict")
     return _e(" · ".join(parts))
 

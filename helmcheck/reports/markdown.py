@@ -23,7 +23,8 @@ import re
 from .identity import backseat_name, identity_rows
 from .linecounters import counters_summary, line_model_summary
 from .rundir import Run
-from .scope import edge_gist, failures, headline, model_coverage_note, precision_note, scope_of
+from .scope import (MODEL_DIMENSIONS, edge_gist, failures, headline, model_coverage, model_coverage_note,
+                    precision_note, reach_text, scope_of)
 from .text import printable
 from .timeline import event_counts
 from .verdicts import describe_process
@@ -145,11 +146,15 @@ def render_markdown(run: Run, comparison_md: str | None = None) -> str:
     out.append("")
     if edge_gist(r):
         out += [md_escape(edge_gist(r)), ""]
-    mc = ((r.get("stats") or {}).get("explore") or {}).get("model_coverage")
-    if isinstance(mc, dict) and mc:
-        out.append("Exploration's model coverage: " + "; ".join(
-            f"{md_escape(k.replace('_', ' '))} {d.get('covered')}/{d.get('of')}" for k, d in mc.items()
-            if isinstance(d, dict)) + ". " + md_escape(model_coverage_note(r)))
+    mc = model_coverage(r)
+    if mc:
+        out.append("Exploration's model coverage: " + md_escape(reach_text(mc, with_cases=True)) + ". "
+                   + md_escape(model_coverage_note(r)))
+        missing = [f"{MODEL_DIMENSIONS.get(k, k)}: " + "; ".join(str(x) for x in d.get("uncovered") or [])
+                   for k, d in mc.items() if d.get("uncovered")]
+        if missing:
+            out += ["", "<details><summary>Not reached by the exploration</summary>", ""]
+            out += [f"- {md_escape(m)}" for m in missing] + ["", "</details>"]
         out.append("")
 
     rows = non_pass_rows(r)

@@ -7,6 +7,9 @@ by clauses exist, that the timeline runs forward, that the wire log path stays i
 results directory, and that the run verdict follows from the clause verdicts
 (:func:`helmcheck.reports.verdicts.run_verdict`). Unknown keys are allowed.
 
+The optional ``stats.explore.model_coverage`` (a vehicle run's exploration, :mod:`helmcheck.certify.vehicle.modelcover`)
+is checked when present: each dimension's counts, percent and texts (:func:`_check_model_coverage`).
+
 The optional ``process`` object describes an implementation under test that helmcheck started
 (``certify … --exec``): ``command``, ``pid``, ``exit_code`` (integer or null), ``signal`` (a
 signal name or null), ``ended_at_s``, ``ended_early`` (a boolean: it ended before the run's
@@ -212,6 +215,9 @@ def validate(results: Any) -> list[str]:
                 ck.err(f"replays[{i}].clause", f"{rep['clause']!r} has no entry in clauses")
     if "coverage" in results:
         _check_coverage(ck, r("coverage"))
+    if isinstance(r("stats"), dict) and isinstance(r("stats").get("explore"), dict) \
+            and "model_coverage" in r("stats")["explore"]:
+        _check_model_coverage(ck, r("stats")["explore"]["model_coverage"])
     if "timeline" in results:
         _check_timeline(ck, r("timeline"))
     if "events" in results:
@@ -441,6 +447,33 @@ def _check_coverage(ck: _Checker, cov: Any) -> None:
         elif ck.arr(f"coverage.{key}", value):
             for i, item in enumerate(value):
                 ck.str_list(f"coverage.{key}[{i}]", item, length)
+
+
+def _check_model_coverage(ck: _Checker, mc: Any) -> None:
+    """``stats.explore.model_coverage``: per dimension (``rows``, ``modes``, ``interrupt_pairs``,
+    ``timers``, ``boundaries``, ``error_codes``, and ``rules`` when the traceability table is
+    plugged in) ``covered`` ≤ ``of``, ``percent``, ``uncovered`` (what was not reached, as texts) and
+    optionally ``with_cases`` (the cases and the exploration together: between ``covered`` and ``of``)."""
+    base = "stats.explore.model_coverage"
+    if not ck.obj(base, mc):
+        return
+    for name, d in mc.items():
+        q = f"{base}.{name}"
+        if not ck.obj(q, d):
+            continue
+        ok = ck.typed(f"{q}.covered", d.get("covered"), (int,), "an integer") and \
+            ck.typed(f"{q}.of", d.get("of"), (int,), "an integer")
+        ck.number(f"{q}.percent", d.get("percent"))
+        ck.str_list(f"{q}.uncovered", d.get("uncovered"))
+        if not ok:
+            continue
+        covered, of = d["covered"], d["of"]
+        if not 0 <= covered <= of:
+            ck.err(f"{q}.covered", f"must be between 0 and of ({of}), got {covered}")
+        both = d.get("with_cases")
+        if both is not None and ck.typed(f"{q}.with_cases", both, (int,), "an integer") \
+                and not covered <= both <= of:
+            ck.err(f"{q}.with_cases", f"must be between covered ({covered}) and of ({of}), got {both}")
 
 
 def _check_timeline(ck: _Checker, timeline: Any) -> None:

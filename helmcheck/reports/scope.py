@@ -22,9 +22,11 @@ A verdict says how the judged clauses went; the scope says how much was judged. 
   too: a certificate of non-conformance.
 
 **Model coverage is not scope.** What a vehicle run's exploration reached of the reference model
-(``stats.explore.model_coverage``: rows, interrupt pairs, timer boundaries, error codes) measures
-the random search on top of the fixed cases; no verdict and no certificate depends on it. Every
-rendering that shows it says so beside it (:func:`model_coverage_note`). Nor are the range edges a
+(``stats.explore.model_coverage``: modes, transitions — the table's rows —, interrupt pairs,
+timers run out, timer boundaries, error codes, and the traceability table's rules once it is
+plugged in) measures the search on top of the fixed cases; no verdict and no certificate depends
+on it. Every rendering that shows it says so beside it (:func:`model_coverage_note`), and the
+verdict line states it in one sentence (:func:`exploration_note`). Nor are the range edges a
 vehicle run reached (``stats.edges``, :func:`edge_gist`): a bound whose edge was not reached is
 still judged by its clause wherever it was met.
 
@@ -45,7 +47,8 @@ from ..judge.verdict import Verdict
 from .view import VERDICT_LABEL, non_pass_rows
 
 __all__ = ["JUDGED", "Gap", "Scope", "claimed_clauses", "scope_of", "headline", "id_ranges", "model_coverage_note",
-           "edge_coverage", "edge_gist", "what_to_change", "precision_note", "failures"]
+           "edge_coverage", "edge_gist", "what_to_change", "precision_note", "failures", "MODEL_DIMENSIONS",
+           "reach_text", "exploration_note", "model_coverage"]
 
 JUDGED = (Verdict.PASS, Verdict.NON_STRICT, Verdict.FAIL)
 _GAPS_SHOWN = 4
@@ -236,6 +239,55 @@ def model_coverage_note(results: Mapping[str, Any]) -> str:
     return ("Model coverage is how much of the reference model the exploration's random sequences "
             "reached within their budget (the fixed test cases are not counted); it is not part of "
             f"the verdict, {rests}.")
+
+
+#: The dimensions of ``stats.explore.model_coverage`` in the order every rendering shows them, each
+#: with its name in a sentence.
+MODEL_DIMENSIONS = {"rows": "transitions", "modes": "modes", "interrupt_pairs": "interrupt pairs",
+                    "timers": "timers run out", "boundaries": "timer boundaries", "error_codes": "error codes",
+                    "rules": "rules"}
+
+
+def model_coverage(results: Mapping[str, Any]) -> dict[str, Mapping[str, Any]]:
+    """``stats.explore.model_coverage`` of a vehicle run, in :data:`MODEL_DIMENSIONS` order (empty
+    when the run recorded none)."""
+    mc = ((results.get("stats") or {}).get("explore") or {}).get("model_coverage")
+    if not isinstance(mc, Mapping):
+        return {}
+    order = list(MODEL_DIMENSIONS) + sorted(k for k in mc if k not in MODEL_DIMENSIONS)
+    return {k: mc[k] for k in order if isinstance(mc.get(k), Mapping)}
+
+
+def reach_text(summary: Mapping[str, Any], with_cases: bool = False) -> str:
+    """``41 of 91 transitions, 9 of 9 modes, …`` from a model coverage summary; ``with_cases``:
+    ``(44 with the cases)`` after each the cases add to."""
+    parts = []
+    for key, d in summary.items():
+        if not isinstance(d, Mapping):
+            continue
+        word = MODEL_DIMENSIONS.get(key, key.replace("_", " "))
+        more = d.get("with_cases")
+        extra = (f" ({more} with the cases)" if with_cases and isinstance(more, int) and more != d.get("covered")
+                 else "")
+        parts.append(f"{d.get('covered')} of {d.get('of')} {word}{extra}")
+    return ", ".join(parts)
+
+
+def exploration_note(results: Mapping[str, Any], shown: int = 3) -> str:
+    """The verdict line's sentence on the exploration's reach: ``The exploration reached 41 of 91
+    transitions, …; not reached: row 2: …, … (not part of the verdict).`` — the first ``shown``
+    transitions (or rules, once the traceability table is plugged in) it did not reach; ``""``
+    for a run without an exploration."""
+    mc = model_coverage(results)
+    if not mc:
+        return ""
+    key = "rules" if "rules" in mc else "rows"
+    missing = [str(x) for x in mc.get(key, {}).get("uncovered") or []]
+    what = MODEL_DIMENSIONS[key]
+    rest = (f"; {what} not reached: {'; '.join(missing[:shown])}" + (f" and {len(missing) - shown} more"
+                                                                       if len(missing) > shown else "")
+            if missing else "")
+    return f"The exploration reached {reach_text(mc)}{rest} (not part of the verdict)."
 
 
 def edge_coverage(results: Mapping[str, Any]) -> Mapping[str, Any]:

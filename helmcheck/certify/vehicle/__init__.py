@@ -24,7 +24,10 @@ entry point is :func:`.runner.certify`. Modules, one concern each:
   episodes), shrunk on failure, within a budget
   in wall and vehicle seconds; :mod:`.generate` — what they draw (every claimed command at its
   range edges and error codes, every mutation of a line); :mod:`.modelcover` — what of the
-  model they reached (rows, interrupt pairs, timer boundaries, error codes).
+  model a run's lines reached (modes, transitions, interrupt pairs, timers run out, timer
+  boundaries, error codes); :mod:`.aim` — what is not reached yet on this vehicle, as targets
+  (a way into the state each needs, a firing there, its cost from the vehicle's own mission and
+  the line), and :mod:`.tour` — the machine that drives tours of them.
 * :mod:`.edges` — the range edges of §4–8b (both sides of every bound and keyword, generated from
   the command checks, the grammar and the model's state checks) and which of them the lines sent
   reached (``stats.edges``).

@@ -15,8 +15,12 @@ it (the example stops there, raising :class:`VehicleFailure`: the one exception 
 meant to find and shrink). Steering is hypothesis's own: ``@initialize`` for the start state,
 ``@precondition`` on what the example has sent (never on the live vehicle, whose timing hypothesis
 cannot replay: a rule whose state the vehicle is not in does nothing), and its swarm testing of
-rules. What the sequences reached of the model is counted (:mod:`.modelcover`) and kept in
-``stats.explore.model_coverage``.
+rules. What the run's lines reached of the model is counted (:mod:`.modelcover`, the cases' apart)
+and the exploration's reach kept in ``stats.explore.model_coverage``.
+
+The batches take turns by the time each kind has used (:data:`SHARES`): random sequences that
+wait for nothing, random episodes, and tours aimed at what the run has not reached yet on this
+vehicle (:mod:`.aim` lists it as targets before each aimed batch, :mod:`.tour` drives them).
 
 Each example starts from a verified reset, at the surface (a dive before it: the vehicle's GPS fix
 back, :meth:`.session.Session.outwait_surface`), with ``$OLOGL`` and ``$OMLOAD`` in ``S`` so that the
@@ -72,10 +76,11 @@ from hypothesis.database import DirectoryBasedExampleDatabase
 from hypothesis.errors import Flaky
 from hypothesis.stateful import run_state_machine_as_test
 
+from .aim import MissionSurvey, targets
 from .flow import LinkLost
 from .generate import control_commands, invalid_lines, timeouts, valid_commands
 from .machine import VehicleFailure, machine
-from .modelcover import ModelCoverage
+from .tour import TOUR_MAX
 from .replay import save_replay
 
 __all__ = ["explore", "PROFILES", "Budget", "valid_commands", "control_commands", "invalid_lines", "timeouts",
@@ -93,10 +98,18 @@ class Budget(NamedTuple):
     vehicle_s: float
 
 
-#: Examples asked of hypothesis at a time (:func:`explore`), and the share of the time given to
-#: the batches whose sequences wait for nothing (:func:`.machine.machine`, ``deep=False``).
-BATCH = 8
-SHALLOW_SHARE = 0.4
+#: Examples asked of hypothesis at a time (:func:`explore`), and the share of the time each kind
+#: of batch takes: sequences that wait for nothing (:func:`.machine.machine`, ``deep=False``), the
+#: episodes (``deep=True``), and the tours aimed at what the run has not reached (:mod:`.tour`).
+BATCH = 2
+SHARES = {"shallow": 0.1, "deep": 0.2, "aimed": 0.7}
+#: Examples in an aimed batch: one sequence that drives the batch's whole list, a tour of
+#: :data:`.tour.TOUR_MAX` targets at a time (the aim is made again before every batch).
+AIMED_BATCH = 1
+#: The share of the wall budget one aimed batch may take (its list made for that much).
+AIMED_SLICE = 0.35
+#: The order the kinds take their first turn (and the tie-break after).
+_FIRST = ("shallow", "aimed", "deep")
 #: The share of the wall budget one finding's shrinking may take (from its first failure); the
 #: exploration then goes on looking for violations of other clauses with the rest.
 SHRINK_SHARE = 0.2
@@ -136,7 +149,12 @@ class _State:
         self.failures = 0
         self.lost: Optional[str] = None
         self.error: Optional[Exception] = None  #: the first tester error (module docstring)
-        self.coverage = ModelCoverage(run.p)
+        self.coverage = run.session.cover  #: the run's model coverage (:mod:`.modelcover`)
+        #: the mutations of a line sent so far (:data:`.steps.RAW_KINDS`) and the aim's probes driven
+        self.lines_sent: set = set()
+        #: the vehicle's mission as its reports describe it (:mod:`.aim`)
+        self.survey = MissionSurvey(max(1, run.p.mission_waypoints))
+        self.seq0 = run.session.obs.seq  #: the observer's line count when the exploration began
 
     @property
     def vehicle_spent(self) -> float:
@@ -160,8 +178,9 @@ class _State:
         """The whole budget is spent, or the present batch's share of it."""
         return self.spent or time.monotonic() > self.batch_end
 
-    def new_batch(self) -> None:
-        self.batch_end = self.end
+    def new_batch(self, share: float = 1.0) -> None:
+        """A batch begins: it may run until the budget is spent, or for ``share`` of the wall budget."""
+        self.batch_end = min(self.end, time.monotonic() + share * self.budget.wall_s)
 
     def shrink_from(self) -> None:
         """A failure in the present batch: its shrinking gets :data:`SHRINK_SHARE` of the budget,
@@ -229,6 +248,21 @@ def _found_clauses(found: dict) -> frozenset:
     return frozenset(c for f in found.values() for c in f["also"])
 
 
+def _aim(run, state) -> list:
+    """The targets of the next aimed batch (:func:`.aim.targets`), from what the run reached so far
+    and the vehicle's mission as its reports showed it."""
+    session = run.session
+    entry = session.obs.missions.entry(run.p.mission)
+    park_wp = entry.park_waypoint if entry is not None else None
+    park_s = float(entry.parks.get(park_wp) or 0.0) if park_wp is not None else 0.0
+    left_v = min(state.budget.vehicle_s - state.vehicle_spent, (state.batch_end - time.monotonic()) * state.k)
+    lines = max(1, session.obs.seq - state.seq0)
+    per_line = (time.monotonic() - state.t0) / lines
+    return targets(state.coverage, session.edges, run.p, state.survey, park_wp=park_wp, park_s=park_s,
+                   durations=session.durations().context(), k=state.k, line_wall_s=per_line, left_v=left_v,
+                   lines_sent=state.lines_sent)
+
+
 def explore(run) -> None:
     """Run the exploration for a :class:`~.runner.Run` and record what it found."""
     o = run.o
@@ -260,27 +294,41 @@ def explore(run) -> None:
     t0 = time.monotonic()
     outcome = "pass"
     session.lazy_silence = True
-    on_poll, session.on_poll = session.on_poll, lambda: (state.coverage.report(session.obs.state()),
+    state.coverage.source = "explore"
+    on_poll, session.on_poll = session.on_poll, lambda: (state.survey.seen(session.obs.last_osi),
                                                          on_poll and on_poll())
     try:
         # in batches: hypothesis runs its examples to the end even when the budget is spent (each
-        # still drawing its steps), so the exploration asks for BATCH at a time until it is spent;
-        # the batches take turns by time: sequences that wait for nothing (many lines each, the
-        # one-step paths) get SHALLOW_SHARE of it, those with the episodes that wait out timers,
-        # parks and the lockout the rest
+        # still drawing its steps), so the exploration asks for a batch at a time until it is spent;
+        # the batches take turns by time (SHARES): sequences that wait for nothing (many lines
+        # each, the one-step paths), those with the episodes that wait out timers, parks and the
+        # lockout, and tours aimed at what the run has not reached yet (:mod:`.aim`), the aim
+        # made again before each of their batches; shallow first, then aimed
         done = 0
         batch = 0
-        spent_by = [0.0, 0.0]  # wall seconds spent on the shallow and the deep batches
+        spent_by = dict.fromkeys(SHARES, 0.0)  # wall seconds spent on each kind of batch
+        aim_empty = False
         while done < examples and not state.spent:
             # a clause found is not stopped at again: the sequences look on for the others
             state.ignored = session.ignore = _found_clauses(state.found)
             state.new_batch()
-            n = min(BATCH, examples - done)
-            deep = spent_by[1] * SHALLOW_SHARE < spent_by[0] * (1 - SHALLOW_SHARE)  # behind its share; shallow first
-            kind = kinds[deep]
+            order = sorted(SHARES, key=lambda x: (spent_by[x] / SHARES[x], _FIRST.index(x)))
+            which = next(x for x in order if not (x == "aimed" and aim_empty))
+            n, count = min(BATCH, examples - done), steps
+            if which == "aimed":
+                state.new_batch(AIMED_SLICE)  # the random batches take their turns between
+                aim = _aim(run, state)
+                if not aim:
+                    aim_empty = True  # nothing left to aim at: the random batches share the rest
+                    session.note("exploration: nothing left to aim at")
+                    continue
+                kind = machine(state, p, tos, deep=True, aim=aim)
+                n, count = min(AIMED_BATCH, examples - done), -(-len(aim) // TOUR_MAX)
+            else:
+                kind = kinds[which == "deep"]
             factory = kind if o.seed is None else seed(o.seed * 1000 + batch)(kind)
             b0 = time.monotonic()
-            cfg = settings(max_examples=n, stateful_step_count=steps, deadline=None, database=db,
+            cfg = settings(max_examples=n, stateful_step_count=count, deadline=None, database=db,
                            suppress_health_check=list(HealthCheck), report_multiple_bugs=False, print_blob=False,
                            # quiet: hypothesis would print the steps of a failing example to stdout;
                            # the run records its own (the replay, the wire log)
@@ -295,7 +343,7 @@ def explore(run) -> None:
                     outcome = type(e).__name__ if outcome == "pass" else outcome
                 else:
                     state.tester_error(e)
-            spent_by[deep] += time.monotonic() - b0
+            spent_by[which] += time.monotonic() - b0
             done += n
             batch += 1
         if outcome == "pass" and state.failures:  # found, and the budget ran out while shrinking
@@ -305,6 +353,10 @@ def explore(run) -> None:
         session.ignore = frozenset()
         session.lazy_silence = False
         session.on_poll = on_poll
+        state.coverage.source = None  # the re-drives below are not counted: they repeat a sequence
+        for eid, case in session.edges.reached.items():  # for the traceability table (modelcover.keys)
+            if case == "explore":
+                state.coverage.reach["explore"].edges.add(eid)
         session.end_case()
     error = state.error
     which = state.which_spent

@@ -7,8 +7,8 @@ report landed just before a model timer's deadline and polled across it, the mis
 the episodes — a control interrupted and released, the mission park interrupted, a control
 bracketed at its timeout (refreshed halfway when drawn), a whole safety episode. Preconditions
 read only what the sequence has sent, never the live vehicle, so hypothesis draws the same data
-when it replays one; a rule whose state the vehicle is not in does nothing. Every line sent
-through :func:`machine`'s ``send`` is counted by the model coverage (:mod:`.modelcover`).
+when it replays one; a rule whose state the vehicle is not in does nothing. The session counts
+every line's model coverage (:mod:`.modelcover`).
 """
 
 from __future__ import annotations
@@ -18,7 +18,6 @@ from typing import Optional
 from hypothesis import strategies as st
 from hypothesis.stateful import RuleBasedStateMachine, initialize, precondition, rule
 
-from ...model.geo import KNOT_MPS
 from ...model.timers import tolerance
 from ...judge.vehicle.blame import GENERIC
 from .flow import CaseStop, LinkLost
@@ -28,6 +27,7 @@ from .interpreter import _here, context, fill, raw_line
 from .safety import BenchSafetyRefused
 from .session import frame
 from .steps import SetRoundTrip
+from .tour import PARK_WITHIN_V, _reach_park, aimed
 
 __all__ = ["machine", "VehicleFailure", "HORIZON_V", "PARK_WITHIN_V", "QUEUE_WITHIN_V"]
 
@@ -41,41 +41,17 @@ class VehicleFailure(AssertionError):
     """An example failed: the observer booked a failure about the vehicle (the reason)."""
 
 
-#: Vehicle seconds ahead within which a timer's deadline is waited for (:meth:`boundary`), and
-#: the longest a sequence waits for the mission to reach its park.
+#: Vehicle seconds ahead within which a timer's deadline is waited for (:meth:`boundary`).
 HORIZON_V = 25.0
-PARK_WITHIN_V = 120.0
 #: The longest a sequence follows its queue of waypoints (:meth:`queue`).
 QUEUE_WITHIN_V = 120.0
-
-
-def _reach_park(session, ctx: dict) -> None:
-    """From ``N``: jump to the test mission's park waypoint (once it is known) and poll until ``P``,
-    when the vehicle can get there within :data:`PARK_WITHIN_V` at the speed it reports (at least
-    half a knot); else, or when it is not there by then, it is left where it is (the observer
-    judges every report on the way; no tester note: the exploration needs no state)."""
-    entry = session.obs.missions.entry(session.profile.mission)
-    wp = entry.park_waypoint if entry is not None else None
-    if wp is not None and session.obs.state().mission_wp != wp:
-        session.exchange(frame(f"OJW,{wp + session.profile.waypoint_base}"))
-    osi = session.poll()
-    mps = max(0.5, float(osi.speed or 0)) * KNOT_MPS
-    if osi.mode != "N" or float(osi.distance or 0) / mps > PARK_WITHIN_V:
-        _here(session, ctx)
-        return
-    end = session.now() + PARK_WITHIN_V / session.k
-    while session.now() < end:
-        if session.poll().mode != "N":
-            break
-        session.link.sleep(max(session.poll_gap, 0.05))
-    _here(session, ctx)
 
 
 #: Commands that may set a timer going (a remote control's timeout, a park, RH-RD-15).
 _ARMING = frozenset({"OMS", "OMP", "OPK", "OMW", "ODVL", "OJW", "OMSTART"})
 
 
-def machine(state, p, tos, deep: bool = True):
+def machine(state, p, tos, deep: bool = True, aim: Optional[list] = None):
     """The ``RuleBasedStateMachine`` class of one exploration: ``state`` is shared by its
     instances (the exploration's budget, counts, coverage and smallest failure). ``deep=False``:
     the rules that wait for protocol time (timers, parks, the lockout) are off and the mission
@@ -92,16 +68,13 @@ def machine(state, p, tos, deep: bool = True):
     hi_to = max(tos.elements) if hasattr(tos, "elements") else int(p.timeout_range[1])
 
     def send(raw: bytes):
-        """One line, exchanged, its model coverage counted."""
-        met = cov.before(obs.state(), raw)
-        sent = session.exchange(raw)
-        cov.command(met, sent.expected if sent is not None else [])
-        return sent
+        """One line, exchanged (the session counts its model coverage)."""
+        return session.exchange(raw)
 
     def mode() -> str:
         return obs.state().mode
 
-    class VehicleMachine(RuleBasedStateMachine):
+    class Base(RuleBasedStateMachine):
         def __init__(self):
             super().__init__()
             self.active = not state.batch_spent
@@ -168,6 +141,8 @@ def machine(state, p, tos, deep: bool = True):
             """From a verified reset: the replay of a failure begins here (:mod:`.replay`)."""
             if start == "P" and not deep:
                 start = "N"
+            if aim is not None:  # an aimed tour takes its own ways from S (:mod:`.tour`)
+                start = "S"
             self.mission = start != "S"
             self.timed = start == "P"
             if not self.active:
@@ -229,6 +204,30 @@ def machine(state, p, tos, deep: bool = True):
             self._sent(body)
             self._guard(lambda: send(frame(fill(body, self.ctx))))
 
+        def _put_back(self) -> None:
+            """The settings this sequence wrote, written back as the run found them: a setting outlives
+            the verified reset, and the next sequence (and a replay, on a fresh vehicle) must not
+            depend on this one."""
+            cust = session.custodian
+            if cust is None:
+                return
+            for rec in cust.records.values():
+                if rec.name in self.wrote and rec.before is not None:
+                    send(frame(f"ORWSET,{rec.name},W,{','.join(rec.before)}"))
+
+        def teardown(self):
+            """Back to a verified reset inside the example, so that whatever the example set going (a
+            lockout, a park, a timer, a setting) is judged within it and its replay holds all of it."""
+            try:
+                if self.active and not self.failed and not state.batch_spent:
+                    self._guard(lambda: (session.finish(), session.reset(mission=False), self._put_back()))
+            finally:
+                session.trace = None
+
+    if aim is not None:
+        return aimed(Base, state, p, aim)
+
+    class VehicleMachine(Base):
         @rule(body=commands(p, tos, "motion"))
         def motion(self, body):
             self._command(body)
@@ -251,6 +250,7 @@ def machine(state, p, tos, deep: bool = True):
 
         def _line(self, line) -> None:
             kind, body = line
+            state.lines_sent.add(kind)  # the aim sends the kinds not sent yet (:mod:`.aim`)
             self._guard(lambda: send(_raw(kind, fill(body, self.ctx), p)))
 
         @rule(line=invalid_lines("framing"))
@@ -279,10 +279,7 @@ def machine(state, p, tos, deep: bool = True):
             within their transmit time — at a high time scale too widely to time what it started
             (an observation the exploration must not book)."""
             bodies = sorted(bodies, key=lambda b: 0 if b.split(",", 1)[0] in _ARMING else 1)
-            raws = [frame(fill(b, self.ctx)) for b in bodies]
-            mets = [cov.before(obs.state(), r) for r in raws]
-            for met, sent in zip(mets, session.burst(raws)):
-                cov.command(met, sent.expected)
+            session.burst([frame(fill(b, self.ctx)) for b in bodies])
 
         @rule(bodies=st.lists(one_field_off(p, tos), min_size=2, max_size=6), together=st.booleans(),
               stopped=st.booleans())
@@ -551,25 +548,5 @@ def machine(state, p, tos, deep: bool = True):
             self.faults += 1
             self.timed = True
             self._guard(lambda: session.exchange(frame(f"OXFLT,{code}")) if obs.state().phase == "none" else None)
-
-        def _put_back(self) -> None:
-            """The settings this sequence wrote, written back as the run found them: a setting outlives
-            the verified reset, and the next sequence (and a replay, on a fresh vehicle) must not
-            depend on this one."""
-            cust = session.custodian
-            if cust is None:
-                return
-            for rec in cust.records.values():
-                if rec.name in self.wrote and rec.before is not None:
-                    send(frame(f"ORWSET,{rec.name},W,{','.join(rec.before)}"))
-
-        def teardown(self):
-            """Back to a verified reset inside the example, so that whatever the example set going (a
-            lockout, a park, a timer, a setting) is judged within it and its replay holds all of it."""
-            try:
-                if self.active and not self.failed and not state.batch_spent:
-                    self._guard(lambda: (session.finish(), session.reset(mission=False), self._put_back()))
-            finally:
-                session.trace = None
 
     return VehicleMachine

@@ -372,6 +372,13 @@ class Run(ExecChild):
     def run_cases(self, cases: list) -> None:
         ses = self.session
         assert ses is not None
+        ses.cover.source = "cases"  # what they reach the exploration need not reach again (:mod:`.aim`)
+        try:
+            self._run_cases(ses, cases)
+        finally:
+            ses.cover.source = None
+
+    def _run_cases(self, ses, cases: list) -> None:
         counters = CaseCounters(self.link)  # the port's error counters around each case (casecounters.py)
         for case in cases:
             self.check_child()

@@ -33,6 +33,10 @@ into the ledger. The session only decides what to send next and how long to wait
   lockout), ``S`` seen (then the settings a case may write are read, :mod:`.restore`); then the
   profile's mission started by name (rh5 form) and seen running.
 
+Every line and report is also counted for what it reached of the reference model
+(:attr:`Session.cover`, :mod:`.modelcover`: for the cases or the exploration, as its ``source``
+says) and of the range edges (:attr:`Session.edges`); counting never judges.
+
 Tester facts go to the log as notes (``not tested …``, ``inconclusive …``) so that an offline
 check of the log reaches the same verdicts.
 """
@@ -51,6 +55,7 @@ from ...judge.wire import case_end_note, case_note, tester_note
 from ...profile import Profile
 from .durations import Durations, derive
 from .edges import EdgeTally
+from .modelcover import ModelCoverage
 from .safety import BenchSafetyRefused
 from .flow import CaseStop, LinkSilent
 from .link import TesterLink
@@ -112,6 +117,9 @@ class Session:
         self.reruns_total = 0  #: every observation made again so far (a case step's state may be stale)
         #: the range edges of §4–8b the lines sent reached (:mod:`.edges`; ``stats.edges``)
         self.edges = EdgeTally(profile)
+        #: what the lines reached of the model, for the cases and the exploration (:mod:`.modelcover`)
+        self.cover = ModelCoverage(profile)
+        self._covering: list = []  #: (sent, what it met, source) until the observer settles it
 
     # ================================================================ the line budget
     def measure_line(self, host: bool = True) -> None:
@@ -201,6 +209,7 @@ class Session:
         if self.custodian is not None:
             self.custodian.check_write(raw)  # no setting is written unless its restore is known
         at = self.edges.before(raw, self.obs.state())
+        met = self.cover.before(self.obs.state(), raw)
         try:
             t = self.link.send(raw)
         except BenchSafetyRefused:
@@ -211,8 +220,26 @@ class Session:
             if sent.seq <= seq:
                 break
             self.edges.track(sent, at)
+            self._cover(sent, met)
             return sent
         return None
+
+    def _cover(self, sent: Optional[Sent], met) -> None:
+        """Count for the model coverage what the lines the observer has settled met (``sent``
+        with what it met, when given, waits until it is settled)."""
+        if sent is not None and met is not None and self.cover.source:
+            self._covering.append((sent, met, self.cover.source))
+        keep = []
+        for x, m, source in self._covering:
+            if not x.done:
+                keep.append((x, m, source))
+                continue
+            was, self.cover.source = self.cover.source, source
+            try:
+                self.cover.command(m, x.expected, self.obs.state())
+            finally:
+                self.cover.source = was
+        self._covering = keep
 
     def exchange(self, raw: bytes) -> Optional[Sent]:
         """Send ``raw`` and wait until the observer has settled it; made again while a faulty line
@@ -248,6 +275,7 @@ class Session:
                 break
         if sent.done:
             self._sample(sent)
+            self._cover(None, None)
             self._trace({"expect": _brief(sent.expected)})
             self.check()
             return sent
@@ -373,6 +401,7 @@ class Session:
                 self.custodian.check_write(raw)
         state = self.obs.state()  # each line's edges as met in the state before the burst (:mod:`.edges`)
         ats = [self.edges.before(raw, state) for raw in raws]
+        mets = [self.cover.before(state, raw) for raw in raws]
         try:
             t = self.link.send(b"".join(raws))
         except BenchSafetyRefused:
@@ -382,8 +411,9 @@ class Session:
         self._trace({"send": _esc(b"".join(raws)), "t": round(t, 6)})
         sents = [x for x in self.obs.sent if x.seq > seq]
         if len(sents) == len(raws):
-            for sent, at in zip(sents, ats):
+            for sent, at, met in zip(sents, ats, mets):
                 self.edges.track(sent, at)
+                self._cover(sent, met)
         while any(not x.done for x in sents):  # until each is answered or the observer gave up on it
             hard = max(self.obs.give_up_at(x) for x in sents if not x.done) + 0.05
             if self.link.next(hard) is None and self.now() >= hard:
@@ -391,6 +421,7 @@ class Session:
         for x in sents:
             if x.done:
                 self._sample(x)
+        self._cover(None, None)
         if any(not x.done for x in sents):
             self._probe(hard)
         self.check()  # a burst is about its timing (a lockout's commands): what the line spoilt of
@@ -413,6 +444,7 @@ class Session:
                 raise CaseStop("inconclusive", "the $OSI answering $OSD,S shows no readable state (mode, "
                                                "waypoint, park time, error state)")
             raise CaseStop("fail", "$OSD,S was answered without an $OSI", "RH-OSD-1")
+        self.cover.report(self.obs.state())
         if self.on_poll is not None:
             self.on_poll()
         return osi
