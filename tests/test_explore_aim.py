@@ -142,3 +142,17 @@ def test_the_mission_survey_reads_the_legs_off_the_reports():
     assert abs(survey.leg_v(0) - 30.0 / mps) < 1e-6 and abs(survey.leg_v(1) - 100.0 / mps) < 1e-6
     assert survey.leg_v(2) == 60.0  # seen only under remote control: not a leg of the mission
     assert abs(survey.to_v(1) - 130.0 / mps) < 1e-6
+
+
+def test_RH_SAF_5_without_the_oxflt_extension_no_target_sends_it():
+    """A profile whose violations are the vehicle's own (``fault_injection`` not ``oxflt``, RH-SAF-5):
+    no target — a way, a firing, a tour, a lockout's error code — sends ``$OXFLT``; with the
+    extension declared, some do (the lockout and the ascent are reached that way)."""
+    ses = _session()
+    drv, state = _driver(ses)
+    with_ext = _aim(ses, state, limit=10_000)
+    assert any("OXFLT" in s for t in with_ext for s in (*(WAYS[t.way].steps if t.way else ()), *t.fire))
+    ses.profile = ses.profile.replace(fault_injection="none", violation_trigger="mission-rule")
+    without = _aim(ses, state, limit=10_000)
+    assert without and not [t for t in without
+                             if any("OXFLT" in s for s in (*(WAYS[t.way].steps if t.way else ()), *t.fire))]

@@ -379,6 +379,8 @@ def targets(cover: ModelCoverage, edges, profile: Profile, survey: MissionSurvey
     found: dict[tuple, Target] = {}
 
     def add(way: str, fire: tuple, what: str, writes: tuple = (), keeps: bool = False) -> None:
+        if not oxflt and any("OXFLT" in f for f in (*(WAYS[way].steps if way else ()), *fire)):
+            return  # no $OXFLT extension declared (RH-SAF-5): a violation is the vehicle's own to raise
         key = (way, fire)
         t = found.get(key)
         if t is None:
