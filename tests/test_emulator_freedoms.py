@@ -9,9 +9,8 @@ profile file, ``--set KEY=VALUE``; :mod:`helmcheck.emulator.freedoms`), and:
 * the property test draws a combination of conforming choices, starts ``helmcheck emulate`` with
   them on a real pty, certifies the clauses those choices touch at time scale 20 or 5 (the
   scales the suite uses for vehicles it did not write) and asserts exit code 0 with no clause
-  FAIL or INCONCLUSIVE. ``make test`` runs its explicit examples and a few derandomised draws;
-  ``make fuzz`` many random ones. The examples marked ``xfail`` are conforming choices the
-  judge or the cases still get wrong (each names the finding); they pass once it is fixed;
+  FAIL or INCONCLUSIVE. ``make test`` runs four explicit examples (:data:`EXAMPLES`), ``make
+  matrix`` all of them and two derandomised draws, ``make fuzz`` many random ones;
 * the bound tests put a timer just past RH-TIM-1's ``max(0.5 s, 5 %)`` (FAIL) and just inside
   (PASS), so the settings are shown to reach the bound and the judge to hold it.
 """
@@ -24,7 +23,7 @@ import time
 from pathlib import Path
 
 import pytest
-from hypothesis import HealthCheck, example, given, settings
+from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from helmcheck.emulator.core import EmulatorCore, plant_params
@@ -382,40 +381,65 @@ def judge(got: dict, st_: EmulatorSettings, strict: bool) -> dict:
     return left
 
 
-@settings(max_examples=2, deadline=None, suppress_health_check=list(HealthCheck))
-@given(choices())
-# each group of freedoms with choices far from the reference emulator's (strict: no finding excused)
-@example((["pacing=burst", "burst_interval_s=0.1"], 20.0, ["RH-ACK-2", "RH-ACK-5", "RH-ACK-6", "RH-OSD-1"], True))
-@example((["control_tick_s=0.2", "timer_factor=0.975", "timer_offset_s=-0.1"], 5.0, ["RH-SRV-4", "RH-PRM-4"], True))
-@example((["speed_factor=0.7", "turn_rate_dps=6", "dive_pitch_deg=12", "ascent_mps=2.0"], 20.0,
-          ["RH-PK-2", "RH-OMW-4", "RH-SAF-3", "RH-SAF-4"], True))
-@example((["decimals.lat=5", "decimals.lon=5", "decimals.distance=0", "decimals.speed=0", "decimals.depth=0",
-           "decimals.true_heading=0", "decimals.battery=0", "idle_distance=last", 'osi_reserved=["x", "", "7"]',
-           'compass_extra=["Mx", "My", "Mz"]', "gprmc_time_decimals=0", 'factory_settings.Sle=[0, "30"]'],
-          20.0, ["RH-OUT-1", "RH-OUT-2", "RH-FRM-8", "RH-PRM-4", "RH-MSN-3", "RH-SET-2", "RH-PK-2"], True))
-@example((["start_lat=41.5215", "start_lon=-71.3185", "start_heading=270", "declination=10",
-           "water_depth_m=8"], 20.0, ["RH-MSN-2", "RH-POS-2", "RH-OMW-4"], True))
-# F1, fixed: a lockout the vehicle ends late within RH-TIM-1's tolerance (answered from the state before it)
-@example((["timer_factor=1.04"], 5.0, ["RH-SAF-1"], True))
-# F2, fixed: an $OPK accepted while the vehicle moved on from the last report waits for on station
-@example((["reply_delay_s=0.2"], 20.0, ["RH-PK-1"], True))
-# F3, fixed: the cases' durations against a slow line (the line budget chooses them)
-@example((["reply_delay_s=0.2"], 20.0, ["RH-SRV-3"], True))
-# F7, fixed: a waypoint reached unseen just before a takeover no longer widens the takeover's timeout
-@example((["reply_delay_s=0.3", "start_lat=41.52125"], 20.0, ["RH-SRV-4"], True))
-# the line at its bound: replies 0.6 s after each line, timers late by what the tick leaves (strict)
-@example((["reply_delay_s=0.6", "control_tick_s=0.2", "timer_offset_s=0.3"], 20.0,
-          ["RH-SRV-3", "RH-SRV-4", "RH-PRM-4", "RH-SAF-1", "RH-TIM-1"], True))
-def test_a_conforming_vehicle_passes_whatever_it_chooses(tmp_path_factory, case):
+#: Each group of freedoms with choices far from the reference emulator's (strict: no finding
+#: excused), and the findings fixed since, kept as regressions. ``make test`` runs those of
+#: :data:`IN_MAKE_TEST` (one per kind of freedom: the line's pacing, the clock, the plant, the line at
+#: its bound), each a test of its own; ``make matrix`` (``HELMCHECK_MATRIX=1``) and ``make fuzz``
+#: all of them and the draws.
+EXAMPLES = {
+    "pacing": (["pacing=burst", "burst_interval_s=0.1"], 20.0, ["RH-ACK-2", "RH-ACK-5", "RH-ACK-6", "RH-OSD-1"], True),
+    "clock": (["control_tick_s=0.2", "timer_factor=0.975", "timer_offset_s=-0.1"], 5.0, ["RH-SRV-4", "RH-PRM-4"],
+              True),
+    "plant": (["speed_factor=0.7", "turn_rate_dps=6", "dive_pitch_deg=12", "ascent_mps=2.0"], 20.0,
+              ["RH-PK-2", "RH-OMW-4", "RH-SAF-3", "RH-SAF-4"], True),
+    "report": (["decimals.lat=5", "decimals.lon=5", "decimals.distance=0", "decimals.speed=0", "decimals.depth=0",
+                "decimals.true_heading=0", "decimals.battery=0", "idle_distance=last", 'osi_reserved=["x", "", "7"]',
+                'compass_extra=["Mx", "My", "Mz"]', "gprmc_time_decimals=0", 'factory_settings.Sle=[0, "30"]'],
+               20.0, ["RH-OUT-1", "RH-OUT-2", "RH-FRM-8", "RH-PRM-4", "RH-MSN-3", "RH-SET-2", "RH-PK-2"], True),
+    "start": (["start_lat=41.5215", "start_lon=-71.3185", "start_heading=270", "declination=10",
+               "water_depth_m=8"], 20.0, ["RH-MSN-2", "RH-POS-2", "RH-OMW-4"], True),
+    # F1, fixed: a lockout the vehicle ends late within RH-TIM-1's tolerance (answered from the state before it)
+    "F1-late-lockout": (["timer_factor=1.04"], 5.0, ["RH-SAF-1"], True),
+    # F2, fixed: an $OPK accepted while the vehicle moved on from the last report waits for on station
+    "F2-opk-moved-on": (["reply_delay_s=0.2"], 20.0, ["RH-PK-1"], True),
+    # F3, fixed: the cases' durations against a slow line (the line budget chooses them)
+    "F3-slow-line": (["reply_delay_s=0.2"], 20.0, ["RH-SRV-3"], True),
+    # F7, fixed: a waypoint reached unseen just before a takeover no longer widens the takeover's timeout
+    "F7-unseen-waypoint": (["reply_delay_s=0.3", "start_lat=41.52125"], 20.0, ["RH-SRV-4"], True),
+    # the line at its bound: replies 0.6 s after each line, timers late by what the tick leaves (strict)
+    "line-bound": (["reply_delay_s=0.6", "control_tick_s=0.2", "timer_offset_s=0.3"], 20.0,
+                   ["RH-SRV-3", "RH-SRV-4", "RH-PRM-4", "RH-SAF-1", "RH-TIM-1"], True),
+}
+IN_MAKE_TEST = ("pacing", "clock", "plant", "line-bound")
+MATRIX = os.environ.get("HELMCHECK_MATRIX") == "1"
+
+
+def _passes_whatever_it_chooses(tmp_path_factory, case) -> None:
     sets, k, groups, strict = case if len(case) == 4 else (*case, False)
-    _STARTED[:] = _STARTED or [time.monotonic()]
-    if PROFILE == "fuzz" and time.monotonic() - _STARTED[0] > FUZZ_BUDGET_S:
-        return  # make fuzz: this test's share of the wall time is spent
     got = certify_with(sets, k, groups, tmp_path_factory.mktemp("freedoms") / "r")
     left = judge(got, settings_of(sets), strict)
     assert got["agree"], (sets, got["disagree"])
     assert not left, (sets, k, got["select"], left)
     assert got["exit"] == 0 or got["bad"], (sets, k, got)  # a run inconclusive for an excused reason only
+
+
+@pytest.mark.parametrize("name", [n if n in IN_MAKE_TEST or MATRIX or PROFILE == "fuzz" else
+                                  pytest.param(n, marks=pytest.mark.skip(reason="make matrix's (HELMCHECK_MATRIX=1)"))
+                                  for n in EXAMPLES])
+def test_a_conforming_vehicle_passes_these_choices(tmp_path_factory, name):
+    """The explicit choices of :data:`EXAMPLES`: certified on the clauses they touch, nothing but PASS."""
+    _passes_whatever_it_chooses(tmp_path_factory, EXAMPLES[name])
+
+
+@pytest.mark.skipif(not (MATRIX or PROFILE == "fuzz"), reason="make matrix's and make fuzz's (random draws)")
+@settings(max_examples=2, deadline=None, suppress_health_check=list(HealthCheck))
+@given(choices())
+def test_a_conforming_vehicle_passes_whatever_it_chooses(tmp_path_factory, case):
+    """Drawn choices (:func:`choices`): certified on the clauses they touch, nothing but PASS."""
+    _STARTED[:] = _STARTED or [time.monotonic()]
+    if PROFILE == "fuzz" and time.monotonic() - _STARTED[0] > FUZZ_BUDGET_S:
+        return  # make fuzz: this test's share of the wall time is spent
+    _passes_whatever_it_chooses(tmp_path_factory, case)
 
 
 # ============================================================================ the bound

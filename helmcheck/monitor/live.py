@@ -39,6 +39,9 @@ __all__ = ["LiveJudge", "Finding", "LogFollower", "helper_process"]
 
 #: How often the judging process looks for new lines when it has none, seconds.
 FOLLOW_S = 0.02
+#: How long the monitor waits for the judging process to be ready before it starts the session
+#: anyway (its findings then come that much later), seconds.
+READY_S = 30.0
 #: How often it sends a state snapshot, seconds.
 STATE_S = 0.25
 #: How much lower the judges' priority is (``nice``). Not the idle scheduling class: measured on a
@@ -135,6 +138,28 @@ class LiveJudge:
         self._state: dict = {}
         self.error: Optional[str] = None
         self._outcome: Optional[CheckOutcome] = None
+        self.ready = False
+
+    def wait_ready(self, timeout: float = READY_S) -> bool:
+        """Wait until the process has imported the judges and built its own (a spawned Python
+        starts in a second or two on a small machine): a session started before that would see
+        its first findings that much later. False when it is not ready within ``timeout``. Then
+        :meth:`follow` tells it the log is there."""
+        end = time.monotonic() + timeout
+        while not self.ready and self.error is None and self._outcome is None:
+            left = end - time.monotonic()
+            if left <= 0 or not self.proc.is_alive() and not self._conn.poll():
+                return False
+            if self._conn.poll(min(left, 0.1)):
+                try:
+                    self._take(self._conn.recv(), [])
+                except (EOFError, OSError):
+                    return False
+        return self.ready
+
+    def follow(self) -> None:
+        """The log is there (a new one, in place of any earlier run's): the process follows it."""
+        self._conn.send(("follow", None))
 
     def poll(self) -> list[Finding]:
         """New findings since the last call (and the latest state, :meth:`state`)."""
@@ -162,6 +187,8 @@ class LiveJudge:
             self._outcome = payload
         elif kind == "error":
             self.error = payload
+        elif kind == "ready":
+            self.ready = True
 
     def state(self) -> dict:
         return self._state
@@ -234,12 +261,20 @@ def _judge_process(conn, first: str, profile: Profile, role: str, time_scale: fl
 
 def _follow(conn, first: Path, profile: Profile, role: str, time_scale: float, baud: int) -> CheckOutcome:
     judge = SessionJudge(profile, role, None, time_scale, 1e-6, baud)
+    conn.send(("ready", None))
+    sha: Optional[str] = None
+    while True:  # the log is followed once it is the session's own (LiveJudge.follow)
+        kind, payload = conn.recv()
+        if kind == "follow":
+            break
+        if kind == "end":  # ended before it began: the log as it is
+            sha = payload
+            break
     sides = [(name, side.ledger) for name, side in (("vehicle", judge.vehicle), ("backseat", judge.backseat))
              if side is not None]
     marks = {name: ledger.mark() for name, ledger in sides}
     seen: set = set()
     follower = LogFollower(first)
-    sha: Optional[str] = None
     last_state = 0.0
     count, newest = 0, None
     while True:

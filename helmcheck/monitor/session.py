@@ -49,6 +49,9 @@ from .live import Finding, LiveJudge, helper_process
 from ..line.relay import Relay
 from .sessionlog import ROTATE_BYTES, SessionLog
 
+#: The session's (first) wire-log segment.
+LOG_NAME = "wire.log"
+
 __all__ = ["Options", "Result", "monitor", "open_sides", "side_roles"]
 
 MODES = ("tap", "between")
@@ -124,15 +127,24 @@ def monitor(opts: Options) -> Result:
             opts.on_port(side, link.name)
     d = Path(opts.report_dir)
     d.mkdir(parents=True, exist_ok=True)
-    started = datetime.now(timezone.utc)
-    meta = [f"started {started.strftime('%Y-%m-%dT%H:%M:%S.%fZ')}  port {b_link.name} {v_link.name}  "
-            f"baud {opts.baud}  time_scale {opts.time_scale:g}",
-            run_header(__version__, "monitor", opts.profile.name,
-                       more=f" --{opts.mode}: backseat {opts.backseat}, vehicle {opts.vehicle}".replace(";", ","))]
-    interim = _Interim(d, opts)
-    slog = SessionLog(d, meta, rotate_bytes=opts.rotate_bytes, on_rotate=interim.rotated)
-    live = LiveJudge(d / slog.name, opts.profile.replace(time_scale=opts.time_scale, baud=opts.baud), role="both",
-                     time_scale=opts.time_scale, baud=opts.baud)
+    # the judging process first: the session starts once its judge can judge (it follows the log
+    # only once told, after the log below replaces any earlier one); nothing is read meanwhile, so
+    # no byte is lost, and a finding at the session's first second is not late by its start-up
+    profile = opts.profile.replace(time_scale=opts.time_scale, baud=opts.baud)
+    live = LiveJudge(d / LOG_NAME, profile, role="both", time_scale=opts.time_scale, baud=opts.baud)
+    try:
+        live.wait_ready()
+        started = datetime.now(timezone.utc)
+        meta = [f"started {started.strftime('%Y-%m-%dT%H:%M:%S.%fZ')}  port {b_link.name} {v_link.name}  "
+                f"baud {opts.baud}  time_scale {opts.time_scale:g}",
+                run_header(__version__, "monitor", opts.profile.name,
+                           more=f" --{opts.mode}: backseat {opts.backseat}, vehicle {opts.vehicle}".replace(";", ","))]
+        interim = _Interim(d, opts)
+        slog = SessionLog(d, meta, rotate_bytes=opts.rotate_bytes, on_rotate=interim.rotated, name=LOG_NAME)
+    except BaseException:
+        live.stop()
+        raise
+    live.follow()
     t0 = time.monotonic()
     roles = dict(zip(("backseat", "vehicle"), side_roles(opts.mode, opts.backseat)))
     gaps = SideGaps({"backseat": opts.backseat, "vehicle": opts.vehicle}, roles, baud=opts.baud,
