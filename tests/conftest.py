@@ -45,7 +45,8 @@ settings.load_profile(PROFILE)
 
 #: Test files whose tests each take a minute or more of waiting on scaled time: collected first,
 #: so that the workers start them first and the suite's wall time is not their tail.
-LONG_FIRST = ("test_third_party_vehicle.py",)
+LONG_FIRST = ("test_third_party_vehicle.py", "test_vehicle3.py", "test_readme_walkthroughs.py", "test_emulator_freedoms.py",
+              "test_certify_vehicle.py", "test_verify.py")
 
 
 def pytest_collection_modifyitems(config, items):  # noqa: ARG001 - pytest hook signature

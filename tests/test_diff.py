@@ -128,12 +128,15 @@ def test_the_emulator_and_the_emulator_with_other_freedoms_do_not_diverge(profil
 
 
 def test_the_emulator_at_two_time_scales_does_not_diverge(profile_file, tmp_path, capsys):
+    """x20 against x40. Both vehicles run in this process (threads): at x50 a tenth of a second
+    the host's load keeps one from its timers is five vehicle seconds, and it was seen to fail
+    RH-OUT-4 by as much — the vehicle's fault there, not the diff's."""
     rdir = tmp_path / "diff"
-    with serve(lambda t: make_core(None, 25.0, t)) as pa, serve(lambda t: make_core(None, 50.0, t)) as pb:
-        code, out, doc = run_diff(capsys, pa, pb, profile_file, rdir, 25.0, 10.0, 5, "--time-scale-b", "50")
+    with serve(lambda t: make_core(None, 20.0, t)) as pa, serve(lambda t: make_core(None, 40.0, t)) as pb:
+        code, out, doc = run_diff(capsys, pa, pb, profile_file, rdir, 20.0, 10.0, 5, "--time-scale-b", "40")
     assert code == 0, out
     assert doc["result"] == "no divergence" and doc["stats"]["sequences"] >= 5
-    assert doc["sides"]["B"]["time_scale"] == 50.0 and doc["sides"]["A"]["time_scale"] == 25.0
+    assert doc["sides"]["B"]["time_scale"] == 40.0 and doc["sides"]["A"]["time_scale"] == 20.0
 
 
 def test_a_side_at_the_wrong_time_scale_is_not_compared(profile_file, tmp_path, capsys):

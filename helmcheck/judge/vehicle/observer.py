@@ -647,9 +647,14 @@ class VehicleObserver(Answers, Deadlines):
             q = self.silent.popleft()
             if self._silent_over(q, t):
                 self._silence_kept(q)
-        for p in self.pending:
-            self.ledger.inconclusive("RH-ACK-1", f"the record ended {t - p.t:.2f} s after {text_of(p)}, inside "
-                                                 f"its ACK window", [p.ev], p.case)
+        if self.pending:  # decision: the record's end is not the vehicle's (a session's duration, a
+            # capture stopped): what it cut off inside its ACK window was never observed, so it is
+            # not judged, as for a cut run (_resume); with nothing else seen the clause is NOT-TESTED
+            p = self.pending[0]
+            why = (f"{len(self.pending)} command(s) still inside their ACK window when the record ended were not "
+                   f"judged (first: {text_of(p)}, {t - p.t:.2f} s before the end)")
+            self.ledger.remark("RH-ACK-1", why)
+            self.ledger.not_tested("RH-ACK-1", why, p.case)
         for p in self.dead:
             self.ledger.inconclusive("RH-ACK-1", f"{text_of(p)}: no $ACK, and the vehicle said nothing at all "
                                                  f"afterwards (a link fault?)", [p.ev], p.case)
