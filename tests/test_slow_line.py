@@ -87,6 +87,8 @@ def _sim_profile(tmp: Path) -> object:
 
 
 @pytest.mark.skipif(not SIM.is_file(), reason=f"the independent simulator is not there: {SIM}")
+@pytest.mark.skipif(not MATRIX, reason="make matrix's (HELMCHECK_MATRIX=1): make test's budget (a vehicle we did not "
+                                        "write behind a bad line: tests/test_bad_line.py)")
 def test_a_vehicle_we_did_not_write_behind_a_slow_line_passes(tmp_path):
     """``uvc_sim.py`` behind the relay: 19200 baud, each line it sends held 0.6 s (its own missions)."""
     from tests.test_third_party_vehicle import uvc_sim

@@ -218,7 +218,12 @@ CAUGHT_ON = {
     # RH-PK-2: an $OPK park counted from 7 m off station fails; from 2.5 m it passes
     ("park-counts-7m-off", 20.0, "RH-PK-2", "RH-PK-2", "fail"),
     ("ok-park-counts-2.5m-off", 20.0, "RH-PK-2", "RH-PK-2", "pass"),
-    *[(f, 20.0, *(c if isinstance(c, tuple) else (c, c))[::-1], "fail") for f, c in CAUGHT_ON.items()],
+    # make test: every other one (each clause of the suite's own faulty vehicles is still failed
+    # there, tests/test_certify_vehicle_mutants.py); make matrix: all of them
+    *[pytest.param(f, 20.0, *(c if isinstance(c, tuple) else (c, c))[::-1], "fail",
+                   marks=() if MATRIX or i % 2 == 0 else pytest.mark.skip(reason="make matrix's (HELMCHECK_MATRIX=1): "
+                                                                                  "make test runs every other variant"))
+      for i, (f, c) in enumerate(CAUGHT_ON.items())],
 ])
 def test_a_faulty_variant_is_told_apart_on_its_clause(tmp_path, fault, k, select, clause, verdict):
     """One defect of a vehicle we did not write, judged on the clause it breaks (and the variant
