@@ -21,6 +21,10 @@ judge on the run's own ``wire.log``) must agree (the suite's ``every_run_verifie
 * faulty variants of it, one defect each (``tests/third_party_faults.py``), each caught on the
   clause it breaks, and the variants just inside a bound passing it.
 
+``make test`` runs its own missions at x20, the five-command profile, every other faulty variant
+and every bound pair; ``make matrix`` (``HELMCHECK_MATRIX=1``) the rest: x5, the mission rule, the
+violation it raises by itself, the plugin and every variant.
+
 Mission files beside its own (its README: a mission of any name may be put into
 ``--mission-dir``): ``end.mis``, a short mission that ends (RH-MSN-4), and ``rule.mis``, a copy of
 its ``conformance.mis``.
