@@ -128,7 +128,9 @@ def test_at_x10_on_19200_the_overrun_is_named_and_rh_bs_5_is_non_strict(runs):
     assert r["run"]["vehicle"]["dropped_out"] > 0  # the default reading sheds polls it cannot answer in time
     cs = clauses(run)
     assert cs["RH-BS-5"]["verdict"] == "non-strict", cs["RH-BS-5"]
-    assert "during a lockout" in cs["RH-BS-5"]["reason"]
+    # its $OMS every second whatever the answer: sent on in the lockout, or (its timer a little
+    # early on a busy host) again within the second after a refusal — whichever the judge met first
+    assert "during a lockout" in cs["RH-BS-5"]["reason"] or "once the vehicle had refused it" in cs["RH-BS-5"]["reason"]
     for cid in ("RH-BS-1", "RH-BS-2", "RH-BS-3", "RH-BS-6", "RH-BS-7", "RH-BS-8"):
         assert cs[cid]["verdict"] == "pass", cs[cid]  # empty trailing fields, one decimal, an empty SRP field
     assert_lockout_whole_or_not_claimed(run)

@@ -24,8 +24,8 @@ The examples: every line of a help that runs helmcheck (``helmcheck …``, or a 
 
 Not run by default, and why (each still parsed and its files checked): an example on hardware
 (``/dev/ttyUSB0``, a lab address, a cluster), one that needs a vehicle on a port (``/dev/pts/N``:
-the emulator an earlier line starts), one that takes more than a few seconds (a whole backseat
-certification, a diff with its budget), and ``helmcheck docs``, which rewrites the checkout's
+the emulator an earlier line starts), one that takes more than a few seconds (a certification
+that starts its implementation, ``--exec``; a diff with its budget), and ``helmcheck docs``, which rewrites the checkout's
 generated files. With ``HELMCHECK_HELP_EXAMPLES=1`` (``make help-examples``) the slow ones run
 too, and those that need a vehicle run against the emulator started on their port.
 """
@@ -241,7 +241,7 @@ def _kind(argv: list[str]) -> tuple[str, str]:
     live = [w for w in argv if VEHICLE_PORT.match(w)] or (argv[:1] == ["monitor"])
     if live:
         return ("live" if RUN_ALL else "skip"), "it needs a vehicle on its port"
-    if ("--exec" in argv and argv[:2] == ["certify", "backseat"]) or argv[:1] == ["diff"]:
+    if ("--exec" in argv and argv[:1] == ["certify"]) or argv[:1] == ["diff"]:
         return ("run" if RUN_ALL else "skip"), "it takes more than a few seconds"
     if argv[:2] == ["certify", "backseat"] and "--plan" in argv:
         return "run", ""  # prints the plan and exits: no port

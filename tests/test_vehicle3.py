@@ -10,11 +10,12 @@ ambiguities it met; where the profile leaves room, every reading is accepted (th
 own pty and prints ``port: …``, so it is started with ``--port announced --exec``.
 
 * ``make test``: the correct vehicle on a fast line (115200 baud, replies 30–40 ms), ×20, under
-  ``$OXFLT`` and under its own mission rule — PASS with a certificate, nothing FAIL or INCONCLUSIVE,
-  ``helmcheck verify`` agreeing; and a representative set of its mutants, each certified on the
-  clause its README names: FAIL there.
-* ``make matrix`` (``HELMCHECK_MATRIX=1``): the correct vehicle on its own default line (19200
-  baud, replies 30–400 ms) under ``$OXFLT``: a certificate. Every mutant certified whole is
+  ``$OXFLT`` — PASS with a certificate, nothing FAIL or INCONCLUSIVE, ``helmcheck verify``
+  agreeing —, and under its own mission rule the lockout clauses, each PASS; and a representative
+  set of its mutants, each certified on the clause its README names: FAIL there.
+* ``make matrix`` (``HELMCHECK_MATRIX=1``): the whole certificate under its mission rule, and the
+  correct vehicle on its own default line (19200 baud, replies 30–400 ms) under ``$OXFLT``: a
+  certificate. Every mutant certified whole is
   ``tests/test_vehicle3_mutants.py``'s.
 
 Where ``../shared`` is not beside the checkout, these tests skip and say so.
@@ -71,7 +72,9 @@ def verified(tmp: Path) -> bool:
 
 # ============================================================================ the correct vehicle
 
-@pytest.mark.parametrize("trigger", ["oxflt", "mission-rule"])
+@pytest.mark.parametrize("trigger", ["oxflt", pytest.param("mission-rule", marks=pytest.mark.skipif(
+    not MATRIX, reason="make matrix's (HELMCHECK_MATRIX=1): make test certifies the lockout clauses under its "
+                       "mission rule (test_its_mission_rule_trips_the_lockout_while_it_dives)"))])
 def test_the_correct_vehicle_certifies_on_a_fast_line(tmp_path, trigger):
     """×20, 115200 baud, replies within 40 ms: every claimed clause PASS, a certificate — the SRP
     name outside the directory refused with 31 (RH-RD-6: 30 or 31), RH-MSN-4 on its own test
@@ -85,6 +88,19 @@ def test_the_correct_vehicle_certifies_on_a_fast_line(tmp_path, trigger):
     assert verified(tmp_path)
     msn = next(c for c in results["clauses"] if c["id"] == "RH-MSN-2")
     assert "srp_bad_path = 31" in msn["reason"], msn["reason"]
+
+
+def test_its_mission_rule_trips_the_lockout_while_it_dives(tmp_path):
+    """Its own time-limit rule as the trigger (RH-SAF-5, no ``$OXFLT`` sent), ×20, fast line: the
+    lockout clauses — its rule trips while V-60's servo dive is under way — each PASS, and
+    ``helmcheck verify`` agrees (the whole certification under this trigger: make matrix)."""
+    code, results, text = certify(tmp_path, ICS + RULE, 115200, FAST, "--examples", "0", "--select", "RH-SAF-*")
+    saf = {c["id"]: c for c in results["clauses"] if c["id"].startswith("RH-SAF-")}
+    assert {c: e["verdict"] for c, e in saf.items() if c != "RH-SAF-5"} == \
+        {"RH-SAF-1": "pass", "RH-SAF-2": "pass", "RH-SAF-3": "pass", "RH-SAF-4": "pass"}, not_passed(results)
+    assert code == 0, text
+    assert "$OXFLT" not in (tmp_path / "run" / "wire.log").read_text().replace("not tested", "")
+    assert verified(tmp_path)
 
 
 @pytest.mark.skipif(not MATRIX, reason="make matrix (HELMCHECK_MATRIX=1): its own default line, about 5 minutes")
