@@ -79,9 +79,12 @@ explore-reach: $(STAMP)
 # scale --precision nominal names); every faulty vehicle of the suite at both its time scales (make
 # test: one each, tests/test_certify_vehicle_mutants.py), every explicit example of the freedoms and
 # two drawn ones (make test: one per kind of freedom, tests/test_emulator_freedoms.py); the
-# independent simulator's own mission rule as the trigger (make test: the third vehicle's).
+# independent simulator's own mission rule as the trigger and every other of its faulty variants
+# (make test: the third vehicle's, every third variant); the third vehicle's whole certificate under its
+# own mission rule (make test: its lockout clauses); ACKs 2.5 s late live, one re-run of two
+# reproducing an exploration finding, Ctrl-C of a two-job check-log (make test: their neighbours).
 matrix: $(STAMP)
-	HELMCHECK_MATRIX=1 $(PY) -m pytest -n 2 tests/test_line_budget.py tests/test_slow_line.py tests/test_unplugged.py tests/test_bad_line.py tests/test_third_party_vehicle.py::test_its_own_missions_with_oxflt_certify tests/test_third_party_vehicle.py::test_its_mission_rule_trips_the_lockout_and_certifies tests/test_third_party_vehicle.py::test_a_violation_it_raises_by_itself_is_judged_like_any_other tests/test_third_party_vehicle.py::test_the_pytest_plugin_certifies_it tests/test_explore_replays.py tests/test_vehicle3.py tests/test_readings.py tests/test_certify_backseat_realtime.py tests/test_vehicle3_mutants.py tests/test_explore_vehicle3.py tests/test_emulator_freedoms.py tests/test_certify_vehicle_mutants.py
+	HELMCHECK_MATRIX=1 $(PY) -m pytest -n 2 tests/test_line_budget.py tests/test_slow_line.py tests/test_unplugged.py tests/test_bad_line.py tests/test_third_party_vehicle.py tests/test_explore_replays.py tests/test_vehicle3.py tests/test_readings.py tests/test_certify_backseat_realtime.py tests/test_vehicle3_mutants.py tests/test_explore_vehicle3.py tests/test_emulator_freedoms.py tests/test_certify_vehicle_mutants.py tests/test_ack_window_bounds.py tests/test_explore_rules.py tests/test_checklog_fleet.py
 
 # Not run by CI (several minutes): every --help example, the slow ones and those that need a
 # vehicle too (run against the emulator on their port); make test runs the others.

@@ -13,6 +13,8 @@ RH-FRM-5: a vehicle must discard a line whose ID it does not know, so any reply 
 
 from __future__ import annotations
 
+import os
+
 from datetime import datetime, timedelta
 from pathlib import Path
 
@@ -216,6 +218,8 @@ def test_live_acks_0_3_s_after_the_window_fail(tmp_path):
     assert out.exit_code == 1
 
 
+@pytest.mark.skipif(os.environ.get("HELMCHECK_MATRIX") != "1", reason="make matrix's (HELMCHECK_MATRIX=1): make "
+                    "test's budget (2.5 s late, judged offline: tests/test_checklog_socat.py; live, 0.3 s past: below)")
 def test_live_acks_2_5_s_late_are_seen_and_fail_as_late_not_missing(tmp_path):
     out, v = certify_core(AcksVeryLate, ["RH-ACK-2"], tmp_path)
     assert v["RH-ACK-2"]["verdict"] == "fail", (out.reason, v["RH-ACK-2"]["reason"])

@@ -18,6 +18,7 @@ imported when it is asked for: the reference engine, locating a syntax error, th
 
 from __future__ import annotations
 
+import contextlib
 import os
 import re
 import typing
@@ -25,6 +26,7 @@ import zlib
 from dataclasses import dataclass, fields
 from decimal import Decimal
 from functools import lru_cache
+from pathlib import Path
 from typing import Any, Callable, Optional
 
 from . import sentences as S
@@ -56,16 +58,54 @@ def grammar_digest(text: str) -> str:
     return f"{zlib.crc32(text.encode('utf-8')):08x}"
 
 
+#: The reference parser's options (:func:`lark_parser`).
+_LARK_OPTIONS = {"parser": "lalr", "start": ["line", "body"], "maybe_placeholders": True}
+
+
+def lark_cache_path(text: str) -> Path:
+    """Where the built reference parser is kept between processes: the user's cache directory
+    (``$XDG_CACHE_HOME`` or ``~/.cache``), ``helmcheck/``, a file named for the grammar's text, the
+    parser's options and the Lark and Python versions (SHA-256: another grammar never loads it)."""
+    import hashlib
+    import sys
+
+    import lark
+
+    key = hashlib.sha256(f"{text}\0{sorted(_LARK_OPTIONS.items())}\0{lark.__version__}\0{sys.version_info[:2]}"
+                         .encode("utf-8")).hexdigest()[:24]
+    base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
+    return Path(base) / "helmcheck" / f"lark-{key}.pickle"
+
+
 @lru_cache(maxsize=1)
 def lark_parser():
     """The reference parser (LALR, contextual lexer) with ``line`` and ``body`` start rules.
 
     Built on first use only (the Lark engine, locating an error, the property tests): the fast
-    path needs just the rule definitions (:func:`grammar_defs`).
+    path needs just the rule definitions (:func:`grammar_defs`). Building its tables takes most of a
+    second of CPU, so the parser built is kept (:func:`lark_cache_path`, written whole or not at
+    all) and loaded by the next process; a cache that cannot be read or written is built without.
     """
     from lark import Lark
 
-    return Lark(grammar_text(), parser="lalr", start=["line", "body"], maybe_placeholders=True)
+    text = grammar_text()
+    path = lark_cache_path(text)
+    try:
+        with open(path, "rb") as f:
+            return Lark.load(f)
+    except Exception:  # noqa: BLE001 - absent, partial or from elsewhere: built again below
+        pass
+    parser = Lark(text, **_LARK_OPTIONS)
+    tmp = path.with_name(f"{path.name}.{os.getpid()}.tmp")
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True, mode=0o700)
+        with open(tmp, "wb") as f:
+            parser.save(f)
+        os.replace(tmp, path)
+    except OSError:
+        with contextlib.suppress(OSError):
+            tmp.unlink()
+    return parser
 
 
 @lru_cache(maxsize=1)
