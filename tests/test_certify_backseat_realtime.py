@@ -120,6 +120,8 @@ def assert_one_judge(run: dict) -> None:
     assert offline == {cid: c["verdict"] for cid, c in clauses(run).items()}
 
 
+@pytest.mark.skipif(not MATRIX, reason="make matrix's (HELMCHECK_MATRIX=1): on a host busy with make test's workers the "
+                                        "lockout's report can reach this backseat after its last $OMS of the lockout")
 def test_at_x10_on_19200_the_overrun_is_named_and_rh_bs_5_is_non_strict(runs):
     run = runs["x10"]
     r = run["results"]

