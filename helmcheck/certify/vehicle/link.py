@@ -27,6 +27,7 @@ from ...grammar import Discard, Framer
 from ...grammar.wirelog import FROM_VEHICLE, TO_VEHICLE, escape, transmit_time
 from ...profile import Profile
 from ...line.recorder import Recorder
+from ...signals import deferred
 from ...line.transport import Link, LinkClosed
 from .flow import LinkLost
 from .safety import BenchGuard, BenchSafetyRefused
@@ -93,11 +94,15 @@ class TesterLink:
         # round trip the judge measures (RH-TIM-1's slack) by the tester's CPU time.
         t0 = self.now()
         failed = None
-        try:
-            self.link.write_all(raw, timeout=max(2.0, 3 * self.transmit_time(len(raw))))
-        except (LinkClosed, OSError) as e:
-            failed = e
-        t = self.rec.bytes(t0, TO_VEHICLE, raw)
+        # the write and its record are one step: an interruption (Ctrl-C, SIGTERM) that came while
+        # the bytes left raises after they are recorded, never between (the vehicle's answer to a
+        # line the record lacks would be judged an answer to nothing)
+        with deferred():
+            try:
+                self.link.write_all(raw, timeout=max(2.0, 3 * self.transmit_time(len(raw))))
+            except (LinkClosed, OSError) as e:
+                failed = e
+            t = self.rec.bytes(t0, TO_VEHICLE, raw)
         if failed is not None:
             self._lose(f"write failed: {failed}")
         self.bytes_out += len(raw)
