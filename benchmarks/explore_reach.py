@@ -15,7 +15,9 @@ third vehicle) are certified the same way and must get no FAIL.
     .venv/bin/python benchmarks/explore_reach.py [--jobs N] [--seed S] [--families F …] [--only NAME …]
                                                  [--json OUT] [--keep DIR]
 
-Prints one line per vehicle — found on its clause / found elsewhere / missed, the clauses failed,
+Prints one line per vehicle — found on its clause (for a fault of a reading, ``RH-RD-*``: or on the
+clause the traceability table books that reading on, :func:`helmcheck.rules.reading_books`) / found
+elsewhere / missed, the clauses failed,
 and the model coverage the exploration reached on it (transitions, modes, interrupt pairs, timers
 run out) — and the figures per family.
 
@@ -166,11 +168,15 @@ def _vehicle3_case(mutant: str, seed: int, k: float, budget: float | None) -> di
 
 
 def _summary(name: str, clause: str, results: dict, family: str) -> dict:
+    from helmcheck.rules import reading_books
     failed = sorted(c["id"] for c in results["clauses"] if c["verdict"] == "fail")
     ex = (results.get("stats") or {}).get("explore") or {}
+    # a fault of a reading (RH-RD-*) is on its own clause where the traceability table books that
+    # reading's rule (RH-RD-16 -> RH-FRM-5 ...), as the whole certification's sweep counts it
+    books = reading_books().get(clause)
     if not clause:
         outcome = "false-fail" if failed else "clean"  # a conforming configuration
-    elif clause in failed:
+    elif clause in failed or books in failed:
         outcome = "own"
     elif failed:
         outcome = "elsewhere"

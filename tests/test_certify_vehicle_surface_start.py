@@ -10,28 +10,20 @@ the emulator's core in virtual time, behind the certifier's own link and observe
 
 from __future__ import annotations
 
-from helmcheck.certify.vehicle import link as tester_link
-from helmcheck.certify.vehicle.session import Session, frame
-from helmcheck.certify.vehicle.virtual import VirtualLine
-from helmcheck.clauses import vehicle_clauses
+from helmcheck.certify.vehicle.session import frame
 from helmcheck.emulator.core import EmulatorCore
 from helmcheck.emulator.missionfile import DirectoryCatalog, builtin_dir
-from helmcheck.judge import Ledger
-from helmcheck.judge.vehicle import VehicleObserver
 from helmcheck.judge.vehicle.closure import osi_depth_m
-from helmcheck.line.recorder import Recorder
 from helmcheck.profile import emulator_profile
+from tests.virtual_vehicle import certifier_session
 
 K = 20.0
 
 
 def session():
     profile = emulator_profile().replace(time_scale=K)
-    core = EmulatorCore(profile, DirectoryCatalog([builtin_dir()]), start=0.0, time_scale=K, baud=profile.baud)
-    line = VirtualLine(core, profile.baud)
-    observer = VehicleObserver(profile, Ledger([c.id for c in vehicle_clauses()]), time_scale=K, baud=profile.baud)
-    link = tester_link.TesterLink(line, profile, Recorder(None, [], [observer]), clock=line.clock)
-    return Session(link, profile, K, observer)
+    return certifier_session(EmulatorCore(profile, DirectoryCatalog([builtin_dir()]), start=0.0, time_scale=K,
+                                       baud=profile.baud), K)
 
 
 def dived(ses) -> float:

@@ -14,32 +14,24 @@ from __future__ import annotations
 import re
 from types import SimpleNamespace
 
-from helmcheck.certify.vehicle import link as tester_link
 from helmcheck.certify.vehicle.aim import BODIES, WAYS, MissionSurvey, edge_body, targets
 from helmcheck.certify.vehicle.explore import Budget
 from helmcheck.certify.vehicle.interpreter import context
-from helmcheck.certify.vehicle.session import Session, frame
+from helmcheck.certify.vehicle.session import frame
 from helmcheck.certify.vehicle.tour import _Driver
-from helmcheck.certify.vehicle.virtual import VirtualLine
-from helmcheck.clauses import vehicle_clauses
 from helmcheck.emulator.core import EmulatorCore
 from helmcheck.emulator.missionfile import DirectoryCatalog, builtin_dir
-from helmcheck.judge import Ledger
-from helmcheck.judge.vehicle import VehicleObserver
-from helmcheck.line.recorder import Recorder
 from helmcheck.model.transitions import TABLE
 from helmcheck.profile import emulator_profile
+from tests.virtual_vehicle import certifier_session
 
 K = 20.0
 
 
 def _session():
     profile = emulator_profile().replace(time_scale=K)
-    core = EmulatorCore(profile, DirectoryCatalog([builtin_dir()]), start=0.0, time_scale=K, baud=profile.baud)
-    line = VirtualLine(core, profile.baud)
-    observer = VehicleObserver(profile, Ledger([c.id for c in vehicle_clauses()]), time_scale=K, baud=profile.baud)
-    link = tester_link.TesterLink(line, profile, Recorder(None, [], [observer]), clock=line.clock)
-    ses = Session(link, profile, K, observer)
+    ses = certifier_session(EmulatorCore(profile, DirectoryCatalog([builtin_dir()]), start=0.0, time_scale=K,
+                                      baud=profile.baud), K)
     ses.measure_line()
     ses.cover.source = "explore"
     return ses
@@ -156,3 +148,52 @@ def test_RH_SAF_5_without_the_oxflt_extension_no_target_sends_it():
     without = _aim(ses, state, limit=10_000)
     assert without and not [t for t in without
                              if any("OXFLT" in s for s in (*(WAYS[t.way].steps if t.way else ()), *t.fire))]
+
+
+def test_an_aimed_batch_drives_every_band_of_its_list_however_short():
+    """hypothesis counts the ``@initialize`` rule (the verified reset) as a step: an aimed batch's
+    step count is one ``tour`` per band of :data:`~helmcheck.certify.vehicle.tour.TOUR_MAX` targets
+    and one more — one fewer, and a list of eight or fewer targets (a long tour alone) was never
+    driven at all. Checked against hypothesis's own stateful runner."""
+    from hypothesis import settings
+    from hypothesis.stateful import RuleBasedStateMachine, initialize, rule, run_state_machine_as_test
+
+    from helmcheck.certify.vehicle.explore import aimed_steps
+    from helmcheck.certify.vehicle.tour import TOUR_MAX
+
+    for n in (1, TOUR_MAX, TOUR_MAX + 1, 96):
+        bands = []
+
+        class Tour(RuleBasedStateMachine):
+            @initialize()
+            def reset(self):
+                bands.append("reset")
+
+            @rule()
+            def tour(self):
+                bands.append("tour")
+
+        run_state_machine_as_test(Tour, settings=settings(max_examples=1, stateful_step_count=aimed_steps(n),
+                                                          deadline=None, database=None))
+        assert bands == ["reset"] + ["tour"] * -(-n // TOUR_MAX), (n, bands)
+
+
+def test_a_target_no_slice_fits_is_a_batch_of_its_own_when_the_whole_budget_fits_it():
+    """The vehicle's own mission toured to its park's end can cost more than an aimed batch's slice
+    (a third vehicle's 165 s park at ×20): given what is left of the whole budget, the aim returns
+    the richest such target alone; without it, none costing more than the slice."""
+    ses = _session()
+    _drv, state = _driver(ses)
+    everything = _aim(ses, state, limit=10_000)
+    slice_v = 25.0
+    assert any(t.cost_v > slice_v for t in everything)
+
+    def aim(**kw):
+        return targets(ses.cover, ses.edges, ses.profile, MissionSurvey(ses.profile.mission_waypoints), park_wp=None,
+                       park_s=0.0, durations=ses.durations().context(), k=K, line_wall_s=0.05, left_v=slice_v,
+                       lines_sent=state.lines_sent, **kw)
+    short = aim()
+    assert short and all(t.cost_v <= slice_v for t in short)
+    long = aim(whole_v=1e9)
+    assert len(long) == 1 and long[0].cost_v > slice_v
+    assert len(long[0].reaches) == max(len(t.reaches) for t in everything if t.cost_v > slice_v)

@@ -13,16 +13,11 @@ emulator's core with that fault, in virtual time, behind the certifier's own lin
 
 from __future__ import annotations
 
-from helmcheck.certify.vehicle import link as tester_link
 from helmcheck.certify.vehicle.explore import counts
 from helmcheck.certify.vehicle.replay import redrive
-from helmcheck.certify.vehicle.session import Session, frame
-from helmcheck.certify.vehicle.virtual import VirtualLine
-from helmcheck.clauses import vehicle_clauses
-from helmcheck.judge import Ledger
-from helmcheck.judge.vehicle import VehicleObserver
-from helmcheck.line.recorder import Recorder
+from helmcheck.certify.vehicle.session import frame
 from tests.faulty_vehicles import MUTANTS, make_core
+from tests.virtual_vehicle import certifier_session
 
 K = 20.0
 STEPS = [{"send": "$OMLOAD,helmcheck-missing.mis,1*4F\\r\\n", "t": 0.0}, {"expect": "$ACK,2,1,1"}]
@@ -30,12 +25,7 @@ STEPS = [{"send": "$OMLOAD,helmcheck-missing.mis,1*4F\\r\\n", "t": 0.0}, {"expec
 
 def _session(name):
     mutant = next(m for m in MUTANTS if m.name == name) if name else None
-    core = make_core(mutant, K, 0.0)
-    profile = core.profile
-    line = VirtualLine(core, profile.baud)
-    observer = VehicleObserver(profile, Ledger([c.id for c in vehicle_clauses()]), time_scale=K, baud=profile.baud)
-    link = tester_link.TesterLink(line, profile, Recorder(None, [], [observer]), clock=line.clock)
-    return Session(link, profile, K, observer)
+    return certifier_session(make_core(mutant, K, 0.0), K)
 
 
 def _left_in_servo(name):

@@ -4,7 +4,9 @@ For tests that need a conforming vehicle in a precise situation (a fix just as i
 waypoint, a violation just after an unseen arrival): :class:`VirtualVehicle` feeds the core a
 framed command at the present virtual time ``now`` and ticks it until the answer's bytes are out;
 :meth:`VirtualVehicle.write` keeps the wire log without the emulator's own notes (``plant:``,
-model notes), so ``check-log`` has to judge it from the wire alone.
+model notes), so ``check-log`` has to judge it from the wire alone. :func:`certifier_session` puts
+the certifier's own session (its link, recorder and vehicle observer) in front of a core over a
+:class:`~helmcheck.certify.vehicle.virtual.VirtualLine`, for tests of the certifier's steps.
 """
 
 from __future__ import annotations
@@ -18,6 +20,24 @@ from helmcheck.emulator.missionfile import DirectoryCatalog, builtin_dir
 from helmcheck.grammar import checksum_hex
 from helmcheck.grammar.wirelog import WireLogWriter
 from helmcheck.profile import Profile
+
+
+def certifier_session(core: EmulatorCore, k: float):
+    """The certifier's session on ``core`` over a line in virtual time at ``k`` (its profile's baud),
+    every line judged by a vehicle observer of every vehicle clause."""
+    from helmcheck.certify.vehicle import link as tester_link
+    from helmcheck.certify.vehicle.session import Session
+    from helmcheck.certify.vehicle.virtual import VirtualLine
+    from helmcheck.clauses import vehicle_clauses
+    from helmcheck.judge import Ledger
+    from helmcheck.judge.vehicle import VehicleObserver
+    from helmcheck.line.recorder import Recorder
+
+    profile = core.profile
+    line = VirtualLine(core, profile.baud)
+    observer = VehicleObserver(profile, Ledger([c.id for c in vehicle_clauses()]), time_scale=k, baud=profile.baud)
+    link = tester_link.TesterLink(line, profile, Recorder(None, [], [observer]), clock=line.clock)
+    return Session(link, profile, k, observer)
 
 
 def frame(body: str) -> bytes:

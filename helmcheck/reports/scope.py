@@ -236,8 +236,12 @@ def model_coverage_note(results: Mapping[str, Any]) -> str:
     rests = (f"which for this certificate rests on the clause verdicts: each of the {len(scope.claimed)} "
              "claimed clauses judged on the exchanges that exercised it" if scope.certificate else
              "which rests on the clause verdicts alone")
+    tour = ((results.get("stats") or {}).get("explore") or {}).get("long_tour")
+    extended = (f" (the budget was extended by {tour['extended_wall_s']:g} s of wall time at most for one tour "
+                f"of the vehicle's own mission that no batch's share could hold, about {tour['cost_v']:g} s of "
+                "vehicle time)") if tour else ""
     return ("Model coverage is how much of the reference model the exploration's random sequences "
-            "reached within their budget (the fixed test cases are not counted); it is not part of "
+            f"reached within their budget{extended} (the fixed test cases are not counted); it is not part of "
             f"the verdict, {rests}.")
 
 

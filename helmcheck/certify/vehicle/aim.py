@@ -20,7 +20,9 @@ reports; which waypoint parks and for how long, as the observer learnt it) and f
 (each line's wall time at this time scale, in vehicle seconds). The list: the quick targets
 first, by worth per second (:data:`_WORTH`), for a share of what is left of the batch's budget,
 then those that wait take turns with the quick ones left; what does not fit in the budget is left
-out. :mod:`.tour` drives it.
+out. A target that waits longer than a batch's share but fits in what is left of the whole budget
+(a long mission park toured to its end: a third vehicle's is 165 s) is listed alone, once a run,
+for one batch after the budget (:func:`.explore._long_tour`). :mod:`.tour` drives it.
 
 Decisions (the profile is silent): a dive for an ascent goes to 3 m at most (deep enough that the
 lockout ends under water at any ascent rate below 0.15 m/s over 20 s); a park is reached by
@@ -45,7 +47,7 @@ from ...profile import Profile
 from .edges import Edge
 from .safety import BenchGuard
 from .session import frame
-from .modelcover import CONTROL_MODES, INTERRUPTING, ModelCoverage, TIMER_EVENTS
+from .modelcover import ModelCoverage
 from .steps import RAW_KINDS
 
 __all__ = ["Target", "Way", "WAYS", "MissionSurvey", "targets", "BODIES", "edge_body"]
@@ -360,9 +362,12 @@ def _raw_lowercase_ok(body: str) -> bool:
 
 def targets(cover: ModelCoverage, edges, profile: Profile, survey: MissionSurvey, *, park_wp: Optional[int],
             park_s: float, durations: dict, k: float, line_wall_s: float, left_v: float,
-            lines_sent: set, limit: int = 96) -> list[Target]:
+            lines_sent: set, limit: int = 96, whole_v: Optional[float] = None) -> list[Target]:
     """What the next aimed batch goes for (module docstring), best first: at most ``limit``
-    targets that fit in ``left_v`` vehicle seconds. ``edges``: the run's
+    targets that fit in ``left_v`` vehicle seconds — or, when ``whole_v`` (what is left of the
+    whole budget) is given and a target that waits needs more than ``left_v`` but fits in
+    ``whole_v``, the richest such target alone (a *long* batch: the vehicle's own mission toured
+    to its park's end; the caller gives it the time it needs). ``edges``: the run's
     :class:`~.edges.EdgeTally`; ``durations``: the durations' template values (``to``,
     ``opk_s``, ``qpark``); ``lines_sent``: the mutation kinds already sent."""
     claimed = set(profile.commands)
@@ -465,6 +470,9 @@ def targets(cover: ModelCoverage, edges, profile: Profile, survey: MissionSurvey
     per_line = max(line_wall_s * k, 0.05)
     in_lockout = max(1, int((profile.lockout_s - 4.0) / per_line))
     found = {t.key: t for t in _merged(list(found.values()), in_lockout)}
+    long = [t for t in found.values() if left_v < t.cost_v <= (whole_v or 0.0) and t.cost_v >= DEEP_V]
+    if long:  # a target no batch's share fits goes first, in a batch of its own (:func:`.explore.explore`)
+        return [max(long, key=lambda t: (_worth(t), -t.cost_v, t.way, t.fire))]
     out = [t for t in found.values() if t.cost_v <= left_v]
     out.sort(key=lambda t: (-_worth(t) / _cost(t, per_line), t.way, t.fire))
     # the quick targets first, for QUICK_SHARE of what is left of the budget; then those that wait

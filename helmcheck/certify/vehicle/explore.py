@@ -20,7 +20,11 @@ and the exploration's reach kept in ``stats.explore.model_coverage``.
 
 The batches take turns by the time each kind has used (:data:`SHARES`): random sequences that
 wait for nothing, random episodes, and tours aimed at what the run has not reached yet on this
-vehicle (:mod:`.aim` lists it as targets before each aimed batch, :mod:`.tour` drives them).
+vehicle (:mod:`.aim` lists it as targets before each aimed batch, :mod:`.tour` drives them). When
+the budget is spent by time, one target no aimed batch's share could hold (the vehicle's own
+mission toured to its long park's end), if the run has not reached what it reaches, is driven
+after it, the budget extended by its estimated cost and a quarter (:func:`_long_tour`; never when
+``--explore-budget`` is given: that budget is kept as given).
 
 Each example starts from a verified reset, at the surface (a dive before it: the vehicle's GPS fix
 back, :meth:`.session.Session.outwait_surface`), with ``$OLOGL`` and ``$OMLOAD`` in ``S`` so that the
@@ -83,7 +87,7 @@ from .machine import VehicleFailure, machine
 from .tour import TOUR_MAX
 from .replay import save_replay
 
-__all__ = ["explore", "PROFILES", "Budget", "valid_commands", "control_commands", "invalid_lines", "timeouts",
+__all__ = ["explore", "PROFILES", "Budget", "aimed_steps", "valid_commands", "control_commands", "invalid_lines", "timeouts",
            "VehicleFailure"]
 
 
@@ -108,6 +112,14 @@ SHARES = {"shallow": 0.1, "deep": 0.2, "aimed": 0.7}
 AIMED_BATCH = 1
 #: The share of the wall budget one aimed batch may take (its list made for that much).
 AIMED_SLICE = 0.35
+#: A target no aimed batch's share holds (:func:`.aim.targets`, ``whole_v``: the vehicle's own
+#: mission toured to its park's end — a third vehicle's 165 s park and its legs are longer than a
+#: slice at ×20) is driven once, after the budget, which it extends by its estimated cost × this
+#: at most (:func:`_long_tour`).
+LONG_MARGIN = 1.25
+#: … and costs at most this share of the budget (in vehicle seconds): a longer tour is not owed,
+#: the budget asked for was not sized for that vehicle's mission (``--explore-budget`` is).
+LONG_AT_MOST = 0.5
 #: The order the kinds take their first turn (and the tie-break after).
 _FIRST = ("shallow", "aimed", "deep")
 #: The share of the wall budget one finding's shrinking may take (from its first failure); the
@@ -116,6 +128,13 @@ SHRINK_SHARE = 0.2
 
 #: name -> :class:`Budget`
 PROFILES = {"fast": Budget(400, 40, 30.0, 1500.0), "patient": Budget(8, 10, 900.0, 600.0)}
+
+
+def aimed_steps(targets: int) -> int:
+    """hypothesis's ``stateful_step_count`` for an aimed batch of ``targets``: one ``tour`` step per
+    :data:`~.tour.TOUR_MAX` of them, and one for the verified reset — hypothesis counts the
+    ``@initialize`` rule as a step too (with one fewer, a list of eight or fewer was never driven)."""
+    return 1 + -(-targets // TOUR_MAX)
 
 
 def _vehicle_finding(e: BaseException, failures: int) -> bool:
@@ -155,6 +174,8 @@ class _State:
         #: the vehicle's mission as its reports describe it (:mod:`.aim`)
         self.survey = MissionSurvey(max(1, run.p.mission_waypoints))
         self.seq0 = run.session.obs.seq  #: the observer's line count when the exploration began
+        self.long_done = False  #: the long tour after the budget was considered (:func:`_long_tour`)
+        self.long_tour: Optional[dict] = None  #: what it drove, and the extension it took
 
     @property
     def vehicle_spent(self) -> float:
@@ -248,19 +269,48 @@ def _found_clauses(found: dict) -> frozenset:
     return frozenset(c for f in found.values() for c in f["also"])
 
 
-def _aim(run, state) -> list:
+def _aim(run, state, left_v: Optional[float] = None, whole_v: Optional[float] = None) -> list:
     """The targets of the next aimed batch (:func:`.aim.targets`), from what the run reached so far
-    and the vehicle's mission as its reports showed it."""
+    and the vehicle's mission as its reports showed it: those that fit in ``left_v`` vehicle
+    seconds (by default what is left of the batch), or (``whole_v``) one long target alone."""
     session = run.session
     entry = session.obs.missions.entry(run.p.mission)
     park_wp = entry.park_waypoint if entry is not None else None
     park_s = float(entry.parks.get(park_wp) or 0.0) if park_wp is not None else 0.0
-    left_v = min(state.budget.vehicle_s - state.vehicle_spent, (state.batch_end - time.monotonic()) * state.k)
+    if left_v is None:
+        left_v = min(state.budget.vehicle_s - state.vehicle_spent, (state.batch_end - time.monotonic()) * state.k)
     lines = max(1, session.obs.seq - state.seq0)
     per_line = (time.monotonic() - state.t0) / lines
     return targets(state.coverage, session.edges, run.p, state.survey, park_wp=park_wp, park_s=park_s,
                    durations=session.durations().context(), k=state.k, line_wall_s=per_line, left_v=left_v,
-                   lines_sent=state.lines_sent)
+                   lines_sent=state.lines_sent, whole_v=whole_v)
+
+
+def _long_tour(run, state) -> Optional[list]:
+    """Once the budget is spent by time (not by examples): the one target no aimed batch could hold
+    — its estimated cost more than :data:`AIMED_SLICE` of the budget, at most :data:`LONG_AT_MOST`
+    of it; the vehicle's own mission toured to its long park's end — as one more batch,
+    the budget extended by its cost × :data:`LONG_MARGIN` (the tour ends the batch when done).
+    None when nothing is owed: such a target was driven already, none is left uncovered, or the
+    run stopped for another reason (a tester error, the link lost)."""
+    if state.long_done or state.error is not None or state.lost is not None or state.which_spent is None:
+        return None
+    state.long_done = True
+    b, k = state.budget, state.k
+    slice_v = AIMED_SLICE * min(b.vehicle_s, b.wall_s * k)
+    aim = _aim(run, state, left_v=slice_v, whole_v=LONG_AT_MOST * min(b.vehicle_s, b.wall_s * k))
+    if len(aim) != 1 or aim[0].cost_v <= slice_v:
+        return None
+    extra_v = LONG_MARGIN * aim[0].cost_v
+    now = time.monotonic()
+    state.end = state.batch_end = now + extra_v / k
+    state.budget = b._replace(vehicle_s=state.vehicle_spent + extra_v)
+    state.long_tour = {"reaches": list(aim[0].reaches), "cost_v": round(aim[0].cost_v, 1),
+                       "extended_wall_s": round(extra_v / k, 1)}
+    run.session.note(f"exploration: the budget spent; one tour no batch's share could hold, after it "
+                     f"({', '.join(aim[0].reaches)}): about {aim[0].cost_v:.0f} s of vehicle time, the "
+                     f"budget extended by {extra_v / k:.1f} s of wall time at most")
+    return aim
 
 
 def explore(run) -> None:
@@ -308,14 +358,23 @@ def explore(run) -> None:
         batch = 0
         spent_by = dict.fromkeys(SHARES, 0.0)  # wall seconds spent on each kind of batch
         aim_empty = False
-        while done < examples and not state.spent:
+        while done < examples:
+            long_aim = None
+            if state.spent:  # the budget is spent: one long tour after it, if one is owed (_long_tour)
+                long_aim = _long_tour(run, state) if o.explore_budget_s is None else None
+                if long_aim is None:
+                    break
             # a clause found is not stopped at again: the sequences look on for the others
             state.ignored = session.ignore = _found_clauses(state.found)
             state.new_batch()
             order = sorted(SHARES, key=lambda x: (spent_by[x] / SHARES[x], _FIRST.index(x)))
             which = next(x for x in order if not (x == "aimed" and aim_empty))
             n, count = min(BATCH, examples - done), steps
-            if which == "aimed":
+            if long_aim is not None:
+                which = "aimed"
+                kind = machine(state, p, tos, deep=True, aim=long_aim)
+                n, count = 1, aimed_steps(1)
+            elif which == "aimed":
                 state.new_batch(AIMED_SLICE)  # the random batches take their turns between
                 aim = _aim(run, state)
                 if not aim:
@@ -323,7 +382,7 @@ def explore(run) -> None:
                     session.note("exploration: nothing left to aim at")
                     continue
                 kind = machine(state, p, tos, deep=True, aim=aim)
-                n, count = min(AIMED_BATCH, examples - done), -(-len(aim) // TOUR_MAX)
+                n, count = min(AIMED_BATCH, examples - done), aimed_steps(len(aim))
             else:
                 kind = kinds[which == "deep"]
             factory = kind if o.seed is None else seed(o.seed * 1000 + batch)(kind)
@@ -367,6 +426,7 @@ def explore(run) -> None:
                             "budget_spent": spent, "wall_s": round(time.monotonic() - t0, 3),
                             "vehicle_s": round(state.vehicle_spent, 1),
                             "outcome": outcome if error is None else "tester error",
+                            **({"long_tour": state.long_tour} if state.long_tour else {}),
                             "model_coverage": state.coverage.summary()}
     if error is not None:
         first = (str(error).splitlines() or [""])[0][:160]
