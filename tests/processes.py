@@ -1,4 +1,5 @@
-"""Processes helmcheck started for a test run, found through ``/proc``.
+"""Processes helmcheck started for a test run, found through ``/proc``; and the programs a test
+starts itself that announce their port (:func:`announced_port`, :func:`stop`).
 
 Every process helmcheck starts with ``--exec`` carries ``HELMCHECK_PORT`` in its environment
 (and so do its own children). The test session sets :data:`MARKER` in its own environment, which
@@ -9,12 +10,17 @@ process — and nothing of other test runs on the same machine.
 
 from __future__ import annotations
 
+import contextlib
 import os
+import re
+import select
 import signal
+import subprocess
 import uuid
 from pathlib import Path
+from typing import Iterator
 
-__all__ = ["MARKER", "install_marker", "survivors", "descendants", "kill"]
+__all__ = ["MARKER", "install_marker", "survivors", "descendants", "kill", "announced_port", "stop"]
 
 MARKER = "HELMCHECK_TEST_RUN"
 
@@ -100,3 +106,33 @@ def kill(procs: list[tuple[int, str]]) -> None:
             os.kill(pid, signal.SIGKILL)
         except OSError:
             pass
+
+
+def stop(proc: subprocess.Popen, within: float = 10.0) -> None:
+    """Stop a program started in a session of its own (``start_new_session``): SIGTERM to its
+    process group, SIGKILL if it is still there after ``within`` seconds."""
+    if proc.poll() is None:
+        os.killpg(proc.pid, signal.SIGTERM)
+        try:
+            proc.wait(within)
+        except subprocess.TimeoutExpired:
+            os.killpg(proc.pid, signal.SIGKILL)
+            proc.wait()
+
+
+@contextlib.contextmanager
+def announced_port(cmd: list[str], name: str, *, within: float = 20.0,
+                   stderr=subprocess.STDOUT) -> Iterator[str]:
+    """Start ``cmd`` (a vehicle we did not write, a simulator) in a session of its own; it prints
+    ``port: PATH`` first. Yields the port, and stops the program at the end (:func:`stop`).
+    Raises :class:`RuntimeError` naming ``name`` when no port came within ``within`` seconds."""
+    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=stderr, start_new_session=True)
+    try:
+        ready, _, _ = select.select([proc.stdout], [], [], within)
+        line = proc.stdout.readline().decode(errors="replace") if ready else ""
+        m = re.match(r"port: (\S+)", line)
+        if not m:
+            raise RuntimeError(f"{name} did not print its port: {line!r}")
+        yield m.group(1)
+    finally:
+        stop(proc)

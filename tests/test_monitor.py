@@ -37,6 +37,7 @@ from helmcheck.grammar.wirelog import read_records
 from helmcheck.line.pty_link import PtyLink
 from helmcheck.profile import DEFAULT
 from helmcheck.reports.segments import session_files
+from tests import processes
 
 ROOT = Path(__file__).resolve().parents[1]
 BACKSEATS = ROOT / "tests" / "backseats"
@@ -95,13 +96,7 @@ def backseat(port: str, *extra: str, faulty: str = "") -> subprocess.Popen:
 
 
 def stop(proc: subprocess.Popen) -> None:
-    if proc.poll() is None:
-        os.killpg(proc.pid, signal.SIGTERM)
-        try:
-            proc.wait(5)
-        except subprocess.TimeoutExpired:
-            os.killpg(proc.pid, signal.SIGKILL)
-            proc.wait()
+    processes.stop(proc, within=5.0)
 
 
 def offline(d: Path) -> list:

@@ -35,16 +35,15 @@ from __future__ import annotations
 import json
 import os
 import re
-import select
 import shutil
-import signal
 import subprocess
 import sys
-import time
 from contextlib import contextmanager
 from pathlib import Path
 
 import pytest
+
+from tests.processes import announced_port
 
 ROOT = Path(__file__).resolve().parent.parent
 SIM = ROOT.parent / "shared" / "third-party" / "uvc_sim.py"
@@ -70,24 +69,10 @@ def uvc_sim(tmp: Path, k: float, *extra: str, fault: str = ""):
     missions.mkdir(exist_ok=True)
     (missions / "end.mis").write_text(END_MIS)
     program = [str(FAULTY), fault] if fault else [str(SIM)]
-    proc = subprocess.Popen([sys.executable, *program, "--time-scale", f"{k:g}", "--mission-dir", str(missions),
-                             "--log", str(tmp / "sim.log"), *extra],
-                            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, start_new_session=True)
-    try:
-        ready, _, _ = select.select([proc.stdout], [], [], 20.0)
-        line = proc.stdout.readline().decode(errors="replace") if ready else ""
-        m = re.match(r"port: (\S+)", line)
-        assert m, f"uvc_sim.py did not print its port: {line!r}"
+    with announced_port([sys.executable, *program, "--time-scale", f"{k:g}", "--mission-dir", str(missions),
+                         "--log", str(tmp / "sim.log"), *extra], "uvc_sim.py") as port:
         shutil.copy(missions / "conformance.mis", missions / "rule.mis")
-        yield m.group(1)
-    finally:
-        if proc.poll() is None:
-            os.killpg(proc.pid, signal.SIGTERM)
-            try:
-                proc.wait(10)
-            except subprocess.TimeoutExpired:
-                os.killpg(proc.pid, signal.SIGKILL)
-                proc.wait()
+        yield port
 
 
 def certify(tmp: Path, port: str, k: float, profile_text: str, *extra: str) -> tuple[int, dict, str]:

@@ -13,14 +13,13 @@ from __future__ import annotations
 
 import contextlib
 import json
-import os
 import re
-import select
-import signal
 import subprocess
 import sys
 from pathlib import Path
 from typing import Iterator, Optional
+
+from tests.processes import announced_port
 
 ROOT = Path(__file__).resolve().parent.parent
 V3 = ROOT.parent / "shared" / "third-party" / "vehicle3" / "vehicle3.py"
@@ -63,21 +62,8 @@ def vehicle3(tmp: Path, k: float, mutant: str = "", *extra: str) -> Iterator[str
     tmp.mkdir(parents=True, exist_ok=True)
     cmd = [sys.executable, str(V3), "--time-scale", f"{k:g}", *LINE, "--mission-dir", str(tmp / "missions"),
            "--log", str(tmp / "vehicle3.log"), *(("--mutant", mutant) if mutant else ()), *extra]
-    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, start_new_session=True)
-    try:
-        ready, _, _ = select.select([proc.stdout], [], [], 20.0)
-        line = proc.stdout.readline().decode(errors="replace") if ready else ""
-        m = re.match(r"port: (\S+)", line)
-        assert m, f"vehicle3.py did not print its port: {line!r}"
-        yield m.group(1)
-    finally:
-        if proc.poll() is None:
-            os.killpg(proc.pid, signal.SIGTERM)
-            try:
-                proc.wait(10)
-            except subprocess.TimeoutExpired:
-                os.killpg(proc.pid, signal.SIGKILL)
-                proc.wait()
+    with announced_port(cmd, "vehicle3.py") as port:
+        yield port
 
 
 def certify(tmp: Path, port: str, k: float, *args: str, timeout: float = 1800) -> dict:

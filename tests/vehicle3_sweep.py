@@ -25,14 +25,14 @@ import argparse
 import json
 import os
 import re
-import select
-import signal
 import subprocess
 import sys
 import time
 from concurrent.futures import ThreadPoolExecutor
 from contextlib import contextmanager
 from pathlib import Path
+
+from tests.processes import announced_port
 
 ROOT = Path(__file__).resolve().parent.parent
 VEHICLE3 = Path(os.environ.get("HELMCHECK_VEHICLE3", ROOT.parent / "shared" / "third-party" / "vehicle3" / "vehicle3.py"))
@@ -73,22 +73,8 @@ def vehicle3(workdir: Path, k: float, mutant: str = "", baud: int = 115200, late
             "--log", str(workdir / "vehicle.log")]
     if mutant:
         args += ["--mutant", mutant]
-    proc = subprocess.Popen(args, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, start_new_session=True)
-    try:
-        ready, _, _ = select.select([proc.stdout], [], [], 30.0)
-        line = proc.stdout.readline().decode(errors="replace") if ready else ""
-        m = re.match(r"port: (\S+)", line)
-        if not m:
-            raise RuntimeError(f"vehicle3 did not print its port: {line!r}")
-        yield m.group(1)
-    finally:
-        if proc.poll() is None:
-            os.killpg(proc.pid, signal.SIGTERM)
-            try:
-                proc.wait(10)
-            except subprocess.TimeoutExpired:
-                os.killpg(proc.pid, signal.SIGKILL)
-                proc.wait()
+    with announced_port(args, "vehicle3", within=30.0, stderr=subprocess.DEVNULL) as port:
+        yield port
 
 
 def outcome(workdir: Path, code: int, seconds: float) -> dict:
