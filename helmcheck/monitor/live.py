@@ -145,16 +145,8 @@ class LiveJudge:
         starts in a second or two on a small machine): a session started before that would see
         its first findings that much later. False when it is not ready within ``timeout``. Then
         :meth:`follow` tells it the log is there."""
-        end = time.monotonic() + timeout
-        while not self.ready and self.error is None and self._outcome is None:
-            left = end - time.monotonic()
-            if left <= 0 or not self.proc.is_alive() and not self._conn.poll():
-                return False
-            if self._conn.poll(min(left, 0.1)):
-                try:
-                    self._take(self._conn.recv(), [])
-                except (EOFError, OSError):
-                    return False
+        self._receive_until(lambda: self.ready or self.error is not None or self._outcome is not None,
+                            time.monotonic() + timeout, 0.1, [])
         return self.ready
 
     def follow(self) -> None:
@@ -199,23 +191,36 @@ class LiveJudge:
         ``RuntimeError`` when the process failed."""
         self._conn.send(("end", sha256))
         late: list[Finding] = []
-        end = None if timeout is None else time.monotonic() + timeout
-        while self._outcome is None and self.error is None:
-            left = None if end is None else end - time.monotonic()
-            if left is not None and left <= 0:
-                raise RuntimeError("the judging process did not finish in time")
-            if self._conn.poll(min(left, 0.5) if left is not None else 0.5):
-                try:
-                    self._take(self._conn.recv(), late)
-                except (EOFError, OSError):
-                    self.error = self.error or "the judging process ended unexpectedly"
-            elif not self.proc.is_alive():
-                self.poll()
-                self.error = self.error or f"the judging process ended (exit code {self.proc.exitcode})"
+        got = self._receive_until(lambda: self._outcome is not None or self.error is not None,
+                                  None if timeout is None else time.monotonic() + timeout, 0.5, late)
+        if got == "time":
+            raise RuntimeError("the judging process did not finish in time")
+        if got == "closed":
+            self.error = self.error or "the judging process ended unexpectedly"
+        elif got == "gone":
+            self.poll()
+            self.error = self.error or f"the judging process ended (exit code {self.proc.exitcode})"
         self.proc.join(5)
         if self.error is not None:
             raise RuntimeError(self.error)
         return self._outcome, late  # type: ignore[return-value]
+
+    def _receive_until(self, done, end: Optional[float], step: float, into: list) -> str:
+        """Take the process's messages (findings into ``into``) until ``done()``: ``"done"``;
+        ``"time"`` when ``end`` (monotonic) passed first, ``"closed"`` when the pipe ended,
+        ``"gone"`` when the process ended with nothing more sent."""
+        while not done():
+            left = None if end is None else end - time.monotonic()
+            if left is not None and left <= 0:
+                return "time"
+            if self._conn.poll(step if left is None else min(left, step)):
+                try:
+                    self._take(self._conn.recv(), into)
+                except (EOFError, OSError):
+                    return "closed"
+            elif not self.proc.is_alive():
+                return "gone"
+        return "done"
 
     def stop(self) -> None:
         """End the process now (nothing is judged any more)."""
