@@ -65,7 +65,9 @@ _LARK_OPTIONS = {"parser": "lalr", "start": ["line", "body"], "maybe_placeholder
 def lark_cache_path(text: str) -> Path:
     """Where the built reference parser is kept between processes: the user's cache directory
     (``$XDG_CACHE_HOME`` or ``~/.cache``), ``helmcheck/``, a file named for the grammar's text, the
-    parser's options and the Lark and Python versions (SHA-256: another grammar never loads it)."""
+    parser's options and the Lark and Python versions (SHA-256). Lark checks its cache's grammar
+    too, but one file for all would be rebuilt and rewritten each time two checkouts of different
+    grammars (or two interpreters) take turns: a file each keeps both built."""
     import hashlib
     import sys
 
