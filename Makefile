@@ -9,7 +9,7 @@ PY     := $(VENV)/bin/python
 unexport PYTHONDONTWRITEBYTECODE
 STAMP  := $(VENV)/.installed
 
-.PHONY: demo example-report test fuzz bench docs clean explore-reach matrix help-examples
+.PHONY: demo example-report test fuzz bench docs clean explore-reach matrix help-examples durations
 
 #: The property tests, for `make fuzz`.
 FUZZ_TESTS := tests/test_grammar_fastpath.py tests/test_grammar_framer.py tests/test_grammar_roundtrip.py \
@@ -44,6 +44,11 @@ TEST_WORKERS ?= 7
 
 test: $(STAMP)
 	$(PY) -m pytest -n $(TEST_WORKERS) --dist loadgroup
+
+# make test, recording each test's wall time into tests/durations.json: make test starts the
+# longest first (tests/conftest.py). Run it after adding or moving slow tests, on a quiet machine.
+durations: $(STAMP)
+	HELMCHECK_DURATIONS=$(CURDIR)/tests/durations.json $(PY) -m pytest -n $(TEST_WORKERS) --dist loadgroup
 
 # Not run by CI: the same property tests with random seeds and 20 times the examples
 # (tests/conftest.py, profile "fuzz"). A failure prints the blob that reproduces it.
@@ -82,9 +87,10 @@ explore-reach: $(STAMP)
 # independent simulator's own mission rule as the trigger and every other of its faulty variants
 # (make test: the third vehicle's, every third variant); the third vehicle's whole certificate under its
 # own mission rule (make test: its lockout clauses); ACKs 2.5 s late live, one re-run of two
-# reproducing an exploration finding, Ctrl-C of a two-job check-log (make test: their neighbours).
+# reproducing an exploration finding, Ctrl-C of a two-job check-log (make test: their neighbours);
+# the README's backseat and ci journeys run twice (make test: once; sign's runs twice).
 matrix: $(STAMP)
-	HELMCHECK_MATRIX=1 $(PY) -m pytest -n 2 tests/test_line_budget.py tests/test_slow_line.py tests/test_unplugged.py tests/test_bad_line.py tests/test_third_party_vehicle.py tests/test_explore_replays.py tests/test_vehicle3.py tests/test_readings.py tests/test_certify_backseat_realtime.py tests/test_vehicle3_mutants.py tests/test_explore_vehicle3.py tests/test_emulator_freedoms.py tests/test_certify_vehicle_mutants.py tests/test_ack_window_bounds.py tests/test_explore_rules.py tests/test_checklog_fleet.py
+	HELMCHECK_MATRIX=1 $(PY) -m pytest -n 2 tests/test_line_budget.py tests/test_slow_line.py tests/test_unplugged.py tests/test_bad_line.py tests/test_third_party_vehicle.py tests/test_explore_replays.py tests/test_vehicle3.py tests/test_readings.py tests/test_certify_backseat_realtime.py tests/test_vehicle3_mutants.py tests/test_explore_vehicle3.py tests/test_emulator_freedoms.py tests/test_certify_vehicle_mutants.py tests/test_ack_window_bounds.py tests/test_explore_rules.py tests/test_checklog_fleet.py tests/test_readme_walkthroughs.py
 
 # Not run by CI (several minutes): every --help example, the slow ones and those that need a
 # vehicle too (run against the emulator on their port); make test runs the others.

@@ -15,7 +15,9 @@ the session, every results directory under this worker's base temporary director
 ``make test`` runs the suite on several workers (pytest-xdist, ``--dist loadgroup``): a module
 whose tests share a module-scoped run marks itself ``xdist_group`` so the run happens once, and
 the full signed emulator certification (:func:`full_emulator_run`) is shared by the tests of the
-group ``full-emulator-run``.
+group ``full-emulator-run``. The longest tests are collected first (their wall times measured by
+``make durations`` into ``tests/durations.json``), so that the workers start the long waits on
+scaled time first and the suite does not end on one of them.
 """
 
 import os
@@ -43,17 +45,47 @@ PROFILE = os.environ.get("HYPOTHESIS_PROFILE", "default")
 settings.load_profile(PROFILE)
 
 
-#: Test files whose tests each take a minute or more of waiting on scaled time: collected first,
-#: so that the workers start them first and the suite's wall time is not their tail.
-LONG_FIRST = ("test_third_party_vehicle.py", "test_vehicle3.py", "test_readme_walkthroughs.py", "test_emulator_freedoms.py",
-              "test_certify_vehicle.py", "test_verify.py")
+#: Each test's wall time in a full ``make test`` (seconds, those of a second or more), measured
+#: by ``make durations`` (``HELMCHECK_DURATIONS=FILE``: :func:`pytest_sessionfinish` writes them).
+DURATIONS = ROOT / "tests" / "durations.json"
+#: What a test not in :data:`DURATIONS` is taken to last.
+UNKNOWN_S = 1.0
+
+
+def _durations() -> dict:
+    try:
+        import json
+        return json.loads(DURATIONS.read_text())
+    except (OSError, ValueError):
+        return {}
+
+
+def _plain(nodeid: str) -> str:
+    """A test's id without the ``@group`` suffix ``--dist loadgroup`` gives it."""
+    head, _, tail = nodeid.rpartition("@")
+    return head if head and not any(c in tail for c in "[]:/") else nodeid
+
+
+def _group(item) -> str:
+    m = item.get_closest_marker("xdist_group")
+    return (m.args[0] if m and m.args else m.kwargs.get("name", "")) if m else ""
 
 
 def pytest_collection_modifyitems(config, items):  # noqa: ARG001 - pytest hook signature
-    """The longest tests first (:data:`LONG_FIRST`). Under ``fuzz``, scale every property test's
-    own ``max_examples`` and drop its ``derandomize``, so tests that fix their example count get
-    more examples too."""
-    items.sort(key=lambda item: 0 if item.path.name in LONG_FIRST else 1)
+    """The longest first (:data:`DURATIONS`; a ``xdist_group`` by its tests' sum, its tests
+    together): the workers start the long waits on scaled time first, and the suite's wall time is
+    not their tail. Under ``fuzz``, scale every property test's own ``max_examples`` and drop its
+    ``derandomize``, so tests that fix their example count get more examples too."""
+    known = _durations()
+    own = {item.nodeid: known.get(_plain(item.nodeid), UNKNOWN_S) for item in items}
+    groups: dict = {}
+    for item in items:
+        g = _group(item)
+        if g:
+            groups[g] = groups.get(g, 0.0) + own[item.nodeid]
+    order = {item.nodeid: i for i, item in enumerate(items)}
+    items.sort(key=lambda item: (-(groups[_group(item)] if _group(item) else own[item.nodeid]), _group(item),
+                                 order[item.nodeid]))
     if PROFILE != "fuzz":
         return
     for item in items:
@@ -79,6 +111,26 @@ def no_process_left_behind():
     if left:
         kill(left)
         pytest.fail(f"processes started by helmcheck survived the test session: {left}", pytrace=False)
+
+
+_WALL: dict = {}
+
+
+def pytest_runtest_logreport(report):
+    """Each test's wall time, setup and teardown included (for ``make durations``)."""
+    if os.environ.get("HELMCHECK_DURATIONS"):
+        key = _plain(report.nodeid)
+        _WALL[key] = _WALL.get(key, 0.0) + report.duration
+
+
+def pytest_sessionfinish(session):
+    """``HELMCHECK_DURATIONS=FILE``: the tests' wall times (a second or more), where the reports
+    gather (the controller, under xdist), for :data:`DURATIONS`."""
+    out = os.environ.get("HELMCHECK_DURATIONS")
+    if not out or os.environ.get("PYTEST_XDIST_WORKER"):
+        return
+    import json
+    Path(out).write_text(json.dumps({k: round(v, 1) for k, v in sorted(_WALL.items()) if v >= 1.0}, indent=0) + "\n")
 
 
 def pytest_configure(config):

@@ -24,7 +24,7 @@ from helmcheck.reports.results import add_clause, finish, new_results
 from helmcheck.reports.view import VERDICT_LABEL
 from tests.faulty_vehicles import EMU_PROFILE, MUTANTS, make_core, serve
 
-FAULTY = ("no-ack-for-osd", "lowercase-checksum-out", "servo-timeout-ignored")
+FAULTY = ("wrong-err-number", "lowercase-checksum-out", "servo-timeout-ignored")
 K = 25.0
 HOSTILE = "<script>alert(1)</script>"
 
