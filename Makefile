@@ -55,7 +55,7 @@ durations: $(STAMP)
 fuzz: $(STAMP)
 	HYPOTHESIS_PROFILE=fuzz $(PY) -m pytest $(FUZZ_TESTS)
 
-# Not run by CI (about 15 minutes): the exploration alone against every faulty vehicle of the
+# Not run by CI (about 45 minutes): the exploration alone against every faulty vehicle of the
 # suite (tests/test_explore_reach.py, benchmarks/explore_reach.py).
 explore-reach: $(STAMP)
 	HELMCHECK_REACH=1 $(PY) -m pytest -q tests/test_explore_reach.py

@@ -9,7 +9,7 @@ clause selected (RH-POS-1), the ``fast`` budget and a fixed seed (``benchmarks/e
 * no conforming configuration (the emulator, the independent simulator) gets a FAIL;
 * every replay a run saved fails again on a fresh instance of the same vehicle.
 
-It runs some 110 certifications (about 35 minutes on two cores, 2 at a time), so ``make test`` leaves it out:
+It runs some 130 certifications (about 45 minutes on two cores, 2 at a time), so ``make test`` leaves it out:
 it runs when ``HELMCHECK_REACH=1`` is set, as ``make explore-reach`` does.
 """
 
