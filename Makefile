@@ -40,7 +40,7 @@ example-report: $(STAMP)
 	$(PY) -m helmcheck.demo --out reports/demo
 
 # The suite mostly waits on ptys and scaled time, so it runs on more workers than cores.
-TEST_WORKERS ?= 7
+TEST_WORKERS ?= 8
 
 test: $(STAMP)
 	$(PY) -m pytest -n $(TEST_WORKERS) --dist loadgroup

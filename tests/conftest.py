@@ -21,6 +21,7 @@ scaled time first and the suite does not end on one of them.
 """
 
 import os
+import signal
 import sys
 from pathlib import Path
 
@@ -30,6 +31,13 @@ from hypothesis import HealthCheck, settings
 ROOT = Path(__file__).resolve().parent.parent
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
+
+# A suite started where SIGINT is ignored (a background job of a script: a shell without job control
+# ignores it for the commands it runs with &) would hand that on to every program it starts, and the
+# tests that interrupt one with SIGINT would see it run on to its end: each test process takes
+# Python's own handler back, so the programs it starts get the default again.
+if signal.getsignal(signal.SIGINT) == signal.SIG_IGN:
+    signal.signal(signal.SIGINT, signal.default_int_handler)
 
 FUZZ_FACTOR = 20
 _QUIET = [HealthCheck.too_slow]
