@@ -24,10 +24,8 @@ FUZZ_TESTS := tests/test_grammar_fastpath.py tests/test_grammar_framer.py tests/
 $(STAMP): pyproject.toml
 	@echo "setting up $(VENV)/ (once, about a minute): a virtual environment for helmcheck"
 	@$(PYTHON) -m venv $(VENV)
-	@echo "  updating pip in $(VENV)/"
-	@$(PY) -m pip install --quiet --upgrade pip
 	@echo "  installing helmcheck from this checkout (editable: your edits run at once) with its test and docs tools"
-	@PYTHONWARNINGS='ignore:Editable installation' $(PY) -m pip install --quiet -e '.[test]'
+	@PYTHONWARNINGS='ignore:Editable installation' $(PY) -m pip install --quiet --disable-pip-version-check -e '.[test]'
 	@touch $(STAMP)
 	@echo "$(VENV)/ is ready"
 
@@ -40,7 +38,7 @@ example-report: $(STAMP)
 	$(PY) -m helmcheck.demo --out reports/demo
 
 # The suite mostly waits on ptys and scaled time, so it runs on more workers than cores.
-TEST_WORKERS ?= 8
+TEST_WORKERS ?= 7
 
 test: $(STAMP)
 	$(PY) -m pytest -n $(TEST_WORKERS) --dist loadgroup

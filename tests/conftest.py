@@ -1,9 +1,10 @@
 """Shared pytest setup: hypothesis profiles and the repository root on sys.path.
 
 ``make test`` does not depend on chance: the default profile is derandomised (the examples are
-a function of the test alone) and keeps no example database between runs. ``make fuzz``
-(``HYPOTHESIS_PROFILE=fuzz``, never run by CI) runs the same property tests with random seeds,
-a database, and :data:`FUZZ_FACTOR` times the examples each test asks for.
+a function of the test alone; :data:`DEFAULT_EXAMPLES` each where a test sets no count) and keeps
+no example database between runs. ``make fuzz`` (``HYPOTHESIS_PROFILE=fuzz``, never run by CI)
+runs the same property tests with random seeds, a database, and :data:`FUZZ_FACTOR` times the
+examples each test asks for (at least 100 × :data:`FUZZ_FACTOR`).
 
 It also checks that no process helmcheck started (``--exec``) outlives the test session, and
 that every results directory a test writes verifies (live and offline judging agree): after
@@ -42,7 +43,9 @@ if signal.getsignal(signal.SIGINT) == signal.SIG_IGN:
 FUZZ_FACTOR = 20
 _QUIET = [HealthCheck.too_slow]
 
-settings.register_profile("default", deadline=None, max_examples=100, derandomize=True, database=None,
+#: Examples a property test without its own count gets in ``make test`` (``make fuzz``: 2000, random).
+DEFAULT_EXAMPLES = 50
+settings.register_profile("default", deadline=None, max_examples=DEFAULT_EXAMPLES, derandomize=True, database=None,
                           suppress_health_check=_QUIET)
 settings.register_profile("ci", parent=settings.get_profile("default"))
 settings.register_profile("fuzz", deadline=None, max_examples=100 * FUZZ_FACTOR, derandomize=False,
