@@ -16,9 +16,10 @@ the session, every results directory under this worker's base temporary director
 ``make test`` runs the suite on several workers (pytest-xdist, ``--dist loadgroup``): a module
 whose tests share a module-scoped run marks itself ``xdist_group`` so the run happens once, and
 the full signed emulator certification (:func:`full_emulator_run`) is shared by the tests of the
-group ``full-emulator-run``. The longest tests are collected first (their wall times measured by
-``make durations`` into ``tests/durations.json``), so that the workers start the long waits on
-scaled time first and the suite does not end on one of them.
+group ``full-emulator-run``. The tests that wait longest on scaled time are collected first, each
+followed by a few short ones (their wall times measured by ``make durations`` into
+``tests/durations.json``), so that the workers start the long waits first and the suite does not
+end on one of them, nor on all the CPU-bound short tests at once.
 """
 
 import os
@@ -82,21 +83,35 @@ def _group(item) -> str:
     return (m.args[0] if m and m.args else m.kwargs.get("name", "")) if m else ""
 
 
+#: A test (or ``xdist_group``) that lasts this long or more waits on scaled time: these start first …
+WAITS_S = 15.0
+#: … each followed by this many of the others, longest first: the CPU the waits leave idle goes to
+#: the tests that need it, instead of all of those running last, on two cores, after the waits.
+BETWEEN = 3
+
+
 def pytest_collection_modifyitems(config, items):  # noqa: ARG001 - pytest hook signature
-    """The longest first (:data:`DURATIONS`; a ``xdist_group`` by its tests' sum, its tests
-    together): the workers start the long waits on scaled time first, and the suite's wall time is
-    not their tail. Under ``fuzz``, scale every property test's own ``max_examples`` and drop its
+    """The order (:data:`DURATIONS`; a ``xdist_group`` counts as its tests' sum, its tests kept
+    together): the tests that wait on scaled time longest first, each followed by :data:`BETWEEN`
+    of the others, longest first — the long waits start early and the suite's wall time is not
+    their tail, and the short tests' CPU work fills the time the waits leave the processors idle.
+    Under ``fuzz``, scale every property test's own ``max_examples`` and drop its
     ``derandomize``, so tests that fix their example count get more examples too."""
     known = _durations()
-    own = {item.nodeid: known.get(_plain(item.nodeid), UNKNOWN_S) for item in items}
-    groups: dict = {}
+    units: dict = {}  #: a group's tests together, else one test each, in collection order
     for item in items:
-        g = _group(item)
-        if g:
-            groups[g] = groups.get(g, 0.0) + own[item.nodeid]
-    order = {item.nodeid: i for i, item in enumerate(items)}
-    items.sort(key=lambda item: (-(groups[_group(item)] if _group(item) else own[item.nodeid]), _group(item),
-                                 order[item.nodeid]))
+        units.setdefault(_group(item) or item.nodeid, []).append(item)
+    cost = {k: sum(known.get(_plain(i.nodeid), UNKNOWN_S) for i in v) for k, v in units.items()}
+    ranked = sorted(units, key=lambda k: -cost[k])  # stable: collection order among equals
+    waits = [k for k in ranked if cost[k] >= WAITS_S]
+    rest = [k for k in ranked if cost[k] < WAITS_S]
+    out: list = []
+    while waits or rest:
+        if waits:
+            out.append(waits.pop(0))
+        out += rest[:BETWEEN]
+        del rest[:BETWEEN]
+    items[:] = [i for k in out for i in units[k]]
     if PROFILE != "fuzz":
         return
     for item in items:
